@@ -1,1 +1,5 @@
-//! wip
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+
+pub mod kmc;
+pub mod pty;
