@@ -5,6 +5,7 @@
 mod datagram;
 pub mod le;
 mod stream;
+pub mod timing;
 
 pub use datagram::DatagramCodec;
 pub use stream::{DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};
