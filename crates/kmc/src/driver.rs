@@ -340,6 +340,30 @@ impl Driver {
         state.queue.pop_front()
     }
 
+    /// Received frames until `deadline`: each as it arrives, ending at the deadline.
+    ///
+    /// Use it between two `set_command` calls, so that a steady flow of responses cannot keep
+    /// the loop from refreshing the command (which then times out and stops the chassis):
+    ///
+    /// ```no_run
+    /// # use std::time::{Duration, Instant};
+    /// # let driver = kmc::Driver::new("/dev/ttyUSB0", Default::default())?;
+    /// loop {
+    ///     driver.set_command(0.5, 0.0)?;
+    ///     for frame in driver.messages_until(Instant::now() + Duration::from_millis(50)) {
+    ///         println!("{frame:?}");
+    ///     }
+    /// }
+    /// # Ok::<(), kmc::KmcError>(())
+    /// ```
+    pub fn messages_until(&self, deadline: std::time::Instant) -> impl Iterator<Item = ChassisFrame> + '_ {
+        std::iter::from_fn(move || {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            if left.is_zero() { self.try_pop_message() } else { self.wait_pop_message(left) }
+        })
+        .take_while(move |_| std::time::Instant::now() <= deadline)
+    }
+
     fn request(&self, request: Request) -> Result<(), KmcError> {
         match &self.running {
             Some(running) if !running.thread.is_finished() => {

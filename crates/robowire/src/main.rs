@@ -1,1 +1,51 @@
-fn main(){}
+//! `robowire`: run the demo on the built-in simulators, run a simulator alone, talk to a real
+//! device, or decode frames.
+
+mod decode;
+mod demo;
+mod hex;
+mod kmc_cmd;
+mod sim;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// robowire: low-level robot protocols, with built-in simulators.
+#[derive(Debug, Parser)]
+#[command(name = "robowire", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Drive every simulated device through its client API and report what was seen.
+    Demo(demo::DemoArgs),
+    /// Run a device simulator alone, for your own client to talk to.
+    #[command(subcommand)]
+    Sim(sim::SimCommand),
+    /// Talk to a KMC wheeled chassis over a serial port.
+    Kmc(kmc_cmd::KmcArgs),
+    /// Decode frames from hex and print them.
+    #[command(subcommand)]
+    Decode(decode::DecodeCommand),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(args) => demo::run(&args),
+        Command::Sim(command) => sim::run(command),
+        Command::Kmc(args) => kmc_cmd::run(args),
+        Command::Decode(command) => decode::run(&command),
+    };
+    match result {
+        Ok(code) => code,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! `robowire kmc --port PATH …`: a real (or simulated) chassis.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, bail};
+use clap::{Args, Subcommand};
+use kmc::{BlockingUartClient, ChassisFrame, Driver, DriverOptions, SerialPortOptions};
+
+#[derive(Debug, Args)]
+pub(crate) struct KmcArgs {
+    /// Serial device of the chassis, e.g. /dev/ttyUSB0 (or the path `robowire sim kmc` prints).
+    #[arg(long)]
+    port: PathBuf,
+    /// Baud rate.
+    #[arg(long, default_value_t = 115_200)]
+    baud: u32,
+    /// Turn RTS/CTS hardware flow control off (it is on by default, as the chassis expects).
+    #[arg(long)]
+    no_flow_control: bool,
+    #[command(subcommand)]
+    command: KmcCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum KmcCommand {
+    /// Stream a command through the Driver and print what comes back.
+    Drive(DriveArgs),
+    /// Ask for the vehicle speed once.
+    Speed(OneShotArgs),
+    /// Read the battery voltage once.
+    Battery(OneShotArgs),
+    /// Read a motor controller's all-state record once.
+    AllState(OneShotArgs),
+}
+
+#[derive(Debug, Args)]
+struct DriveArgs {
+    /// Forward velocity, m/s (negative reverses).
+    #[arg(long, allow_hyphen_values = true)]
+    velocity: f32,
+    /// Yaw rate, rad/s (dropped when |velocity| <= 1 mm/s: the chassis cannot turn in place).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    yaw_rate: f32,
+    /// How long to drive, s; then the stop burst.
+    #[arg(long, default_value_t = 5.0)]
+    duration: f64,
+    /// Don't poll the battery (1 Hz) and the all-state records (10 Hz).
+    #[arg(long)]
+    no_polls: bool,
+}
+
+#[derive(Debug, Args)]
+struct OneShotArgs {
+    /// Motor controller (0 = left, 1 = right).
+    #[arg(long, default_value_t = 0)]
+    motor: u8,
+    /// How long to wait for the answer, ms.
+    #[arg(long, default_value_t = 1000)]
+    timeout_ms: u64,
+}
+
+pub(crate) fn run(args: KmcArgs) -> anyhow::Result<ExitCode> {
+    let serial = SerialPortOptions {
+        baud_rate: args.baud,
+        rts_cts_flow_control: !args.no_flow_control,
+        ..SerialPortOptions::default()
+    };
+    match args.command {
+        KmcCommand::Drive(drive) => run_drive(&args.port, serial, &drive),
+        KmcCommand::Speed(one) => one_shot(&args.port, &serial, &one, "vehicle speed", |c, _| c.request_vehicle_speed()),
+        KmcCommand::Battery(one) => one_shot(&args.port, &serial, &one, "battery voltage", |c, m| c.request_battery_voltage(m)),
+        KmcCommand::AllState(one) => one_shot(&args.port, &serial, &one, "all-state", |c, m| c.request_all_state(m)),
+    }
+}
+
+fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> anyhow::Result<ExitCode> {
+    if !(args.duration.is_finite() && args.duration >= 0.0) {
+        bail!("--duration must be a finite number of seconds, got {}", args.duration);
+    }
+    let options = DriverOptions { serial, poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..Default::default() };
+    let mut driver = Driver::new(port, options)?;
+    // Validate before the port is even opened.
+    driver.set_command(args.velocity, args.yaw_rate).context("refusing to drive")?;
+    driver.start().with_context(|| format!("starting the driver on {}", port.display()))?;
+    println!("driving {:+.3} m/s at {:+.3} rad/s for {:.1} s on {}", args.velocity, args.yaw_rate, args.duration, port.display());
+    let end = Instant::now() + Duration::from_secs_f64(args.duration);
+    while Instant::now() < end {
+        // Refresh well inside the Driver's 300 ms command timeout, printing what arrives.
+        driver.set_command(args.velocity, args.yaw_rate)?;
+        for frame in driver.messages_until((Instant::now() + Duration::from_millis(50)).min(end)) {
+            print_frame(&frame);
+        }
+    }
+    driver.stop().context("sending the stop burst")?;
+    let s = driver.stats();
+    println!(
+        "stopped. sent: control {} (timeout stops {}), stop burst {}, speed requests {}, battery {}, all-state {} | received {} | skipped bytes {}, rejected candidates {} | lateness p50 {} µs p99 {} µs",
+        s.control_frames_sent, s.timeout_frames_sent, s.stop_frames_sent, s.speed_requests_sent, s.battery_requests_sent,
+        s.all_state_requests_sent, s.frames_received, s.link.decoder.skipped_bytes, s.link.decoder.rejected_candidates,
+        s.control_lateness.p50_us, s.control_lateness.p99_us
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn one_shot(
+    port: &PathBuf,
+    serial: &SerialPortOptions,
+    args: &OneShotArgs,
+    what: &str,
+    request: impl Fn(&mut BlockingUartClient, u8) -> Result<(), kmc::KmcError>,
+) -> anyhow::Result<ExitCode> {
+    let mut client = BlockingUartClient::open(port, serial)?;
+    request(&mut client, args.motor)?;
+    match client.poll(Duration::from_millis(args.timeout_ms))? {
+        Some(frame) => {
+            print_frame(&frame);
+            Ok(ExitCode::SUCCESS)
+        }
+        None => bail!("no {what} answer within {} ms", args.timeout_ms),
+    }
+}
+
+fn print_frame(frame: &ChassisFrame) {
+    match frame {
+        ChassisFrame::VehicleSpeed(v) => println!("speed      {:+.3} m/s", v.speed_mps),
+        ChassisFrame::BatteryVoltage(b) => println!("battery    motor {} {:.2} V", b.motor_id, b.volts),
+        ChassisFrame::AllState(s) => println!(
+            "all-state  motor {} id {} position {:.1}° speed {:.1} rpm current {:.2} A temperature {:.1} °C error 0x{:08x}",
+            s.motor_id, s.id, s.position_deg, s.speed_rpm, s.current_a, s.temperature_c, s.error_code
+        ),
+        ChassisFrame::Af(raw) => println!("af         {raw:?}"),
+    }
+}
