@@ -1,0 +1,120 @@
+//! `cargo xtask bench`: runs the criterion benchmarks and prints one table, each figure beside
+//! its baseline measured in the same run, with the ratio and the target from the issues.
+//! Writes the table to `target/bench-report.md` and `target/bench-report.json`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, bail};
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::workspace_root;
+
+/// A criterion bench target to run: package and bench name.
+const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec")];
+
+/// One row of the table.
+#[derive(Debug, Serialize)]
+pub struct Row {
+    /// What was measured.
+    pub path: String,
+    /// The figure.
+    pub figure: String,
+    /// The baseline, measured in the same run.
+    pub baseline: String,
+    /// Figure relative to baseline.
+    pub ratio: String,
+    /// The target from the issues.
+    pub target: String,
+    /// Whether the target is met (`None` when there is no target).
+    pub met: Option<bool>,
+}
+
+fn target_dir(root: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
+}
+
+/// Mean time of one criterion benchmark, ns.
+fn mean_ns(criterion: &Path, group: &str, bench: &str) -> anyhow::Result<f64> {
+    let path = criterion.join(group).join(bench).join("new/estimates.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let value: Value = serde_json::from_str(&text)?;
+    value["mean"]["point_estimate"].as_f64().with_context(|| format!("no mean in {}", path.display()))
+}
+
+/// Runs the benchmarks (`quick`: shorter measurements) and returns the table.
+pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
+    let root = workspace_root();
+    let target = target_dir(&root);
+    std::fs::create_dir_all(&target)?;
+    let meta_path = target.join("bench-meta.json");
+    let times: &[&str] = if quick {
+        &["--warm-up-time", "0.5", "--measurement-time", "1"]
+    } else {
+        &["--warm-up-time", "2", "--measurement-time", "5"]
+    };
+    for (package, bench) in BENCHES {
+        let status = Command::new("cargo")
+            .args(["bench", "-p", package, "--bench", bench, "--"])
+            .args(times)
+            .env("ROBOWIRE_BENCH_META", &meta_path)
+            .current_dir(&root)
+            .status()
+            .context("running cargo bench")?;
+        if !status.success() {
+            bail!("cargo bench -p {package} --bench {bench} failed ({status})");
+        }
+    }
+    let criterion = target.join("criterion");
+    let meta: Value = serde_json::from_str(&std::fs::read_to_string(&meta_path).context("bench metadata")?)?;
+    let mut rows = Vec::new();
+
+    let encode = mean_ns(&criterion, "kmc_encode", "pc_control")?;
+    let copy9 = mean_ns(&criterion, "kmc_encode", "memcpy_9B")?;
+    rows.push(Row {
+        path: "KMC encode 0xA5 (9 B)".into(),
+        figure: format!("{encode:.2} ns/frame"),
+        baseline: format!("memcpy 9 B: {copy9:.2} ns"),
+        ratio: format!("{:.1}×", encode / copy9),
+        target: "–".into(),
+        met: None,
+    });
+    let stream_bytes = meta["kmc_decode_1MiB"]["stream_bytes"].as_f64().context("stream_bytes")?;
+    let copy = mean_ns(&criterion, "kmc_decode_1MiB", "memcpy")?;
+    let copy_mbps = stream_bytes / copy * 1e3;
+    for (bench, label) in [("host_side", "KMC decode, host side (1 MiB mixed)"), ("device_side", "KMC decode, device side (1 MiB mixed)")] {
+        let ns = mean_ns(&criterion, "kmc_decode_1MiB", bench)?;
+        let mbps = stream_bytes / ns * 1e3;
+        let frames = meta["kmc_decode_1MiB"][format!("{bench}_frames")].as_f64().context("frame count")?;
+        rows.push(Row {
+            path: label.into(),
+            figure: format!("{mbps:.0} MB/s, {:.1} M frames/s", frames / ns * 1e3),
+            baseline: format!("memcpy 1 MiB: {copy_mbps:.0} MB/s"),
+            ratio: format!("{:.2} %", 100.0 * mbps / copy_mbps),
+            target: "≥ 200 MB/s".into(),
+            met: Some(mbps >= 200.0),
+        });
+    }
+
+    let markdown = to_markdown(&rows);
+    println!("\n{markdown}");
+    std::fs::write(target.join("bench-report.md"), &markdown)?;
+    std::fs::write(target.join("bench-report.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
+    println!("written: {} and bench-report.json", target.join("bench-report.md").display());
+    Ok(rows)
+}
+
+/// The table as Markdown.
+pub fn to_markdown(rows: &[Row]) -> String {
+    let mut out = String::from("| path | figure | baseline (same run) | ratio | target | met |\n|---|---|---|---|---|---|\n");
+    for r in rows {
+        let met = match r.met {
+            Some(true) => "yes",
+            Some(false) => "**no**",
+            None => "–",
+        };
+        out.push_str(&format!("| {} | {} | {} | {} | {} | {met} |\n", r.path, r.figure, r.baseline, r.ratio, r.target));
+    }
+    out
+}

@@ -1,0 +1,140 @@
+//! `cargo xtask fuzz`: cargo-fuzz targets with seed corpora made from the golden fixtures.
+
+use std::path::Path;
+use std::process::Command;
+
+use anyhow::{Context, bail};
+
+use crate::golden::{kmc_fixture_path, load_kmc};
+use crate::{hex_decode, workspace_root};
+
+/// A fuzz target and where its seeds come from.
+#[derive(Debug, Clone, Copy)]
+pub struct Target {
+    /// cargo-fuzz target name (`fuzz/fuzz_targets/<name>.rs`).
+    pub name: &'static str,
+    /// The fixture direction whose frames seed it.
+    pub direction: &'static str,
+    /// The check it runs, for replay under `cargo test`.
+    pub check: fn(&[u8]),
+}
+
+/// Every fuzz target.
+pub const TARGETS: &[Target] = &[
+    Target { name: "kmc_host_decoder", direction: "chassis->host", check: kmc_proto::harness::chassis_frame_stream },
+    Target { name: "kmc_device_decoder", direction: "host->chassis", check: kmc_proto::harness::host_frame_stream },
+];
+
+/// Seed inputs for `target`: each fixture frame alone and all of them back to back, each with
+/// chunk-size byte 0 (1-byte chunks) and 7 (8-byte chunks). Named for the corpus directory.
+pub fn seeds(target: &Target) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let fixtures = load_kmc(&kmc_fixture_path())?;
+    let mut streams: Vec<(String, Vec<u8>)> = fixtures
+        .iter()
+        .filter(|f| f.direction == target.direction)
+        .map(|f| Ok((f.name.clone(), hex_decode(&f.hex)?)))
+        .collect::<anyhow::Result<_>>()?;
+    if streams.is_empty() {
+        bail!("no fixtures for {} ({})", target.name, target.direction);
+    }
+    let all = streams.iter().flat_map(|(_, bytes)| bytes.clone()).collect();
+    streams.push(("all".into(), all));
+    Ok(streams
+        .into_iter()
+        .flat_map(|(name, stream)| {
+            [0u8, 7].map(|chunk| {
+                let mut input = vec![chunk];
+                input.extend_from_slice(&stream);
+                (format!("seed-{name}-chunk{}", chunk + 1), input)
+            })
+        })
+        .collect())
+}
+
+fn has_nightly() -> bool {
+    Command::new("cargo").args(["+nightly", "--version"]).output().is_ok_and(|o| o.status.success())
+}
+
+/// Writes the seeds and runs each selected target for `seconds`.
+///
+/// With a nightly toolchain the targets run under AddressSanitizer; with stable only, with
+/// `-s none` (no sanitizer; the checks in the harness still run).
+pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
+    let root = workspace_root();
+    let fuzz_dir = root.join("fuzz");
+    let version = Command::new("cargo").args(["fuzz", "--version"]).output();
+    if !version.is_ok_and(|o| o.status.success()) {
+        bail!("cargo-fuzz is not installed: cargo install --locked cargo-fuzz");
+    }
+    let targets: Vec<&Target> = TARGETS.iter().filter(|t| only.is_none_or(|name| t.name == name)).collect();
+    if targets.is_empty() {
+        let names: Vec<_> = TARGETS.iter().map(|t| t.name).collect();
+        bail!("unknown fuzz target {only:?}; targets: {}", names.join(", "));
+    }
+    let nightly = has_nightly() && std::env::var("ROBOWIRE_FUZZ_STABLE").is_err();
+    for target in targets {
+        let corpus = fuzz_dir.join("corpus").join(target.name);
+        std::fs::create_dir_all(&corpus)?;
+        for (name, input) in seeds(target)? {
+            std::fs::write(corpus.join(name), input)?;
+        }
+        let mut command = Command::new("cargo");
+        if nightly {
+            command.arg("+nightly");
+        }
+        command.args(["fuzz", "run"]);
+        if !nightly {
+            command.args(["-s", "none"]);
+        }
+        command.arg(target.name).arg(&corpus).arg("--").arg(format!("-max_total_time={seconds}"));
+        println!(
+            "fuzz {} for {seconds} s ({})",
+            target.name,
+            if nightly { "nightly, AddressSanitizer" } else { "stable, -s none" }
+        );
+        let status = command.current_dir(&root).status().context("running cargo fuzz")?;
+        if !status.success() {
+            bail!(
+                "fuzz target {} failed ({status}); the input is under {}; commit it to {} to replay it in cargo test",
+                target.name,
+                display(&fuzz_dir.join("artifacts").join(target.name)),
+                display(&fuzz_dir.join("regressions").join(target.name))
+            );
+        }
+    }
+    Ok(())
+}
+
+fn display(path: &Path) -> String {
+    path.display().to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The seed corpus, replayed through the checks the fuzz targets run.
+    #[test]
+    fn seed_corpus_replays() {
+        for target in TARGETS {
+            let seeds = seeds(target).unwrap();
+            assert!(seeds.len() >= 4, "{}", target.name);
+            for (_, input) in seeds {
+                (target.check)(&input);
+            }
+        }
+    }
+
+    /// Inputs committed under `fuzz/regressions/<target>/` (crashes the fuzzer found, once
+    /// fixed) are replayed too.
+    #[test]
+    fn committed_regressions_replay() {
+        for target in TARGETS {
+            let dir = workspace_root().join("fuzz/regressions").join(target.name);
+            let Ok(entries) = std::fs::read_dir(&dir) else { continue };
+            for entry in entries {
+                (target.check)(&std::fs::read(entry.unwrap().path()).unwrap());
+            }
+        }
+    }
+}

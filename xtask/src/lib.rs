@@ -1,0 +1,33 @@
+//! robowire project automation, as a library so that its checks also run under `cargo test`.
+
+pub mod bench;
+pub mod fuzz;
+pub mod golden;
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+
+/// The workspace root (the parent of `xtask/`).
+pub fn workspace_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).parent().map(PathBuf::from).unwrap_or_default()
+}
+
+/// Bytes from lowercase or uppercase hex without separators.
+pub fn hex_decode(text: &str) -> anyhow::Result<Vec<u8>> {
+    if text.len() % 2 != 0 {
+        bail!("odd number of hex digits in {text:?}");
+    }
+    (0..text.len())
+        .step_by(2)
+        .map(|i| {
+            let pair = text.get(i..i + 2).context("non-ASCII hex")?;
+            u8::from_str_radix(pair, 16).with_context(|| format!("{pair:?} is not hex"))
+        })
+        .collect()
+}
+
+/// Lowercase hex without separators.
+pub fn hex_encode(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
