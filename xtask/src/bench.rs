@@ -83,7 +83,9 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let stream_bytes = meta["kmc_decode_1MiB"]["stream_bytes"].as_f64().context("stream_bytes")?;
     let copy = mean_ns(&criterion, "kmc_decode_1MiB", "memcpy")?;
     let copy_mbps = stream_bytes / copy * 1e3;
-    for (bench, label) in [("host_side", "KMC decode, host side (1 MiB mixed)"), ("device_side", "KMC decode, device side (1 MiB mixed)")] {
+    for (bench, label) in
+        [("host_side", "KMC decode, host side (1 MiB mixed)"), ("device_side", "KMC decode, device side (1 MiB mixed)")]
+    {
         let ns = mean_ns(&criterion, "kmc_decode_1MiB", bench)?;
         let mbps = stream_bytes / ns * 1e3;
         let frames = meta["kmc_decode_1MiB"][format!("{bench}_frames")].as_f64().context("frame count")?;
@@ -107,7 +109,8 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
 
 /// The table as Markdown.
 pub fn to_markdown(rows: &[Row]) -> String {
-    let mut out = String::from("| path | figure | baseline (same run) | ratio | target | met |\n|---|---|---|---|---|---|\n");
+    let mut out =
+        String::from("| path | figure | baseline (same run) | ratio | target | met |\n|---|---|---|---|---|---|\n");
     for r in rows {
         let met = match r.met {
             Some(true) => "yes",

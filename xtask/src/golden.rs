@@ -5,7 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use kmc_proto::{ChassisFrame, ChassisFrameDecoder, FrameBuffer, HostFrame, HostFrameDecoder, MAX_FRAME_LEN};
+use kmc_proto::{
+    ChassisFrame, ChassisFrameDecoder, DecoderCounters, EncodeError, FrameBuffer, HostFrame, HostFrameDecoder,
+    MAX_FRAME_LEN, StreamDecoder,
+};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -87,28 +90,16 @@ fn check_one(fixture: &KmcFixture) -> anyhow::Result<(Option<Value>, Vec<String>
 fn check_streams(fixtures: &[KmcFixture]) -> anyhow::Result<Vec<String>> {
     let mut problems = Vec::new();
     for direction in ["host->chassis", "chassis->host"] {
-        let frames: Vec<Vec<u8>> =
-            fixtures.iter().filter(|f| f.direction == direction).map(|f| hex_decode(&f.hex)).collect::<Result<_, _>>()?;
+        let frames: Vec<Vec<u8>> = fixtures
+            .iter()
+            .filter(|f| f.direction == direction)
+            .map(|f| hex_decode(&f.hex))
+            .collect::<Result<_, _>>()?;
         let stream = frames.concat();
-        let mut decoded = Vec::new();
-        let counters = if direction == "host->chassis" {
-            let mut rx: FrameBuffer<HostFrameDecoder, 128> = FrameBuffer::new(HostFrameDecoder::new());
-            for byte in &stream {
-                rx.push_all(std::slice::from_ref(byte), |f| {
-                    let mut out = [0u8; MAX_FRAME_LEN];
-                    decoded.push(f.emit(&mut out).map(|n| out[..n].to_vec()).unwrap_or_default());
-                });
-            }
-            rx.counters()
+        let (decoded, counters) = if direction == "host->chassis" {
+            byte_by_byte(HostFrameDecoder::new(), &stream, HostFrame::emit)
         } else {
-            let mut rx: FrameBuffer<ChassisFrameDecoder, 128> = FrameBuffer::new(ChassisFrameDecoder::new());
-            for byte in &stream {
-                rx.push_all(std::slice::from_ref(byte), |f| {
-                    let mut out = [0u8; MAX_FRAME_LEN];
-                    decoded.push(f.emit(&mut out).map(|n| out[..n].to_vec()).unwrap_or_default());
-                });
-            }
-            rx.counters()
+            byte_by_byte(ChassisFrameDecoder::new(), &stream, ChassisFrame::emit)
         };
         if decoded != frames || counters.skipped_bytes != 0 || counters.rejected_candidates != 0 {
             problems.push(format!(
@@ -121,6 +112,23 @@ fn check_streams(fixtures: &[KmcFixture]) -> anyhow::Result<Vec<String>> {
     Ok(problems)
 }
 
+/// Feeds `stream` one byte at a time; returns the re-encoded frames and the counters.
+fn byte_by_byte<D: StreamDecoder>(
+    decoder: D,
+    stream: &[u8],
+    emit: fn(&D::Frame, &mut [u8]) -> Result<usize, EncodeError>,
+) -> (Vec<Vec<u8>>, DecoderCounters) {
+    let mut rx: FrameBuffer<D, 128> = FrameBuffer::new(decoder);
+    let mut decoded = Vec::new();
+    for byte in stream {
+        rx.push_all(std::slice::from_ref(byte), |f| {
+            let mut out = [0u8; MAX_FRAME_LEN];
+            decoded.push(emit(&f, &mut out).map(|n| out[..n].to_vec()).unwrap_or_default());
+        });
+    }
+    (decoded, rx.counters())
+}
+
 /// Runs the KMC suite on `path`; with `bless`, rewrites mismatching `fields` and saves.
 pub fn check_kmc(path: &Path, bless: bool) -> anyhow::Result<Vec<Outcome>> {
     let mut fixtures = load_kmc(path)?;
@@ -129,15 +137,14 @@ pub fn check_kmc(path: &Path, bless: bool) -> anyhow::Result<Vec<Outcome>> {
     for fixture in &mut fixtures {
         let (fields, mut problems) = check_one(fixture)?;
         let mut blessed = false;
-        if bless {
-            if let Some(fields) = fields {
-                if fields != fixture.fields {
-                    fixture.fields = fields;
-                    blessed = true;
-                    changed = true;
-                    problems.retain(|p| !p.starts_with("decoded "));
-                }
-            }
+        if bless
+            && let Some(fields) = fields
+            && fields != fixture.fields
+        {
+            fixture.fields = fields;
+            blessed = true;
+            changed = true;
+            problems.retain(|p| !p.starts_with("decoded "));
         }
         outcomes.push(Outcome { name: fixture.name.clone(), problems, blessed });
     }

@@ -15,7 +15,7 @@ pub fn workspace_root() -> PathBuf {
 
 /// Bytes from lowercase or uppercase hex without separators.
 pub fn hex_decode(text: &str) -> anyhow::Result<Vec<u8>> {
-    if text.len() % 2 != 0 {
+    if !text.len().is_multiple_of(2) {
         bail!("odd number of hex digits in {text:?}");
     }
     (0..text.len())

@@ -110,13 +110,7 @@ impl AfFrame {
         if count == 0 || count > MAX_IDS {
             return Err(EncodeError::IdCount(count));
         }
-        Ok(Self {
-            motor_id,
-            rw,
-            n_ids: count as u8,
-            ids: [ParamId::SystemReset; MAX_IDS],
-            slots: [[0; 4]; MAX_IDS],
-        })
+        Ok(Self { motor_id, rw, n_ids: count as u8, ids: [ParamId::SystemReset; MAX_IDS], slots: [[0; 4]; MAX_IDS] })
     }
 
     /// A read request for `ids` (1..=16 of them).

@@ -47,11 +47,8 @@ impl PcControl {
         if !yaw_rate_radps.is_finite() {
             return Err(EncodeError::NonFinite { offset: 5 });
         }
-        let curvature_per_m = if velocity_mps.abs() > CURVATURE_VELOCITY_THRESHOLD_MPS {
-            yaw_rate_radps / velocity_mps
-        } else {
-            0.0
-        };
+        let curvature_per_m =
+            if velocity_mps.abs() > CURVATURE_VELOCITY_THRESHOLD_MPS { yaw_rate_radps / velocity_mps } else { 0.0 };
         let command = Self { velocity_mps, curvature_per_m };
         // |v| > 1e-3 bounds the quotient, but a huge yaw rate can still overflow to infinity.
         match command.non_finite_offset() {

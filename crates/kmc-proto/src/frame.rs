@@ -2,9 +2,8 @@
 
 use crate::af::Scan;
 use crate::{
-    AfFrame, AfRequest, AfResponse, AllState, BatteryVoltage, DEFAULT_MAX_SPEED_MPS, DecodeError,
-    EncodeError, FRAME_ID_AF, FRAME_ID_CONTROL, FRAME_ID_SPEED, ParamId, PcControl, Rw,
-    VehicleSpeed, VehicleSpeedRequest,
+    AfFrame, AfRequest, AfResponse, AllState, BatteryVoltage, DEFAULT_MAX_SPEED_MPS, DecodeError, EncodeError,
+    FRAME_ID_AF, FRAME_ID_CONTROL, FRAME_ID_SPEED, ParamId, PcControl, Rw, VehicleSpeed, VehicleSpeedRequest,
 };
 
 /// A frame the host sends to the chassis.
@@ -138,9 +137,7 @@ impl ChassisFrame {
 
     /// Maps a well-formed 0xAF frame per spec §6.1 and checks its float slots (§6.2 step 3).
     fn classify(frame: AfFrame) -> Result<Self, DecodeError> {
-        let (mapped, non_finite) = if frame.rw() == Rw::Write
-            && frame.ids() == [ParamId::BatteryVoltage]
-        {
+        let (mapped, non_finite) = if frame.rw() == Rw::Write && frame.ids() == [ParamId::BatteryVoltage] {
             let volts = frame.slot_f32(0).unwrap_or(f32::NAN);
             let battery = BatteryVoltage { motor_id: frame.motor_id(), volts };
             (Self::BatteryVoltage(battery), frame.non_finite_offset(|_, _| true))
@@ -192,9 +189,7 @@ fn parse_exact<F>(
         Scan::Frame(frame, len) if len == bytes.len() => Ok(frame),
         Scan::Frame(_, len) => Err(DecodeError::TrailingBytes { frame_len: len, available: bytes.len() }),
         Scan::Reject(e) => Err(e),
-        Scan::Incomplete => {
-            Err(DecodeError::Truncated { needed: known_len(bytes), available: bytes.len() })
-        }
+        Scan::Incomplete => Err(DecodeError::Truncated { needed: known_len(bytes), available: bytes.len() }),
     }
 }
 

@@ -20,7 +20,11 @@ fn interleave(frames: &[Vec<u8>], garbage: &[Vec<u8>]) -> (Vec<u8>, Vec<(usize, 
 }
 
 /// Decodes `stream` whole and returns the spans of accepted frames and the pending tail start.
-fn accepted_spans<D: StreamDecoder>(decoder: &mut D, stream: &[u8], frame_len: impl Fn(&D::Frame) -> usize) -> (Vec<(usize, usize)>, usize) {
+fn accepted_spans<D: StreamDecoder>(
+    decoder: &mut D,
+    stream: &[u8],
+    frame_len: impl Fn(&D::Frame) -> usize,
+) -> (Vec<(usize, usize)>, usize) {
     let mut spans = Vec::new();
     let mut pos = 0;
     loop {
@@ -33,7 +37,13 @@ fn accepted_spans<D: StreamDecoder>(decoder: &mut D, stream: &[u8], frame_len: i
     }
 }
 
-fn check_recovery(stream: &[u8], originals: &[(usize, usize)], accepted: &[(usize, usize)], pending_from: usize, skipped: u64) {
+fn check_recovery(
+    stream: &[u8],
+    originals: &[(usize, usize)],
+    accepted: &[(usize, usize)],
+    pending_from: usize,
+    skipped: u64,
+) {
     let overlaps = |a: (usize, usize), b: (usize, usize)| a.0 < b.1 && b.0 < a.1;
     // Frames the decoder accepted that are not an original frame at its own position.
     let false_frames: Vec<_> = accepted.iter().filter(|s| !originals.contains(s)).copied().collect();
@@ -50,10 +60,7 @@ fn check_recovery(stream: &[u8], originals: &[(usize, usize)], accepted: &[(usiz
 
 /// Garbage before each frame: none in most gaps, so that about 10 % of all bytes are garbage.
 fn garbage_for(count: usize) -> impl Strategy<Value = Vec<Vec<u8>>> {
-    prop::collection::vec(
-        prop_oneof![3 => Just(Vec::new()), 1 => prop::collection::vec(any::<u8>(), 1..8)],
-        count,
-    )
+    prop::collection::vec(prop_oneof![3 => Just(Vec::new()), 1 => prop::collection::vec(any::<u8>(), 1..8)], count)
 }
 
 proptest! {
@@ -88,7 +95,9 @@ proptest! {
 #[test]
 fn adversarial_prefixes_do_not_hide_untouched_frames() {
     let real = emit_chassis(&kmc_proto::ChassisFrame::VehicleSpeed(kmc_proto::VehicleSpeed { speed_mps: 1.25 }));
-    for junk in [&[0xaf][..], &[0xaf, 0x00], &[0xaf, 0x00, 0x01], &[0xaf, 0x00, 0x01, 0x01], &[0xb3], &[0xb3, 0xff, 0xff]] {
+    for junk in
+        [&[0xaf][..], &[0xaf, 0x00], &[0xaf, 0x00, 0x01], &[0xaf, 0x00, 0x01, 0x01], &[0xb3], &[0xb3, 0xff, 0xff]]
+    {
         let mut stream = junk.to_vec();
         stream.extend_from_slice(&real);
         let mut decoder = ChassisFrameDecoder::new();

@@ -2,13 +2,18 @@
 
 mod strategies;
 
-use kmc_proto::{ChassisFrame, ChassisFrameDecoder, FrameBuffer, HostFrame, HostFrameDecoder};
+use kmc_proto::{ChassisFrame, ChassisFrameDecoder, FrameBuffer, HostFrame, HostFrameDecoder, StreamDecoder};
 use proptest::prelude::*;
 use strategies::*;
 
 /// Feeds `stream` in the given chunk sizes (cycled) and returns the re-encoded frames.
-fn decode_chunked_host(stream: &[u8], chunks: &[usize]) -> (Vec<Vec<u8>>, FrameBuffer<HostFrameDecoder, 128>) {
-    let mut rx = FrameBuffer::new(HostFrameDecoder::new());
+fn decode_chunked<D: StreamDecoder>(
+    decoder: D,
+    stream: &[u8],
+    chunks: &[usize],
+    emit: fn(&D::Frame) -> Vec<u8>,
+) -> (Vec<Vec<u8>>, FrameBuffer<D, 128>) {
+    let mut rx = FrameBuffer::new(decoder);
     let mut out = Vec::new();
     let mut rest = stream;
     for &size in chunks.iter().cycle() {
@@ -16,22 +21,7 @@ fn decode_chunked_host(stream: &[u8], chunks: &[usize]) -> (Vec<Vec<u8>>, FrameB
             break;
         }
         let (part, tail) = rest.split_at(size.min(rest.len()));
-        rx.push_all(part, |f| out.push(emit_host(&f)));
-        rest = tail;
-    }
-    (out, rx)
-}
-
-fn decode_chunked_chassis(stream: &[u8], chunks: &[usize]) -> (Vec<Vec<u8>>, FrameBuffer<ChassisFrameDecoder, 128>) {
-    let mut rx = FrameBuffer::new(ChassisFrameDecoder::new());
-    let mut out = Vec::new();
-    let mut rest = stream;
-    for &size in chunks.iter().cycle() {
-        if rest.is_empty() {
-            break;
-        }
-        let (part, tail) = rest.split_at(size.min(rest.len()));
-        rx.push_all(part, |f| out.push(emit_chassis(&f)));
+        rx.push_all(part, |f| out.push(emit(&f)));
         rest = tail;
     }
     (out, rx)
@@ -63,7 +53,7 @@ proptest! {
         chunks in prop::collection::vec(1usize..100, 1..10),
     ) {
         let encoded: Vec<Vec<u8>> = frames.iter().map(emit_host).collect();
-        let (decoded, rx) = decode_chunked_host(&encoded.concat(), &chunks);
+        let (decoded, rx) = decode_chunked(HostFrameDecoder::new(), &encoded.concat(), &chunks, emit_host);
         prop_assert_eq!(decoded, encoded);
         let c = rx.counters();
         prop_assert_eq!((c.frames, c.skipped_bytes, c.rejected_candidates), (frames.len() as u64, 0, 0));
@@ -76,7 +66,7 @@ proptest! {
         chunks in prop::collection::vec(1usize..100, 1..10),
     ) {
         let encoded: Vec<Vec<u8>> = frames.iter().map(emit_chassis).collect();
-        let (decoded, rx) = decode_chunked_chassis(&encoded.concat(), &chunks);
+        let (decoded, rx) = decode_chunked(ChassisFrameDecoder::new(), &encoded.concat(), &chunks, emit_chassis);
         prop_assert_eq!(decoded, encoded);
         let c = rx.counters();
         prop_assert_eq!((c.frames, c.skipped_bytes, c.rejected_candidates), (frames.len() as u64, 0, 0));

@@ -2,6 +2,7 @@
 //! command, polls the chassis, and queues what comes back.
 
 use std::collections::VecDeque;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, mpsc as std_mpsc};
 use std::thread::JoinHandle;
@@ -80,7 +81,9 @@ impl Default for DriverOptions {
 impl DriverOptions {
     fn validate(&self) -> Result<(), KmcError> {
         let bad = |name: &'static str, reason: String| Err(KmcError::Option { name, reason });
-        for (name, hz) in [("control_rate_hz", self.control_rate_hz), ("vehicle_speed_rate_hz", self.vehicle_speed_rate_hz)] {
+        for (name, hz) in
+            [("control_rate_hz", self.control_rate_hz), ("vehicle_speed_rate_hz", self.vehicle_speed_rate_hz)]
+        {
             if !(hz.is_finite() && hz > 0.0 && hz <= MAX_RATE_HZ) {
                 return bad(name, format!("{hz} Hz is outside (0, {MAX_RATE_HZ}]"));
             }
@@ -91,10 +94,10 @@ impl DriverOptions {
         if self.max_queue == 0 {
             return bad("max_queue", "the queue must hold at least one frame".into());
         }
-        if let Some(priority) = self.realtime_priority {
-            if !(1..=99).contains(&priority) {
-                return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
-            }
+        if let Some(priority) = self.realtime_priority
+            && !(1..=99).contains(&priority)
+        {
+            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
         }
         if !(self.max_speed_mps.is_finite() && self.max_speed_mps > 0.0) {
             return bad("max_speed_mps", format!("{} must be finite and positive", self.max_speed_mps));
@@ -498,63 +501,68 @@ impl IoLoop {
 
     async fn run(mut self) {
         loop {
-            if self.link.is_open() {
+            let flow = if self.link.is_open() {
                 let deadline = self.next_deadline();
                 // tokio's timer rounds up to whole milliseconds: wake early through it, then
                 // finish with a precise sleep (this thread has no other task to starve).
                 let coarse = deadline.checked_sub(TIMER_SLACK).unwrap_or(deadline);
                 tokio::select! {
                     biased;
-                    request = self.requests.recv() => match request {
-                        Some(Request::Stop(reply)) => {
-                            let _ = reply.send(self.stop_burst().await);
-                            return;
-                        }
-                        // The Driver was dropped without stop(): still stop the chassis.
-                        None => {
-                            let _ = self.stop_burst().await;
-                            return;
-                        }
-                        Some(Request::Battery(motor)) => self.send_battery(motor).await,
-                        Some(Request::AllState(motor)) => self.send_all_state(motor).await,
-                    },
+                    request = self.requests.recv() => self.handle(request).await,
                     () = tokio::time::sleep_until(coarse) => {
                         std::thread::sleep(deadline.saturating_duration_since(Instant::now()));
                         self.tick().await;
+                        ControlFlow::Continue(())
                     }
-                    frame = self.link.recv() => match frame {
-                        Ok(frame) => self.enqueue(frame),
-                        Err(_) => self.on_disconnect(),
-                    },
-                }
-            } else {
-                let Some(backoff) = self.options.reopen else {
-                    // Nothing to do but wait for stop.
-                    match self.requests.recv().await {
-                        Some(Request::Stop(reply)) => {
-                            let _ = reply.send(self.stop_burst().await);
-                            return;
+                    frame = self.link.recv() => {
+                        match frame {
+                            Ok(frame) => self.enqueue(frame),
+                            Err(_) => self.on_disconnect(),
                         }
-                        None => return,
-                        Some(_) => continue,
+                        ControlFlow::Continue(())
                     }
-                };
+                }
+            } else if let Some(backoff) = self.options.reopen {
                 tokio::select! {
                     biased;
-                    request = self.requests.recv() => match request {
-                        Some(Request::Stop(reply)) => {
-                            let _ = reply.send(self.stop_burst().await);
-                            return;
-                        }
-                        None => return,
-                        Some(_) => {}
-                    },
+                    request = self.requests.recv() => self.handle(request).await,
                     reopened = self.link.reopen(&backoff) => {
                         if reopened.is_ok() {
                             self.on_reconnect();
                         }
+                        ControlFlow::Continue(())
                     }
                 }
+            } else {
+                // No reopening: wait for stop.
+                let request = self.requests.recv().await;
+                self.handle(request).await
+            };
+            if flow.is_break() {
+                return;
+            }
+        }
+    }
+
+    /// A request from the [`Driver`]; `Break` ends the loop.
+    async fn handle(&mut self, request: Option<Request>) -> ControlFlow<()> {
+        match request {
+            Some(Request::Stop(reply)) => {
+                let _ = reply.send(self.stop_burst().await);
+                ControlFlow::Break(())
+            }
+            // The Driver went away without stop(): still stop the chassis.
+            None => {
+                let _ = self.stop_burst().await;
+                ControlFlow::Break(())
+            }
+            Some(Request::Battery(motor)) => {
+                self.send_battery(motor).await;
+                ControlFlow::Continue(())
+            }
+            Some(Request::AllState(motor)) => {
+                self.send_all_state(motor).await;
+                ControlFlow::Continue(())
             }
         }
     }

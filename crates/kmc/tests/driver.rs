@@ -46,7 +46,8 @@ fn streams_at_100_hz_on_absolute_deadlines() {
     let window_end = Instant::now();
     driver.stop().unwrap();
 
-    let frames: Vec<_> = controls(&sim.received()).into_iter().filter(|(at, _)| *at >= begin && *at <= window_end).collect();
+    let frames: Vec<_> =
+        controls(&sim.received()).into_iter().filter(|(at, _)| *at >= begin && *at <= window_end).collect();
     let seconds = (window_end - begin).as_secs_f64();
     let rate = frames.len() as f64 / seconds;
     assert!((90.0..=110.0).contains(&rate), "{} frames in {seconds:.3} s = {rate:.1} Hz", frames.len());
@@ -158,7 +159,7 @@ fn polls_and_one_shot_requests_deliver_messages() {
     let begin = Instant::now();
     while begin.elapsed() < Duration::from_millis(1200) {
         driver.set_command(0.8, 0.0).unwrap();
-        while let Some(frame) = driver.wait_pop_message(Duration::from_millis(20)) {
+        for frame in driver.messages_until(Instant::now() + Duration::from_millis(20)) {
             match frame {
                 ChassisFrame::VehicleSpeed(v) => speeds.push(v.speed_mps),
                 ChassisFrame::BatteryVoltage(b) => {
@@ -170,15 +171,19 @@ fn polls_and_one_shot_requests_deliver_messages() {
             }
         }
     }
+    // Polls only ever ask motor 0 for the battery: an answer from motor 1 is the one-shot's.
     driver.request_battery_once(1).unwrap();
-    let extra = driver.wait_pop_message(Duration::from_secs(1));
+    let one_shot = driver
+        .messages_until(Instant::now() + Duration::from_secs(1))
+        .find(|f| matches!(f, ChassisFrame::BatteryVoltage(b) if b.motor_id == 1));
     driver.stop().unwrap();
     assert!(speeds.len() > 40, "speed responses at 50 Hz: {}", speeds.len());
     // First-order response: the speed rises towards 0.8 m/s.
     assert!(speeds.last().is_some_and(|&v| (v - 0.8).abs() < 0.05), "final speed {:?}", speeds.last());
     assert!(batteries >= 1, "battery polled at 1 Hz");
     assert!(states[0] >= 8 && states[1] >= 8, "all-state polled at 10 Hz for both motors: {states:?}");
-    assert!(extra.is_some());
+    assert!(one_shot.is_some(), "the one-shot battery read was answered");
+    assert_eq!(driver.stats().command_timeouts, 0);
     assert_eq!(driver.stats().link.decoder.skipped_bytes, 0);
 }
 
@@ -243,15 +248,16 @@ fn invalid_options_and_start_failures_are_typed() {
     pinned.start().unwrap();
     assert!(matches!(pinned.start(), Err(KmcError::AlreadyRunning)));
     pinned.stop().unwrap();
-    let mut nowhere = Driver::new(sim.path(), DriverOptions { cpu_affinity: Some(1 << 20), ..Default::default() }).unwrap();
+    let mut nowhere =
+        Driver::new(sim.path(), DriverOptions { cpu_affinity: Some(1 << 20), ..Default::default() }).unwrap();
     assert!(matches!(nowhere.start(), Err(KmcError::CpuAffinity { cpu, .. }) if cpu == 1 << 20));
     // SCHED_FIFO needs privileges this machine may or may not grant: either it works, or the
     // error says which priority failed.
-    let mut realtime = Driver::new(sim.path(), DriverOptions { realtime_priority: Some(10), ..Default::default() }).unwrap();
+    let mut realtime =
+        Driver::new(sim.path(), DriverOptions { realtime_priority: Some(10), ..Default::default() }).unwrap();
     match realtime.start() {
         Ok(()) => realtime.stop().unwrap(),
         Err(KmcError::RealtimePriority { priority: 10, .. }) => {}
         Err(other) => panic!("unexpected error {other}"),
     }
 }
-

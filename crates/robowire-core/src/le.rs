@@ -66,10 +66,7 @@ impl<'a> LeWriter<'a> {
     pub fn put_bytes(&mut self, bytes: &[u8]) -> Result<(), BufferTooSmall> {
         let end = self.pos + bytes.len();
         let available = self.buf.len();
-        let dst = self
-            .buf
-            .get_mut(self.pos..end)
-            .ok_or(BufferTooSmall { needed: end, available })?;
+        let dst = self.buf.get_mut(self.pos..end).ok_or(BufferTooSmall { needed: end, available })?;
         dst.copy_from_slice(bytes);
         self.pos = end;
         Ok(())

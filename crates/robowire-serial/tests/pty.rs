@@ -85,7 +85,8 @@ fn reopen_after_replug_at_a_stable_path() {
 
         // Nothing to reopen yet: a bounded backoff gives up with the open error.
         std::fs::remove_file(&link_path).unwrap();
-        let quick = Backoff { initial: Duration::from_millis(5), max: Duration::from_millis(10), max_attempts: Some(3) };
+        let quick =
+            Backoff { initial: Duration::from_millis(5), max: Duration::from_millis(10), max_attempts: Some(3) };
         let gave_up = link.reopen(&quick).await.unwrap_err();
         assert!(matches!(gave_up, SerialError::ReopenFailed { attempts: 3, .. }), "{gave_up}");
 
@@ -95,10 +96,7 @@ fn reopen_after_replug_at_a_stable_path() {
             sim.replug().unwrap();
         };
         let patient = Backoff { initial: Duration::from_millis(5), ..Backoff::default() };
-        let (reopened, ()) = tokio::join!(
-            tokio::time::timeout(WATCHDOG, link.reopen(&patient)),
-            replug
-        );
+        let (reopened, ()) = tokio::join!(tokio::time::timeout(WATCHDOG, link.reopen(&patient)), replug);
         reopened.expect("reopened in time").unwrap();
         assert_eq!(link.counters().reopens, 1);
         send(&mut link, HostFrame::VehicleSpeedRequest).await;
@@ -110,8 +108,9 @@ fn reopen_after_replug_at_a_stable_path() {
 #[test]
 fn open_error_names_the_path() {
     runtime().block_on(async {
-        let err = SerialLink::open("/dev/robowire-no-such-port", &SerialPortOptions::default(), ChassisFrameDecoder::new())
-            .unwrap_err();
+        let err =
+            SerialLink::open("/dev/robowire-no-such-port", &SerialPortOptions::default(), ChassisFrameDecoder::new())
+                .unwrap_err();
         let text = err.to_string();
         assert!(text.contains("/dev/robowire-no-such-port"), "{text}");
         assert!(matches!(err, SerialError::Open { .. }));

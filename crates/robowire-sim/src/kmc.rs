@@ -369,12 +369,13 @@ impl Model {
     fn advance(&mut self, s: &mut Shared, now: Instant) {
         let dt = now.saturating_duration_since(self.last_update).as_secs_f32();
         self.last_update = now;
-        if let (Some(limit), Some(last)) = (self.config.command_watchdog, self.last_control) {
-            if now.saturating_duration_since(last) > limit && s.state.commanded_velocity_mps != 0.0 {
-                s.state.commanded_velocity_mps = 0.0;
-                s.state.commanded_curvature_per_m = 0.0;
-                s.stats.watchdog_stops += 1;
-            }
+        if let (Some(limit), Some(last)) = (self.config.command_watchdog, self.last_control)
+            && now.saturating_duration_since(last) > limit
+            && s.state.commanded_velocity_mps != 0.0
+        {
+            s.state.commanded_velocity_mps = 0.0;
+            s.state.commanded_curvature_per_m = 0.0;
+            s.stats.watchdog_stops += 1;
         }
         let st = &mut s.state;
         let tau = self.config.speed_time_constant.as_secs_f32().max(1e-3);
@@ -413,9 +414,10 @@ impl Model {
             Rw::Read => {
                 s.stats.af_reads += 1;
                 match request.ids() {
-                    [ParamId::BatteryVoltage] => {
-                        Some(ChassisFrame::BatteryVoltage(BatteryVoltage { motor_id: motor, volts: s.state.battery_volts }))
-                    }
+                    [ParamId::BatteryVoltage] => Some(ChassisFrame::BatteryVoltage(BatteryVoltage {
+                        motor_id: motor,
+                        volts: s.state.battery_volts,
+                    })),
                     [ParamId::AllState] => Some(ChassisFrame::AllState(self.all_state(s, motor))),
                     _ => {
                         s.stats.unanswered_reads += 1;

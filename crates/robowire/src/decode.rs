@@ -81,7 +81,11 @@ where
         c.rejected_candidates,
         if pending > 0 { " (an incomplete frame at the end)" } else { "" }
     );
-    if json { eprintln!("{summary}") } else { println!("{summary}") }
+    if json {
+        eprintln!("{summary}")
+    } else {
+        println!("{summary}")
+    }
     Ok(c.frames)
 }
 

@@ -22,7 +22,7 @@ pub(crate) fn parse(text: &str) -> anyhow::Result<Vec<u8>> {
         let token = token.strip_prefix("0x").or_else(|| token.strip_prefix("0X")).unwrap_or(token);
         digits.extend(token.chars());
     }
-    if digits.len() % 2 != 0 {
+    if !digits.len().is_multiple_of(2) {
         bail!("odd number of hex digits ({})", digits.len());
     }
     digits

@@ -69,8 +69,12 @@ pub(crate) fn run(args: KmcArgs) -> anyhow::Result<ExitCode> {
     };
     match args.command {
         KmcCommand::Drive(drive) => run_drive(&args.port, serial, &drive),
-        KmcCommand::Speed(one) => one_shot(&args.port, &serial, &one, "vehicle speed", |c, _| c.request_vehicle_speed()),
-        KmcCommand::Battery(one) => one_shot(&args.port, &serial, &one, "battery voltage", |c, m| c.request_battery_voltage(m)),
+        KmcCommand::Speed(one) => {
+            one_shot(&args.port, &serial, &one, "vehicle speed", |c, _| c.request_vehicle_speed())
+        }
+        KmcCommand::Battery(one) => {
+            one_shot(&args.port, &serial, &one, "battery voltage", |c, m| c.request_battery_voltage(m))
+        }
         KmcCommand::AllState(one) => one_shot(&args.port, &serial, &one, "all-state", |c, m| c.request_all_state(m)),
     }
 }
@@ -79,12 +83,19 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
     if !(args.duration.is_finite() && args.duration >= 0.0) {
         bail!("--duration must be a finite number of seconds, got {}", args.duration);
     }
-    let options = DriverOptions { serial, poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..Default::default() };
+    let options =
+        DriverOptions { serial, poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..Default::default() };
     let mut driver = Driver::new(port, options)?;
     // Validate before the port is even opened.
     driver.set_command(args.velocity, args.yaw_rate).context("refusing to drive")?;
     driver.start().with_context(|| format!("starting the driver on {}", port.display()))?;
-    println!("driving {:+.3} m/s at {:+.3} rad/s for {:.1} s on {}", args.velocity, args.yaw_rate, args.duration, port.display());
+    println!(
+        "driving {:+.3} m/s at {:+.3} rad/s for {:.1} s on {}",
+        args.velocity,
+        args.yaw_rate,
+        args.duration,
+        port.display()
+    );
     let end = Instant::now() + Duration::from_secs_f64(args.duration);
     while Instant::now() < end {
         // Refresh well inside the Driver's 300 ms command timeout, printing what arrives.
@@ -97,9 +108,17 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
     let s = driver.stats();
     println!(
         "stopped. sent: control {} (timeout stops {}), stop burst {}, speed requests {}, battery {}, all-state {} | received {} | skipped bytes {}, rejected candidates {} | lateness p50 {} µs p99 {} µs",
-        s.control_frames_sent, s.timeout_frames_sent, s.stop_frames_sent, s.speed_requests_sent, s.battery_requests_sent,
-        s.all_state_requests_sent, s.frames_received, s.link.decoder.skipped_bytes, s.link.decoder.rejected_candidates,
-        s.control_lateness.p50_us, s.control_lateness.p99_us
+        s.control_frames_sent,
+        s.timeout_frames_sent,
+        s.stop_frames_sent,
+        s.speed_requests_sent,
+        s.battery_requests_sent,
+        s.all_state_requests_sent,
+        s.frames_received,
+        s.link.decoder.skipped_bytes,
+        s.link.decoder.rejected_candidates,
+        s.control_lateness.p50_us,
+        s.control_lateness.p99_us
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -73,27 +73,26 @@ pub fn all_state() -> impl Strategy<Value = AllState> {
 /// Raw responses: slots whose ID is 0x06 hold any bits, the others finite floats. Frames that
 /// spec §6.1 maps to [`BatteryVoltage`] or [`AllState`] are left out.
 pub fn af_response() -> impl Strategy<Value = AfFrame> {
-    let entries = prop::collection::vec((param_id(), any::<u32>(), finite_f32()), 1..=16).prop_filter(
-        "typed responses are not raw",
-        |e| !(e.len() == 1 && e[0].0 == ParamId::BatteryVoltage) && !(e.len() == 9 && e[0].0 == ParamId::AllState),
-    );
-    (any::<u8>(), entries).prop_map(
-        |(motor, entries)| {
-            let raw: Vec<(ParamId, [u8; 4])> = entries
-                .iter()
-                .map(|&(id, bits, value)| {
-                    (id, if id == ParamId::AllState { bits.to_le_bytes() } else { value.to_le_bytes() })
-                })
-                .collect();
-            AfFrame::write_raw(motor, &raw).unwrap()
-        },
-    )
+    let entries = prop::collection::vec((param_id(), any::<u32>(), finite_f32()), 1..=16)
+        .prop_filter("typed responses are not raw", |e| {
+            !((e.len() == 1 && e[0].0 == ParamId::BatteryVoltage) || (e.len() == 9 && e[0].0 == ParamId::AllState))
+        });
+    (any::<u8>(), entries).prop_map(|(motor, entries)| {
+        let raw: Vec<(ParamId, [u8; 4])> = entries
+            .iter()
+            .map(|&(id, bits, value)| {
+                (id, if id == ParamId::AllState { bits.to_le_bytes() } else { value.to_le_bytes() })
+            })
+            .collect();
+        AfFrame::write_raw(motor, &raw).unwrap()
+    })
 }
 
 pub fn chassis_frame() -> impl Strategy<Value = ChassisFrame> {
     prop_oneof![
         vehicle_speed().prop_map(ChassisFrame::VehicleSpeed),
-        (any::<u8>(), finite_f32()).prop_map(|(motor_id, volts)| ChassisFrame::BatteryVoltage(BatteryVoltage { motor_id, volts })),
+        (any::<u8>(), finite_f32())
+            .prop_map(|(motor_id, volts)| ChassisFrame::BatteryVoltage(BatteryVoltage { motor_id, volts })),
         all_state().prop_map(ChassisFrame::AllState),
         af_response().prop_map(ChassisFrame::Af),
     ]

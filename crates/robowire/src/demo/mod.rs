@@ -9,7 +9,8 @@ use clap::{Args, ValueEnum};
 
 #[derive(Debug, Args)]
 pub(crate) struct DemoArgs {
-    /// Seconds of motion per device scenario (split over its phases).
+    /// Seconds of motion per device scenario, split over its phases (at least 0.8 s each, so
+    /// the machine can settle).
     #[arg(long, default_value_t = 3.0)]
     duration: f64,
     /// Run one device's scenario only.

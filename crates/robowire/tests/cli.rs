@@ -1,0 +1,118 @@
+//! The `robowire` binary as users script it.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+fn robowire() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+fn fixtures() -> Vec<serde_json::Value> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/kmc/frames.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn decode_json_prints_every_fixture_as_its_fields() {
+    for fixture in fixtures() {
+        let direction = if fixture["direction"] == "host->chassis" { "host" } else { "device" };
+        let out = robowire()
+            .args(["decode", "kmc", fixture["hex"].as_str().unwrap(), "--direction", direction, "--json"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let stdout = String::from_utf8(out.stdout).unwrap();
+        let lines: Vec<&str> = stdout.lines().collect();
+        assert_eq!(lines.len(), 1, "one object per frame: {stdout}");
+        let printed: serde_json::Value = serde_json::from_str(lines[0]).unwrap();
+        assert_eq!(printed, fixture["fields"], "{}", fixture["name"]);
+        assert!(String::from_utf8_lossy(&out.stderr).contains("frames=1 skipped_bytes=0"));
+    }
+}
+
+#[test]
+fn decode_matches_the_documented_example_exactly() {
+    let out = robowire().args(["decode", "kmc", "a5 00 00 00 3f cd cc cc 3e", "--json"]).output().unwrap();
+    assert_eq!(
+        String::from_utf8(out.stdout).unwrap(),
+        "{\"frame\":\"pc_control\",\"velocity_mps\":0.5,\"curvature_per_m\":0.4}\n"
+    );
+}
+
+#[test]
+fn decode_reports_noise_and_fails_without_frames() {
+    let out = robowire().args(["decode", "kmc", "--direction", "device", "00 b3 00 00 a0 3f af"]).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("vehicle_speed speed_mps=1.25"), "{text}");
+    assert!(text.contains("frames=1 skipped_bytes=1 rejected_candidates=0 pending_bytes=1"), "{text}");
+
+    let none = robowire().args(["decode", "kmc", "00 01 02"]).output().unwrap();
+    assert_eq!(none.status.code(), Some(1));
+    let bad = robowire().args(["decode", "kmc", "a5 0"]).output().unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("odd number of hex digits"));
+}
+
+#[test]
+fn demo_drives_the_simulated_chassis_and_checks_what_it_saw() {
+    let out = robowire().args(["demo", "--only", "kmc", "--duration", "1.5"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("demo passed"), "{stdout}");
+    for phase in ["straight", "turn", "reverse", "timeout", "stop"] {
+        assert!(stdout.contains(phase), "{phase} missing from {stdout}");
+    }
+}
+
+#[test]
+fn demo_refuses_a_nonsense_duration() {
+    let out = robowire().args(["demo", "--duration", "NaN"]).output().unwrap();
+    assert!(!out.status.success());
+}
+
+#[test]
+fn sim_and_device_commands_as_two_processes() {
+    let mut sim = robowire()
+        .args(["sim", "kmc", "--report-every-s", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut first_line = String::new();
+    BufReader::new(sim.stdout.take().unwrap()).read_line(&mut first_line).unwrap();
+    let port = first_line.trim().to_string();
+    assert!(port.starts_with("/dev/pts/"), "{port}");
+
+    let speed = robowire().args(["kmc", "--port", &port, "speed"]).output().unwrap();
+    let battery = robowire().args(["kmc", "--port", &port, "battery", "--motor", "1"]).output().unwrap();
+    let drive = robowire()
+        .args([
+            "kmc",
+            "--port",
+            &port,
+            "drive",
+            "--velocity",
+            "0.4",
+            "--yaw-rate",
+            "-0.1",
+            "--duration",
+            "0.5",
+            "--no-polls",
+        ])
+        .output()
+        .unwrap();
+    let refused = robowire().args(["kmc", "--port", &port, "drive", "--velocity", "inf"]).output().unwrap();
+    sim.kill().unwrap();
+    let _ = sim.wait();
+
+    assert!(speed.status.success(), "{}", String::from_utf8_lossy(&speed.stderr));
+    assert!(String::from_utf8_lossy(&speed.stdout).starts_with("speed"));
+    assert!(String::from_utf8_lossy(&battery.stdout).contains("battery    motor 1"));
+    let drive_out = String::from_utf8_lossy(&drive.stdout);
+    assert!(drive.status.success(), "{drive_out}{}", String::from_utf8_lossy(&drive.stderr));
+    assert!(drive_out.contains("stopped."), "{drive_out}");
+    assert!(drive_out.contains("stop burst 3"), "{drive_out}");
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("velocity_mps must be finite"));
+}
