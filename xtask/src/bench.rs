@@ -12,7 +12,7 @@ use serde_json::Value;
 use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
-const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec")];
+const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd")];
 
 /// One row of the table.
 #[derive(Debug, Serialize)]
@@ -99,11 +99,70 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
         });
     }
 
+    rows.extend(lowcmd_rows(&criterion)?);
+
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
     std::fs::write(target.join("bench-report.md"), &markdown)?;
     std::fs::write(target.join("bench-report.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
     println!("written: {} and bench-report.json", target.join("bench-report.md").display());
+    Ok(rows)
+}
+
+/// Rows of the Unitree LowCmd/LowState benchmarks.
+fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
+    let group = "lowcmd_crc_808B";
+    let ours = mean_ns(criterion, group, "crc_fast")?;
+    let kernel = mean_ns(criterion, group, "pclmul_kernel_only")?;
+    let table = mean_ns(criterion, group, "table16")?;
+    let bitwise = mean_ns(criterion, group, "bitwise_oracle")?;
+    let mut rows = vec![
+        Row {
+            path: "LowCmd CRC, 808 B (byte swap + crc-fast)".into(),
+            figure: format!("{ours:.0} ns"),
+            baseline: format!("PCLMUL kernel alone: {kernel:.0} ns"),
+            ratio: format!("{:.2}×", ours / kernel),
+            target: "≤ 2× PCLMUL and ≤ 150 ns".into(),
+            met: Some(ours <= 2.0 * kernel && ours <= 150.0),
+        },
+        Row {
+            path: "LowCmd CRC vs Unitree's bitwise routine".into(),
+            figure: format!("{ours:.0} ns"),
+            baseline: format!("bitwise: {bitwise:.0} ns"),
+            ratio: format!("{:.0}× faster", bitwise / ours),
+            target: "–".into(),
+            met: None,
+        },
+        Row {
+            path: "LowCmd CRC, no_std table backend".into(),
+            figure: format!("{table:.0} ns"),
+            baseline: format!("bitwise: {bitwise:.0} ns"),
+            ratio: format!("{:.0}× faster", bitwise / table),
+            target: "–".into(),
+            met: None,
+        },
+    ];
+    let codec = "lowcmd_codec";
+    let copy_cmd = mean_ns(criterion, codec, "memcpy_812B")?;
+    let copy_state = mean_ns(criterion, codec, "memcpy_1180B")?;
+    for (bench, label, copy, copy_label) in [
+        ("lowcmd_encode_image", "LowCmd encode (zero padding, CRC)", copy_cmd, "memcpy 812 B"),
+        ("lowcmd_decode_verify_image", "LowCmd decode + verify", copy_cmd, "memcpy 812 B"),
+        ("lowcmd_encode_xcdr1", "LowCmd encode XCDR1", copy_cmd, "memcpy 812 B"),
+        ("lowcmd_decode_verify_xcdr1", "LowCmd decode XCDR1 + verify", copy_cmd, "memcpy 812 B"),
+        ("lowstate_encode_image", "LowState encode (zero padding, CRC)", copy_state, "memcpy 1180 B"),
+        ("lowstate_decode_verify_image", "LowState decode + verify", copy_state, "memcpy 1180 B"),
+    ] {
+        let ns = mean_ns(criterion, codec, bench)?;
+        rows.push(Row {
+            path: label.into(),
+            figure: format!("{ns:.0} ns"),
+            baseline: format!("{copy_label}: {copy:.0} ns"),
+            ratio: format!("{:.1}×", ns / copy),
+            target: "–".into(),
+            met: None,
+        });
+    }
     Ok(rows)
 }
 

@@ -5,37 +5,54 @@ use std::process::Command;
 
 use anyhow::{Context, bail};
 
-use crate::golden::{kmc_fixture_path, load_kmc};
+use crate::golden::kmc::{kmc_fixture_path, load_kmc};
 use crate::{hex_decode, workspace_root};
 
-/// A fuzz target and where its seeds come from.
+/// Named seed inputs for a corpus directory.
+pub type Seeds = anyhow::Result<Vec<(String, Vec<u8>)>>;
+
+/// A fuzz target, where its seeds come from, and the check it runs.
 #[derive(Debug, Clone, Copy)]
 pub struct Target {
     /// cargo-fuzz target name (`fuzz/fuzz_targets/<name>.rs`).
     pub name: &'static str,
-    /// The fixture direction whose frames seed it.
-    pub direction: &'static str,
+    /// Its seed corpus, named for the corpus directory.
+    pub seeds: fn() -> Seeds,
     /// The check it runs, for replay under `cargo test`.
     pub check: fn(&[u8]),
 }
 
 /// Every fuzz target.
 pub const TARGETS: &[Target] = &[
-    Target { name: "kmc_host_decoder", direction: "chassis->host", check: kmc_proto::harness::chassis_frame_stream },
-    Target { name: "kmc_device_decoder", direction: "host->chassis", check: kmc_proto::harness::host_frame_stream },
+    Target {
+        name: "kmc_host_decoder",
+        seeds: || kmc_seeds("chassis->host"),
+        check: kmc_proto::harness::chassis_frame_stream,
+    },
+    Target {
+        name: "kmc_device_decoder",
+        seeds: || kmc_seeds("host->chassis"),
+        check: kmc_proto::harness::host_frame_stream,
+    },
+    Target {
+        name: "lowcmd_image_decode",
+        seeds: || unitree_seeds("packed_hex"),
+        check: lowcmd_proto::harness::image_decode,
+    },
+    Target { name: "lowcmd_cdr_decode", seeds: || unitree_seeds("cdr_hex"), check: lowcmd_proto::harness::cdr_decode },
 ];
 
-/// Seed inputs for `target`: each fixture frame alone and all of them back to back, each with
-/// chunk-size byte 0 (1-byte chunks) and 7 (8-byte chunks). Named for the corpus directory.
-pub fn seeds(target: &Target) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+/// KMC seeds: each fixture frame of `direction` alone and all of them back to back, each with
+/// chunk-size byte 0 (1-byte chunks) and 7 (8-byte chunks).
+fn kmc_seeds(direction: &str) -> Seeds {
     let fixtures = load_kmc(&kmc_fixture_path())?;
     let mut streams: Vec<(String, Vec<u8>)> = fixtures
         .iter()
-        .filter(|f| f.direction == target.direction)
+        .filter(|f| f.direction == direction)
         .map(|f| Ok((f.name.clone(), hex_decode(&f.hex)?)))
         .collect::<anyhow::Result<_>>()?;
     if streams.is_empty() {
-        bail!("no fixtures for {} ({})", target.name, target.direction);
+        bail!("no KMC fixtures for {direction}");
     }
     let all = streams.iter().flat_map(|(_, bytes)| bytes.clone()).collect();
     streams.push(("all".into(), all));
@@ -49,6 +66,27 @@ pub fn seeds(target: &Target) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
             })
         })
         .collect())
+}
+
+/// Unitree seeds: every vector's struct image (`packed_hex`) or CDR payload (`cdr_hex`), with
+/// the selector byte of its message type (0 LowCmd, 1 LowState).
+fn unitree_seeds(key: &str) -> Seeds {
+    let vectors = crate::golden::unitree::load(&crate::golden::unitree::vectors_path())?;
+    let mut seeds = Vec::new();
+    for list in ["lowcmd", "lowstate", "cdr"] {
+        for vector in vectors[list].as_array().into_iter().flatten() {
+            let Some(hex) = vector[key].as_str() else { continue };
+            let is_state =
+                list == "lowstate" || vector["dds_type_name"].as_str().is_some_and(|t| t.ends_with("LowState_"));
+            let mut input = vec![u8::from(is_state)];
+            input.extend(hex_decode(hex)?);
+            seeds.push((format!("seed-{}", vector["name"].as_str().unwrap_or("vector")), input));
+        }
+    }
+    if seeds.is_empty() {
+        bail!("no Unitree vectors with {key}");
+    }
+    Ok(seeds)
 }
 
 fn has_nightly() -> bool {
@@ -75,7 +113,7 @@ pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
     for target in targets {
         let corpus = fuzz_dir.join("corpus").join(target.name);
         std::fs::create_dir_all(&corpus)?;
-        for (name, input) in seeds(target)? {
+        for (name, input) in (target.seeds)()? {
             std::fs::write(corpus.join(name), input)?;
         }
         let mut command = Command::new("cargo");
@@ -117,7 +155,7 @@ mod tests {
     #[test]
     fn seed_corpus_replays() {
         for target in TARGETS {
-            let seeds = seeds(target).unwrap();
+            let seeds = (target.seeds)().unwrap();
             assert!(seeds.len() >= 4, "{}", target.name);
             for (_, input) in seeds {
                 (target.check)(&input);

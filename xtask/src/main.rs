@@ -55,24 +55,32 @@ fn main() -> ExitCode {
 }
 
 fn golden(bless: bool) -> anyhow::Result<()> {
-    let path = xtask::golden::kmc_fixture_path();
-    let outcomes = xtask::golden::check_kmc(&path, bless)?;
+    let kmc_path = xtask::golden::kmc::kmc_fixture_path();
+    let unitree_path = xtask::golden::unitree::vectors_path();
+    let suites = [
+        ("kmc", xtask::golden::kmc::check_kmc(&kmc_path, bless)?),
+        ("unitree", xtask::golden::unitree::check(&unitree_path)?),
+    ];
     let mut failed = 0;
-    for outcome in &outcomes {
-        let status = if !outcome.problems.is_empty() {
-            failed += 1;
-            "FAIL"
-        } else if outcome.blessed {
-            "BLESSED"
-        } else {
-            "ok"
-        };
-        println!("kmc {:<28} {status}", outcome.name);
-        for problem in &outcome.problems {
-            println!("    {problem}");
+    let mut total = 0;
+    for (suite, outcomes) in &suites {
+        for outcome in outcomes {
+            total += 1;
+            let status = if !outcome.problems.is_empty() {
+                failed += 1;
+                "FAIL"
+            } else if outcome.blessed {
+                "BLESSED"
+            } else {
+                "ok"
+            };
+            println!("{suite:<8} {:<40} {status}", outcome.name);
+            for problem in &outcome.problems {
+                println!("    {problem}");
+            }
         }
     }
-    anyhow::ensure!(failed == 0, "{failed} golden check(s) failed ({})", path.display());
-    println!("{} golden checks passed ({})", outcomes.len(), path.display());
+    anyhow::ensure!(failed == 0, "{failed} of {total} golden checks failed");
+    println!("{total} golden checks passed ({}, {})", kmc_path.display(), unitree_path.display());
     Ok(())
 }

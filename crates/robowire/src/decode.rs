@@ -6,11 +6,42 @@ use clap::{Args, Subcommand, ValueEnum};
 use kmc_proto::{ChassisFrame, ChassisFrameDecoder, HostFrame, HostFrameDecoder, StreamDecoder};
 
 use crate::hex;
+use crate::lowlevel::{self, Kind};
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum DecodeCommand {
     /// KMC chassis UART frames (0xA5, 0xB3, 0xAF). Exit status 1 if no frame was found.
     Kmc(KmcDecodeArgs),
+    /// Unitree Go2 LowCmd (812-byte struct image, or a CDR payload with --cdr).
+    Lowcmd(lowlevel::DecodeArgs),
+    /// Unitree Go2 LowState (1180-byte struct image, or a CDR payload with --cdr).
+    Lowstate(lowlevel::DecodeArgs),
+    /// Unitree HG (G1, H1-2) LowCmd (1004 bytes).
+    LowcmdHg(lowlevel::DecodeArgs),
+    /// Unitree HG (G1, H1-2) LowState (2092 bytes).
+    LowstateHg(lowlevel::DecodeArgs),
+}
+
+/// `robowire encode …`.
+#[derive(Debug, Subcommand)]
+pub(crate) enum EncodeCommand {
+    /// Unitree Go2 LowCmd from JSON: the struct image (CRC filled in), or a CDR payload.
+    Lowcmd(lowlevel::EncodeArgs),
+    /// Unitree Go2 LowState from JSON.
+    Lowstate(lowlevel::EncodeArgs),
+    /// Unitree HG LowCmd from JSON.
+    LowcmdHg(lowlevel::EncodeArgs),
+    /// Unitree HG LowState from JSON.
+    LowstateHg(lowlevel::EncodeArgs),
+}
+
+pub(crate) fn run_encode(command: &EncodeCommand) -> anyhow::Result<ExitCode> {
+    match command {
+        EncodeCommand::Lowcmd(args) => lowlevel::encode(Kind::LowCmd, args),
+        EncodeCommand::Lowstate(args) => lowlevel::encode(Kind::LowState, args),
+        EncodeCommand::LowcmdHg(args) => lowlevel::encode(Kind::HgLowCmd, args),
+        EncodeCommand::LowstateHg(args) => lowlevel::encode(Kind::HgLowState, args),
+    }
 }
 
 /// Who sent the bytes.
@@ -38,6 +69,10 @@ pub(crate) struct KmcDecodeArgs {
 pub(crate) fn run(command: &DecodeCommand) -> anyhow::Result<ExitCode> {
     match command {
         DecodeCommand::Kmc(args) => decode_kmc(args),
+        DecodeCommand::Lowcmd(args) => lowlevel::decode(Kind::LowCmd, args),
+        DecodeCommand::Lowstate(args) => lowlevel::decode(Kind::LowState, args),
+        DecodeCommand::LowcmdHg(args) => lowlevel::decode(Kind::HgLowCmd, args),
+        DecodeCommand::LowstateHg(args) => lowlevel::decode(Kind::HgLowState, args),
     }
 }
 

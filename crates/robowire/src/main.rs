@@ -5,6 +5,7 @@ mod decode;
 mod demo;
 mod hex;
 mod kmc_cmd;
+mod lowlevel;
 mod sim;
 
 use std::process::ExitCode;
@@ -28,18 +29,25 @@ enum Command {
     Sim(sim::SimCommand),
     /// Talk to a KMC wheeled chassis over a serial port.
     Kmc(kmc_cmd::KmcArgs),
-    /// Decode frames from hex and print them.
+    /// Decode frames or messages from hex and print them.
     #[command(subcommand)]
     Decode(decode::DecodeCommand),
+    /// Encode a message from JSON and print its bytes in hex.
+    #[command(subcommand)]
+    Encode(decode::EncodeCommand),
 }
 
 fn main() -> ExitCode {
+    // Die quietly on a closed pipe (`robowire decode … | head`) like other Unix tools, instead of
+    // panicking in println!.
+    sigpipe::reset();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => demo::run(&args),
         Command::Sim(command) => sim::run(command),
         Command::Kmc(args) => kmc_cmd::run(args),
         Command::Decode(command) => decode::run(&command),
+        Command::Encode(command) => decode::run_encode(&command),
     };
     match result {
         Ok(code) => code,

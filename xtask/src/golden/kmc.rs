@@ -1,6 +1,4 @@
-//! The golden-frame regression suite: every fixture decodes to its expected fields and
-//! re-encodes byte for byte. `--bless` rewrites the expected fields from the decoder (never
-//! the bytes); it is the only way a fixture changes.
+//! KMC golden frames (`fixtures/kmc/frames.json`): the 12 worked examples of the spec.
 
 use std::path::{Path, PathBuf};
 
@@ -12,6 +10,7 @@ use kmc_proto::{
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use super::{Outcome, to_json};
 use crate::{hex_decode, hex_encode, workspace_root};
 
 /// One KMC golden frame (`fixtures/kmc/frames.json`).
@@ -31,17 +30,6 @@ pub struct KmcFixture {
     pub fields: Value,
 }
 
-/// What the suite found for one fixture.
-#[derive(Debug)]
-pub struct Outcome {
-    /// Fixture name.
-    pub name: String,
-    /// Everything that did not match; empty when the fixture passed.
-    pub problems: Vec<String>,
-    /// The expected fields were rewritten (`--bless`).
-    pub blessed: bool,
-}
-
 /// The KMC fixture file.
 pub fn kmc_fixture_path() -> PathBuf {
     workspace_root().join("fixtures/kmc/frames.json")
@@ -51,11 +39,6 @@ pub fn kmc_fixture_path() -> PathBuf {
 pub fn load_kmc(path: &Path) -> anyhow::Result<Vec<KmcFixture>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
-}
-
-/// A frame as JSON, through text so that f32 values keep their shortest form.
-fn to_json<T: Serialize>(frame: &T) -> anyhow::Result<Value> {
-    Ok(serde_json::from_str(&serde_json::to_string(frame)?)?)
 }
 
 /// Decodes, compares and re-encodes one fixture; returns the decoded fields and the problems.

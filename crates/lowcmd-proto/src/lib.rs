@@ -1,0 +1,24 @@
+#![doc = include_str!("../README.md")]
+#![cfg_attr(not(feature = "std"), no_std)]
+#![forbid(unsafe_code)]
+
+mod cdr;
+pub mod crc;
+mod error;
+pub mod go2;
+#[doc(hidden)]
+pub mod harness;
+pub mod hg;
+#[cfg(feature = "json")]
+pub mod json;
+pub mod layout;
+mod message;
+
+pub use cdr::CdrEncoding;
+pub use error::DecodeError;
+pub use go2::{BmsCmd, BmsState, ImuState, LowCmd, LowState, MotorCmd, MotorState};
+pub use hg::{HgImuState, HgLowCmd, HgLowState, HgMotorCmd, HgMotorState};
+pub use message::{CrcCheck, MAX_IMAGE_LEN, Message, Unverified};
+pub use robowire_core::BufferTooSmall;
+pub use zerocopy::little_endian::{F32, I16, I32, U16, U32};
+pub use zerocopy::{FromZeros, IntoBytes};

@@ -1,0 +1,216 @@
+//! What every low-level message can do: struct image with CRC, CDR, both ways.
+
+use robowire_core::BufferTooSmall;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
+
+use crate::cdr::{self, BodyError, CdrEncoding, Decoder, Encoder};
+use crate::crc::crc32_words;
+use crate::layout::StructLayout;
+use crate::{DecodeError, go2, hg};
+
+/// Largest struct image (HG `LowState_`).
+pub const MAX_IMAGE_LEN: usize = 2092;
+
+/// The CRC a message carries and the one its zero-padded image gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct CrcCheck {
+    /// CRC computed over the zero-padded image.
+    pub computed: u32,
+    /// The message's `crc` field.
+    pub received: u32,
+}
+
+impl CrcCheck {
+    /// Do they agree?
+    pub fn is_ok(&self) -> bool {
+        self.computed == self.received
+    }
+}
+
+/// A message decoded without verification, with what verification would have found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Unverified<M> {
+    /// The message, padding zeroed.
+    pub message: M,
+    /// CRC agreement.
+    pub crc: CrcCheck,
+    /// Offset and value of the first non-zero padding byte in a struct image, if any.
+    pub padding: Option<(usize, u8)>,
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// A Unitree low-level message: Go2 [`LowCmd`](crate::LowCmd) / [`LowState`](crate::LowState),
+/// HG [`HgLowCmd`](crate::HgLowCmd) / [`HgLowState`](crate::HgLowState).
+///
+/// Encoding always zeroes the padding and writes the CRC; decoding verifies both (use the
+/// `_unverified` variants to look at a broken message).
+pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immutable + Copy + Default {
+    /// Field table.
+    const FIELDS: &'static StructLayout;
+    /// DDS type name on the wire.
+    const DDS_TYPE_NAME: &'static str;
+    /// DDS topic.
+    const TOPIC: &'static str;
+    /// Struct image length in bytes.
+    const IMAGE_LEN: usize = size_of::<Self>();
+
+    /// Sets every padding byte to zero.
+    fn zero_padding(&mut self);
+
+    /// The `crc` field (the last 4 bytes).
+    fn crc(&self) -> u32 {
+        let bytes = self.as_bytes();
+        let n = bytes.len();
+        u32::from_le_bytes([bytes[n - 4], bytes[n - 3], bytes[n - 2], bytes[n - 1]])
+    }
+
+    /// The CRC of the zero-padded image (what [`seal`](Self::seal) writes).
+    fn computed_crc(&self) -> u32 {
+        let mut copy = *self;
+        copy.zero_padding();
+        let bytes = copy.as_bytes();
+        crc32_words(&bytes[..bytes.len() - 4]).unwrap_or(0)
+    }
+
+    /// Zeroes the padding and writes the CRC: the message as it must be sent.
+    fn seal(&mut self) {
+        self.zero_padding();
+        let crc = self.computed_crc();
+        let bytes = self.as_mut_bytes();
+        let n = bytes.len();
+        bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    }
+
+    /// A sealed copy.
+    fn sealed(&self) -> Self {
+        let mut copy = *self;
+        copy.seal();
+        copy
+    }
+
+    /// Writes the sealed struct image (zero padding, CRC) into `out`; returns its length.
+    fn encode_image(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let (needed, available) = (Self::IMAGE_LEN, out.len());
+        let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
+        dst.copy_from_slice(self.sealed().as_bytes());
+        Ok(needed)
+    }
+
+    /// Decodes a struct image without verifying padding or CRC.
+    fn decode_image_unverified(bytes: &[u8]) -> Result<Unverified<Self>, DecodeError<Self>> {
+        let mut message = Self::read_from_bytes(bytes)
+            .map_err(|_| DecodeError::Length { expected: Self::IMAGE_LEN, found: bytes.len() })?;
+        message.zero_padding();
+        let padding = bytes.iter().zip(message.as_bytes()).position(|(a, b)| a != b).map(|i| (i, bytes[i]));
+        let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
+        Ok(Unverified { message, crc, padding })
+    }
+
+    /// Decodes a struct image: exact length, zero padding, matching CRC.
+    fn decode_image(bytes: &[u8]) -> Result<Self, DecodeError<Self>> {
+        Self::decode_image_unverified(bytes)?.verify()
+    }
+
+    /// Length of the CDR payload, header included.
+    fn cdr_len(encoding: CdrEncoding) -> usize {
+        4 + cdr::body_len(Self::FIELDS, encoding)
+    }
+
+    /// Writes the CDR payload of the sealed message (header, body) into `out`; returns its length.
+    fn encode_cdr(&self, encoding: CdrEncoding, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let (needed, available) = (Self::cdr_len(encoding), out.len());
+        let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
+        dst.fill(0);
+        dst[..4].copy_from_slice(&encoding.header());
+        let sealed = self.sealed();
+        let mut encoder = Encoder { image: sealed.as_bytes(), body: &mut dst[4..] };
+        let mut pos = 0;
+        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut encoder)
+            .map_err(|_| BufferTooSmall { needed, available })?;
+        Ok(needed)
+    }
+
+    /// Decodes a CDR payload (XCDR1 or XCDR2) without verifying the CRC.
+    fn decode_cdr_unverified(bytes: &[u8]) -> Result<(Unverified<Self>, CdrEncoding), DecodeError<Self>> {
+        let header: [u8; 4] = bytes
+            .get(..4)
+            .and_then(|h| h.try_into().ok())
+            .ok_or(DecodeError::Length { expected: Self::cdr_len(CdrEncoding::Xcdr1), found: bytes.len() })?;
+        let encoding = CdrEncoding::from_header(header).ok_or(DecodeError::Encapsulation { found: header })?;
+        let expected = Self::cdr_len(encoding);
+        if bytes.len() != expected {
+            return Err(DecodeError::Length { expected, found: bytes.len() });
+        }
+        let mut image = [0u8; MAX_IMAGE_LEN];
+        let image = &mut image[..Self::IMAGE_LEN];
+        let mut decoder = Decoder { body: &bytes[4..], image };
+        let mut pos = 0;
+        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut decoder).map_err(|e| match e {
+            BodyError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
+            BodyError::OutOfBounds => DecodeError::Length { expected, found: bytes.len() },
+        })?;
+        let message = Self::read_from_bytes(image).map_err(|_| DecodeError::Length { expected, found: bytes.len() })?;
+        let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
+        // CDR carries no struct padding: the rebuilt image is zero-padded by construction.
+        Ok((Unverified { message, crc, padding: None }, encoding))
+    }
+
+    /// Decodes a CDR payload (XCDR1 or XCDR2) and verifies the CRC over the rebuilt image.
+    fn decode_cdr(bytes: &[u8]) -> Result<(Self, CdrEncoding), DecodeError<Self>> {
+        let (unverified, encoding) = Self::decode_cdr_unverified(bytes)?;
+        Ok((unverified.verify()?, encoding))
+    }
+}
+
+impl<M: Message> Unverified<M> {
+    /// The message if padding and CRC are right, else the error (carrying the message).
+    ///
+    /// Built with `cfg(fuzzing)`, both checks pass, so that fuzzers reach the parser.
+    pub fn verify(self) -> Result<M, DecodeError<M>> {
+        if cfg!(fuzzing) {
+            return Ok(self.message);
+        }
+        if let Some((offset, value)) = self.padding {
+            return Err(DecodeError::NonZeroPadding { offset, value });
+        }
+        if !self.crc.is_ok() {
+            return Err(DecodeError::CrcMismatch {
+                expected: self.crc.computed,
+                found: self.crc.received,
+                message: self.message,
+            });
+        }
+        Ok(self.message)
+    }
+}
+
+macro_rules! message {
+    ($ty:ty, $layout:expr, $dds:literal, $topic:literal, $len:literal) => {
+        impl sealed::Sealed for $ty {}
+        impl Message for $ty {
+            const FIELDS: &'static StructLayout = &$layout;
+            const DDS_TYPE_NAME: &'static str = $dds;
+            const TOPIC: &'static str = $topic;
+            fn zero_padding(&mut self) {
+                self.zero_padding_impl();
+            }
+        }
+        impl $ty {
+            #[doc = concat!("The sealed ", stringify!($len), "-byte struct image (zero padding, CRC).")]
+            pub fn to_image(&self) -> [u8; $len] {
+                let mut out = [0u8; $len];
+                out.copy_from_slice(self.sealed().as_bytes());
+                out
+            }
+        }
+        const _: () = assert!(size_of::<$ty>() == $len && $len <= MAX_IMAGE_LEN);
+    };
+}
+
+message!(go2::LowCmd, go2::LOW_CMD_LAYOUT, "unitree_go::msg::dds_::LowCmd_", "rt/lowcmd", 812);
+message!(go2::LowState, go2::LOW_STATE_LAYOUT, "unitree_go::msg::dds_::LowState_", "rt/lowstate", 1180);
+message!(hg::HgLowCmd, hg::HG_LOW_CMD_LAYOUT, "unitree_hg::msg::dds_::LowCmd_", "rt/lowcmd", 1004);
+message!(hg::HgLowState, hg::HG_LOW_STATE_LAYOUT, "unitree_hg::msg::dds_::LowState_", "rt/lowstate", 2092);

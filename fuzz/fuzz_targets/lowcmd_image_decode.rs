@@ -1,0 +1,7 @@
+//! Unitree struct-image decoding (Go2 and HG, selected by byte 0), CRC and padding checks
+//! bypassed under `cfg(fuzzing)`: re-encoding and verified re-decoding must agree.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| lowcmd_proto::harness::image_decode(data));
