@@ -32,7 +32,8 @@ impl CdrEncoding {
 /// What the walker does at each primitive and each XCDR2 array header.
 pub(crate) trait Visitor {
     type Error;
-    /// A primitive of `size` bytes at body offset `body` and image offset `image`.
+    /// `size` bytes of primitives (one, or a whole array) at body offset `body` and image offset
+    /// `image`.
     fn scalar(&mut self, body: usize, image: usize, size: usize) -> Result<(), Self::Error>;
     /// The DHEADER at body offset `at` of an array of structs that took `len` body bytes.
     fn array_header(&mut self, at: usize, len: u32, field: &'static str) -> Result<(), Self::Error>;
@@ -53,12 +54,12 @@ pub(crate) fn walk<V: Visitor>(
     for field in layout.fields {
         match field.shape {
             Shape::Scalar(scalar) => {
-                let size = scalar.size();
-                for i in 0..field.len() {
-                    *pos = align(*pos, size);
-                    visitor.scalar(*pos, base + field.offset + i * size, size)?;
-                    *pos += size;
-                }
+                // Once the first element is aligned, an array's elements are contiguous in the
+                // body as in the image: one copy for the whole array.
+                let len = scalar.size() * field.len();
+                *pos = align(*pos, scalar.size());
+                visitor.scalar(*pos, base + field.offset, len)?;
+                *pos += len;
             }
             Shape::Struct(sub) => {
                 let header_at = (xcdr2 && field.count.is_some()).then(|| {
@@ -101,22 +102,64 @@ pub(crate) fn body_len(layout: &StructLayout, encoding: CdrEncoding) -> usize {
     pos
 }
 
-/// Copies image scalars into a zeroed body; fills in DHEADERs.
+/// A pending copy that grows while the walk stays contiguous in both buffers.
+#[derive(Default)]
+struct Run {
+    body: usize,
+    image: usize,
+    len: usize,
+}
+
+impl Run {
+    /// Extends the run with `len` bytes at (`body`, `image`) if contiguous; else returns the
+    /// finished run and starts a new one.
+    fn push(&mut self, body: usize, image: usize, len: usize) -> Option<Run> {
+        if self.len > 0 && body == self.body + self.len && image == self.image + self.len {
+            self.len += len;
+            None
+        } else {
+            Some(core::mem::replace(self, Run { body, image, len }))
+        }
+    }
+}
+
+/// Copies image scalars into a zeroed body in as few runs as the layout allows; fills in
+/// DHEADERs. Call [`Encoder::finish`] after the walk.
 pub(crate) struct Encoder<'a> {
     pub(crate) image: &'a [u8],
     pub(crate) body: &'a mut [u8],
+    run: Run,
 }
 
 /// The walk left the buffers' bounds (a layout bug; never with the crate's own layouts).
 #[derive(Debug)]
 pub(crate) struct OutOfBounds;
 
+impl<'a> Encoder<'a> {
+    pub(crate) fn new(image: &'a [u8], body: &'a mut [u8]) -> Self {
+        Self { image, body, run: Run::default() }
+    }
+
+    fn copy(&mut self, run: &Run) -> Result<(), OutOfBounds> {
+        let src = self.image.get(run.image..run.image + run.len).ok_or(OutOfBounds)?;
+        self.body.get_mut(run.body..run.body + run.len).ok_or(OutOfBounds)?.copy_from_slice(src);
+        Ok(())
+    }
+
+    /// Copies the last pending run.
+    pub(crate) fn finish(mut self) -> Result<(), OutOfBounds> {
+        let run = core::mem::take(&mut self.run);
+        self.copy(&run)
+    }
+}
+
 impl Visitor for Encoder<'_> {
     type Error = OutOfBounds;
     fn scalar(&mut self, body: usize, image: usize, size: usize) -> Result<(), OutOfBounds> {
-        let src = self.image.get(image..image + size).ok_or(OutOfBounds)?;
-        self.body.get_mut(body..body + size).ok_or(OutOfBounds)?.copy_from_slice(src);
-        Ok(())
+        match self.run.push(body, image, size) {
+            Some(done) => self.copy(&done),
+            None => Ok(()),
+        }
     }
     fn array_header(&mut self, at: usize, len: u32, _: &'static str) -> Result<(), OutOfBounds> {
         self.body.get_mut(at..at + 4).ok_or(OutOfBounds)?.copy_from_slice(&len.to_le_bytes());
@@ -124,10 +167,12 @@ impl Visitor for Encoder<'_> {
     }
 }
 
-/// Copies body scalars into a zeroed image; checks DHEADERs.
+/// Copies body scalars into a zeroed image in as few runs as the layout allows; checks
+/// DHEADERs. Call [`Decoder::finish`] after the walk.
 pub(crate) struct Decoder<'a> {
     pub(crate) body: &'a [u8],
     pub(crate) image: &'a mut [u8],
+    run: Run,
 }
 
 /// Why a body did not decode.
@@ -137,12 +182,31 @@ pub(crate) enum BodyError {
     ArrayHeader { field: &'static str, expected: u32, found: u32 },
 }
 
+impl<'a> Decoder<'a> {
+    pub(crate) fn new(body: &'a [u8], image: &'a mut [u8]) -> Self {
+        Self { body, image, run: Run::default() }
+    }
+
+    fn copy(&mut self, run: &Run) -> Result<(), BodyError> {
+        let src = self.body.get(run.body..run.body + run.len).ok_or(BodyError::OutOfBounds)?;
+        self.image.get_mut(run.image..run.image + run.len).ok_or(BodyError::OutOfBounds)?.copy_from_slice(src);
+        Ok(())
+    }
+
+    /// Copies the last pending run.
+    pub(crate) fn finish(mut self) -> Result<(), BodyError> {
+        let run = core::mem::take(&mut self.run);
+        self.copy(&run)
+    }
+}
+
 impl Visitor for Decoder<'_> {
     type Error = BodyError;
     fn scalar(&mut self, body: usize, image: usize, size: usize) -> Result<(), BodyError> {
-        let src = self.body.get(body..body + size).ok_or(BodyError::OutOfBounds)?;
-        self.image.get_mut(image..image + size).ok_or(BodyError::OutOfBounds)?.copy_from_slice(src);
-        Ok(())
+        match self.run.push(body, image, size) {
+            Some(done) => self.copy(&done),
+            None => Ok(()),
+        }
     }
     fn array_header(&mut self, at: usize, len: u32, field: &'static str) -> Result<(), BodyError> {
         let bytes = self.body.get(at..at + 4).ok_or(BodyError::OutOfBounds)?;

@@ -36,6 +36,19 @@ pub fn crc32_words(covered: &[u8]) -> Option<u32> {
     Some(backend(&buf[..len]))
 }
 
+/// CRC of `covered`, reversing its 4-byte groups in place first (they stay reversed): the
+/// fast path for a caller that owns a scratch copy of the image anyway.
+pub fn crc32_words_in_place(covered: &mut [u8]) -> Option<u32> {
+    if !covered.len().is_multiple_of(4) || covered.len() > MAX_COVERED_LEN {
+        return None;
+    }
+    let (words, _) = covered.as_chunks_mut::<4>();
+    for word in words {
+        *word = u32::from_le_bytes(*word).to_be_bytes();
+    }
+    Some(backend(covered))
+}
+
 /// CRC of `covered` on the portable table backend (what `no_std` builds use).
 pub fn crc32_words_table(covered: &[u8]) -> Option<u32> {
     let (buf, len) = swapped(covered)?;
@@ -71,6 +84,7 @@ mod tests {
         for (input, crc) in cases {
             assert_eq!(crc32_words(input), Some(crc));
             assert_eq!(crc32_words_table(input), Some(crc));
+            assert_eq!(crc32_words_in_place(&mut input.to_vec()), Some(crc));
         }
         assert_eq!(crc32_words(&[0; 3]), None);
         assert_eq!(crc32_words(&[0; MAX_COVERED_LEN + 4]), None);

@@ -4,7 +4,7 @@ use robowire_core::BufferTooSmall;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use crate::cdr::{self, BodyError, CdrEncoding, Decoder, Encoder};
-use crate::crc::crc32_words;
+use crate::crc::crc32_words_in_place;
 use crate::layout::StructLayout;
 use crate::{DecodeError, go2, hg};
 
@@ -69,10 +69,11 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
 
     /// The CRC of the zero-padded image (what [`seal`](Self::seal) writes).
     fn computed_crc(&self) -> u32 {
-        let mut copy = *self;
-        copy.zero_padding();
-        let bytes = copy.as_bytes();
-        crc32_words(&bytes[..bytes.len() - 4]).unwrap_or(0)
+        let mut scratch = *self;
+        scratch.zero_padding();
+        let bytes = scratch.as_mut_bytes();
+        let n = bytes.len();
+        crc32_words_in_place(&mut bytes[..n - 4]).unwrap_or(0)
     }
 
     /// Zeroes the padding and writes the CRC: the message as it must be sent.
@@ -104,7 +105,12 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         let mut message = Self::read_from_bytes(bytes)
             .map_err(|_| DecodeError::Length { expected: Self::IMAGE_LEN, found: bytes.len() })?;
         message.zero_padding();
-        let padding = bytes.iter().zip(message.as_bytes()).position(|(a, b)| a != b).map(|i| (i, bytes[i]));
+        // Zeroing changed a byte only if that padding byte was not zero.
+        let padding = if bytes == message.as_bytes() {
+            None
+        } else {
+            bytes.iter().zip(message.as_bytes()).position(|(a, b)| a != b).map(|i| (i, bytes[i]))
+        };
         let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
         Ok(Unverified { message, crc, padding })
     }
@@ -126,9 +132,10 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         dst.fill(0);
         dst[..4].copy_from_slice(&encoding.header());
         let sealed = self.sealed();
-        let mut encoder = Encoder { image: sealed.as_bytes(), body: &mut dst[4..] };
+        let mut encoder = Encoder::new(sealed.as_bytes(), &mut dst[4..]);
         let mut pos = 0;
         cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut encoder)
+            .and_then(|()| encoder.finish())
             .map_err(|_| BufferTooSmall { needed, available })?;
         Ok(needed)
     }
@@ -146,12 +153,16 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         }
         let mut image = [0u8; MAX_IMAGE_LEN];
         let image = &mut image[..Self::IMAGE_LEN];
-        let mut decoder = Decoder { body: &bytes[4..], image };
+        let mut decoder = Decoder::new(&bytes[4..], image);
         let mut pos = 0;
-        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut decoder).map_err(|e| match e {
-            BodyError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
-            BodyError::OutOfBounds => DecodeError::Length { expected, found: bytes.len() },
-        })?;
+        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut decoder)
+            .and_then(|()| decoder.finish())
+            .map_err(|e| match e {
+                BodyError::ArrayHeader { field, expected, found } => {
+                    DecodeError::ArrayHeader { field, expected, found }
+                }
+                BodyError::OutOfBounds => DecodeError::Length { expected, found: bytes.len() },
+            })?;
         let message = Self::read_from_bytes(image).map_err(|_| DecodeError::Length { expected, found: bytes.len() })?;
         let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
         // CDR carries no struct padding: the rebuilt image is zero-padded by construction.
