@@ -1,0 +1,2 @@
+//! Placeholder until the cross-process handshake benchmark lands.
+fn main() {}

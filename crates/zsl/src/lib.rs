@@ -1,0 +1,12 @@
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+
+pub mod spline;
+
+pub use spline::{
+    CommandUpdate, ImuError, ImuReader, ImuSample, ImuWriter, SplineClient, SplineClientCounters, SplineDaemon,
+    SplineDaemonCounters, SplineError,
+};
+pub use zsl_proto::shm::{
+    ConsumerIndex, JointControl, JointFlags, JointIndex, Leg, SplineCommandBlock, SplineStateBlock,
+};

@@ -1,0 +1,159 @@
+//! Client, daemon and IMU on a heap region: the protocol without the operating system (these
+//! tests also run under Miri).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use robowire_shm::{HeapRegion, SharedRegion};
+use zsl::spline::{ImuSample, ImuWriter, SPLINE_DATA_LEN};
+use zsl::{
+    CommandUpdate, ConsumerIndex, ImuError, ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock,
+    SplineDaemon, SplineError, SplineStateBlock,
+};
+
+fn region() -> Arc<HeapRegion> {
+    Arc::new(HeapRegion::new(10240))
+}
+
+fn command(marker: f32) -> SplineCommandBlock {
+    let mut cmd = SplineCommandBlock::default();
+    for leg in Leg::ALL {
+        for joint in JointIndex::ALL {
+            *cmd.joint_mut(leg, joint) = JointControl::new(marker, 0.0, 20.0, 1.0, 0.0);
+        }
+    }
+    cmd
+}
+
+#[test]
+fn command_and_state_round_trip() {
+    let shared = region();
+    let mut client = SplineClient::new(shared.clone()).unwrap();
+    let mut daemon = SplineDaemon::new(shared.clone()).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Repeated, "nothing fresh yet");
+    client.write_command(&command(0.5)).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Fresh);
+    assert_eq!(daemon.command().joint(Leg::RearLeft, JointIndex::Knee).p_des.get(), 0.5);
+    assert_eq!(daemon.command().legs[2].flags.get(), 1, "leg flags are always 1");
+    assert_eq!(shared.load_u32(336, Ordering::Acquire), Ok(0), "the daemon cleared the control flag");
+
+    assert_eq!(client.try_read_state().unwrap(), None, "no state published yet");
+    let mut state = SplineStateBlock::default();
+    state.joint_mut(Leg::FrontLeft, JointIndex::Hip).p = 1.25.into();
+    daemon.publish_state(&state).unwrap();
+    let got = client.try_read_state().unwrap().expect("fresh state");
+    assert_eq!(got.joint(Leg::FrontLeft, JointIndex::Hip).p.get(), 1.25);
+    assert_eq!(client.try_read_state().unwrap(), None, "consumed");
+    // A monitor reads through the other consumer flag, which the controller left set.
+    let mut monitor = SplineClient::new(shared.clone()).unwrap().with_consumer(ConsumerIndex::Other);
+    assert!(monitor.try_read_state().unwrap().is_some());
+    assert_eq!(client.counters().commands_written, 1);
+    assert_eq!(client.counters().states_read, 1);
+}
+
+#[test]
+fn daemon_clears_the_command_after_ten_missed_cycles() {
+    let shared = region();
+    let mut client = SplineClient::new(shared.clone()).unwrap();
+    let mut daemon = SplineDaemon::new(shared).unwrap();
+    client.write_command(&command(0.3)).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Fresh);
+    for cycle in 1..10 {
+        assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Repeated, "cycle {cycle}");
+        assert_eq!(daemon.command().joint(Leg::FrontRight, JointIndex::Abad).p_des.get(), 0.3);
+    }
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Cleared);
+    assert_eq!(*daemon.command(), SplineCommandBlock::default(), "limp: kp = kd = 0");
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Cleared);
+    assert_eq!(daemon.counters().clears, 1);
+    client.write_command(&command(0.4)).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Fresh, "a fresh command resumes");
+}
+
+#[test]
+fn non_finite_commands_are_refused_on_both_sides() {
+    let shared = region();
+    let mut client = SplineClient::new(shared.clone()).unwrap();
+    let mut bad = command(0.1);
+    bad.joint_mut(Leg::RearRight, JointIndex::Knee).kd = f32::NAN.into();
+    match client.write_command(&bad) {
+        Err(SplineError::NonFinite { leg: Leg::RearRight, joint: JointIndex::Knee, field: "kd" }) => {}
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(shared.load_u32(336, Ordering::Acquire), Ok(0), "nothing published");
+    // A foreign client that writes NaN anyway: the daemon ignores the command.
+    use zsl_proto::zerocopy::IntoBytes;
+    shared.write(0, &bad.as_bytes()[..336]).unwrap();
+    shared.store_u32(336, 1, Ordering::Release).unwrap();
+    let mut daemon = SplineDaemon::new(shared).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Rejected);
+    assert_eq!(*daemon.command(), SplineCommandBlock::default());
+}
+
+#[test]
+fn a_silent_daemon_is_reported_as_stalled() {
+    let shared = region();
+    let mut client = SplineClient::new(shared).unwrap().with_stall_after(Duration::from_millis(5));
+    match client.wait_state(Duration::from_secs(5)) {
+        Err(SplineError::DaemonStalled { stalled_for }) => assert!(stalled_for >= Duration::from_millis(5)),
+        other => panic!("{other:?}"),
+    }
+    assert!(client.is_stalled());
+    assert_eq!(client.counters().stalls, 1);
+    assert!(matches!(client.wait_state(Duration::from_millis(1)), Err(SplineError::DaemonStalled { .. })));
+    assert_eq!(client.counters().stalls, 1, "one stall, reported once");
+}
+
+#[test]
+fn regions_too_small_are_refused() {
+    assert!(SplineClient::new(HeapRegion::new(SPLINE_DATA_LEN - 4)).is_err());
+    assert!(ImuReader::new(HeapRegion::new(40)).is_err());
+}
+
+#[test]
+fn imu_writer_racing_the_reader_never_yields_a_torn_sample() {
+    let shared = region();
+    let mut reader = ImuReader::new(shared.clone()).unwrap().with_max_attempts(1000);
+    assert!(matches!(reader.read(), Err(ImuError::NoSample)));
+    let stop = Arc::new(AtomicBool::new(false));
+    let writer = {
+        let (shared, stop) = (shared.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let mut writer = ImuWriter::new(shared).unwrap();
+            let mut k = 1u64;
+            while !stop.load(Ordering::Relaxed) {
+                let v = k as f32;
+                writer
+                    .publish(&ImuSample {
+                        timestamp_ns: k,
+                        acc_mps2: [v; 3],
+                        gyro_radps: [v; 3],
+                        quaternion_wxyz: [v; 4],
+                    })
+                    .unwrap();
+                k += 1;
+            }
+            k
+        })
+    };
+    let reads = if cfg!(miri) { 50 } else { 200_000 };
+    let mut consistent = 0;
+    for _ in 0..reads {
+        match reader.read() {
+            Ok(sample) => {
+                let v = sample.timestamp_ns as f32;
+                assert!(
+                    sample.acc_mps2.iter().chain(&sample.gyro_radps).chain(&sample.quaternion_wxyz).all(|&x| x == v),
+                    "torn sample {sample:?}"
+                );
+                consistent += 1;
+            }
+            Err(ImuError::NoSample | ImuError::Torn { .. }) => {}
+            Err(other) => panic!("{other}"),
+        }
+    }
+    stop.store(true, Ordering::Relaxed);
+    let written = writer.join().unwrap();
+    assert!(consistent > 0 && written > 1, "the race happened: {consistent} reads, {written} writes");
+}
