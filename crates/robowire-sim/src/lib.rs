@@ -3,3 +3,4 @@
 
 pub mod kmc;
 pub mod pty;
+pub mod spline;

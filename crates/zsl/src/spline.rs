@@ -211,9 +211,12 @@ impl<R: SharedRegion> SplineClient<R> {
         Ok(Some(state))
     }
 
-    /// Waits for fresh state: spins briefly, then sleeps in short steps. Fails with
-    /// [`SplineError::DaemonStalled`] once no fresh state came for the stall bound, or with
-    /// [`SplineError::Timeout`] at `timeout`.
+    /// Waits for fresh state: spins briefly, then sleeps in short steps.
+    ///
+    /// Crossing the stall bound (no fresh state for `stall_after`) returns
+    /// [`SplineError::DaemonStalled`] at once, the first time. While stalled, a call waits up to
+    /// `timeout` for the daemon to come back and returns `DaemonStalled` again if it does not.
+    /// A healthy daemon that is merely slower than `timeout` gives [`SplineError::Timeout`].
     pub fn wait_state(&mut self, timeout: Duration) -> Result<SplineStateBlock, SplineError> {
         let start = Instant::now();
         loop {
@@ -222,16 +225,18 @@ impl<R: SharedRegion> SplineClient<R> {
             }
             let now = Instant::now();
             let since_fresh = now.saturating_duration_since(self.last_fresh);
-            if since_fresh >= self.stall_after {
-                if !self.stalled {
-                    self.stalled = true;
-                    self.counters.stalls += 1;
-                }
+            if since_fresh >= self.stall_after && !self.stalled {
+                self.stalled = true;
+                self.counters.stalls += 1;
                 return Err(SplineError::DaemonStalled { stalled_for: since_fresh });
             }
             let waited = now.saturating_duration_since(start);
             if waited >= timeout {
-                return Err(SplineError::Timeout { timeout });
+                return Err(if self.stalled {
+                    SplineError::DaemonStalled { stalled_for: since_fresh }
+                } else {
+                    SplineError::Timeout { timeout }
+                });
             }
             if waited < Duration::from_micros(50) {
                 std::hint::spin_loop();
