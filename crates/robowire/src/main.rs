@@ -6,6 +6,7 @@ mod demo;
 mod hex;
 mod kmc_cmd;
 mod lowlevel;
+mod shm_cmd;
 mod sim;
 
 use std::process::ExitCode;
@@ -29,6 +30,9 @@ enum Command {
     Sim(sim::SimCommand),
     /// Talk to a KMC wheeled chassis over a serial port.
     Kmc(kmc_cmd::KmcArgs),
+    /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
+    #[command(subcommand)]
+    Shm(shm_cmd::ShmCommand),
     /// Decode frames or messages from hex and print them.
     #[command(subcommand)]
     Decode(decode::DecodeCommand),
@@ -46,6 +50,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => demo::run(&args),
         Command::Sim(command) => sim::run(command),
         Command::Kmc(args) => kmc_cmd::run(args),
+        Command::Shm(command) => shm_cmd::run(&command),
         Command::Decode(command) => decode::run(&command),
         Command::Encode(command) => decode::run_encode(&command),
     };

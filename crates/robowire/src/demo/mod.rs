@@ -2,6 +2,7 @@
 //! what was commanded was observed.
 
 mod kmc;
+mod spline;
 
 use std::process::ExitCode;
 
@@ -22,6 +23,8 @@ pub(crate) struct DemoArgs {
 enum Device {
     /// KMC wheeled chassis on a pseudo-terminal.
     Kmc,
+    /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).
+    Spline,
 }
 
 /// One thing a scenario commanded and whether it was observed.
@@ -47,6 +50,10 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     let mut checks = Vec::new();
     if args.only.is_none_or(|d| d == Device::Kmc) {
         checks.extend(kmc::run(args.duration)?);
+    }
+    if args.only.is_none_or(|d| d == Device::Spline) {
+        println!();
+        checks.extend(spline::run(args.duration)?);
     }
     println!();
     println!("checks");
