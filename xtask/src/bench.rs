@@ -12,7 +12,7 @@ use serde_json::Value;
 use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
-const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd")];
+const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline")];
 
 /// One row of the table.
 #[derive(Debug, Serialize)]
@@ -49,6 +49,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let target = target_dir(&root);
     std::fs::create_dir_all(&target)?;
     let meta_path = target.join("bench-meta.json");
+    let spline_meta_path = target.join("bench-meta-spline.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -59,6 +60,8 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .args(["bench", "-p", package, "--bench", bench, "--"])
             .args(times)
             .env("ROBOWIRE_BENCH_META", &meta_path)
+            .env("ROBOWIRE_BENCH_META_SPLINE", &spline_meta_path)
+            .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
             .context("running cargo bench")?;
@@ -100,6 +103,9 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     }
 
     rows.extend(lowcmd_rows(&criterion)?);
+    let spline: Value =
+        serde_json::from_str(&std::fs::read_to_string(&spline_meta_path).context("spline bench metadata")?)?;
+    rows.extend(spline_rows(&spline)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
@@ -172,6 +178,37 @@ fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
             met: None,
         });
     }
+    Ok(rows)
+}
+
+/// Rows of the spline shared-memory benchmark (cross-process round trip, 1 kHz loop).
+fn spline_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let rt = &meta["spline_roundtrip"];
+    let ns = |key: &str| rt[key].as_f64().with_context(|| format!("spline_roundtrip.{key}"));
+    let mut rows = Vec::new();
+    for pct in ["p50", "p99"] {
+        let (facade, raw, flags) =
+            (ns(&format!("facade_{pct}_ns"))?, ns(&format!("raw_{pct}_ns"))?, ns(&format!("flags_{pct}_ns"))?);
+        rows.push(Row {
+            path: format!("Spline handshake round trip, 2 processes, {pct}"),
+            figure: format!("{facade:.0} ns"),
+            baseline: format!("raw C-like atomics + copies: {raw:.0} ns (flags only: {flags:.0} ns)"),
+            ratio: format!("{:.2}×", facade / raw),
+            target: "≤ 1.5× raw".into(),
+            met: Some(facade <= 1.5 * raw),
+        });
+    }
+    let l = &meta["spline_loop"];
+    let us = |key: &str| l[key].as_u64().with_context(|| format!("spline_loop.{key}"));
+    let (p50, p99, max) = (us("p50_us")?, us("p99_us")?, us("max_us")?);
+    rows.push(Row {
+        path: format!("Spline daemon 1 kHz lateness over {} s", us("seconds")?),
+        figure: format!("p50 {p50} µs, p99 {p99} µs, max {max} µs"),
+        baseline: format!("{} cycles, {} missed", us("cycles")?, us("missed")?),
+        ratio: "–".into(),
+        target: "p50 ≤ 20 µs, p99 ≤ 100 µs".into(),
+        met: Some(p50 <= 20 && p99 <= 100),
+    });
     Ok(rows)
 }
 

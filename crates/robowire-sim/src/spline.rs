@@ -208,7 +208,7 @@ impl JointModel {
                 let c = command.joint(leg, joint);
                 let enabled = c.kp.get() != 0.0 || c.kd.get() != 0.0;
                 let temperature = 30 + (self.t[l][j].abs() / 3.0) as i16;
-                let bits = u32::from(enabled) * JointFlags::ENABLED | fault_bits[l][j];
+                let bits = if enabled { JointFlags::ENABLED } else { 0 } | fault_bits[l][j];
                 let s = state.joint_mut(leg, joint);
                 s.flags = JointFlags::new(48, temperature, bits).0.into();
                 s.p = self.p[l][j].into();

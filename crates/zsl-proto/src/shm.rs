@@ -167,6 +167,15 @@ impl SplineCommandBlock {
 
     /// The first non-finite value as (leg, joint, field index 0..5 in memory order), if any.
     pub fn first_non_finite(&self) -> Option<(Leg, JointIndex, usize)> {
+        // Fast path, branch-free over the 80 joint floats: NaN and ±inf have an all-ones exponent.
+        let mut any = false;
+        for leg in &self.legs {
+            let (words, _) = leg.joints.as_bytes().as_chunks::<4>();
+            any |= words.iter().fold(false, |acc, w| acc | (u32::from_le_bytes(*w) & 0x7f80_0000 == 0x7f80_0000));
+        }
+        if !any {
+            return None;
+        }
         for leg in Leg::ALL {
             for joint in JointIndex::ALL {
                 if let Some(field) = self.joint(leg, joint).values().iter().position(|v| !v.is_finite()) {

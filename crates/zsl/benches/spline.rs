@@ -1,2 +1,208 @@
-//! Placeholder until the cross-process handshake benchmark lands.
-fn main() {}
+//! Spline shared memory across two processes, busy-spinning on both sides.
+//!
+//! - `spline_roundtrip/facade`: `SplineClient::write_command` → the echo process's
+//!   `SplineDaemon` takes it and publishes state → `SplineClient::try_read_state` sees it.
+//! - `spline_roundtrip/raw_c_like`: the same protocol written as a C program would: block copies
+//!   and release/acquire flags straight on the region, no validation, no bookkeeping.
+//! - `spline_roundtrip/flags_only`: the flag ping-pong alone.
+//!
+//! After criterion, each variant's p50/p99 over individually timed round trips, and the spline
+//! daemon simulator's 1 kHz lateness over 10 s (3 s with `ROBOWIRE_BENCH_QUICK`), go to
+//! `$ROBOWIRE_BENCH_META` for `cargo xtask bench`.
+
+// `criterion_group!`-style functions are undocumented by nature.
+#![allow(missing_docs)]
+
+use std::hint::black_box;
+use std::process::{Child, Command};
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+use criterion::Criterion;
+use robowire_shm::{CreateOptions, MappedRegion, SharedRegion};
+use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use zsl::{
+    CommandUpdate, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineDaemon, SplineStateBlock,
+};
+use zsl_proto::zerocopy::IntoBytes;
+
+const ECHO_ENV: &str = "ROBOWIRE_SPLINE_ECHO";
+const READY_OFFSET: usize = 1024;
+const CMD_FLAG: usize = 336;
+const STATE_FLAG: usize = 600;
+
+fn command() -> SplineCommandBlock {
+    let mut cmd = SplineCommandBlock::default();
+    for leg in Leg::ALL {
+        for joint in JointIndex::ALL {
+            *cmd.joint_mut(leg, joint) = JointControl::new(0.5, 0.0, 40.0, 1.0, 0.0);
+        }
+    }
+    cmd
+}
+
+/// The echo process: answers every command with a state, spinning, until killed.
+fn echo(spec: &str) {
+    let (mode, name) = spec.split_once(':').expect("mode:name");
+    let region = MappedRegion::open(name, 2048).expect("the bench created the object");
+    region.store_u32(READY_OFFSET, 1, Ordering::Release).unwrap();
+    let state = SplineStateBlock::default();
+    match mode {
+        "facade" => {
+            let mut daemon = SplineDaemon::new(&region).unwrap();
+            loop {
+                if daemon.take_command().unwrap() == CommandUpdate::Fresh {
+                    daemon.publish_state(&state).unwrap();
+                }
+            }
+        }
+        "raw" => {
+            let mut cmd = [0u8; 336];
+            loop {
+                if region.load_u32(CMD_FLAG, Ordering::Acquire).unwrap() != 0 {
+                    region.read(0, &mut cmd).unwrap();
+                    region.store_u32(CMD_FLAG, 0, Ordering::Release).unwrap();
+                    region.write(344, &state.as_bytes()[..256]).unwrap();
+                    // Both readers' flags, as the protocol requires.
+                    region.store_u32(STATE_FLAG, 1, Ordering::Release).unwrap();
+                    region.store_u32(STATE_FLAG + 4, 1, Ordering::Release).unwrap();
+                }
+            }
+        }
+        _ => loop {
+            if region.load_u32(CMD_FLAG, Ordering::Acquire).unwrap() != 0 {
+                region.store_u32(CMD_FLAG, 0, Ordering::Relaxed).unwrap();
+                region.store_u32(STATE_FLAG, 1, Ordering::Release).unwrap();
+            }
+        },
+    }
+}
+
+struct Peer {
+    region: MappedRegion,
+    child: Child,
+}
+
+impl Peer {
+    fn start(mode: &str) -> Self {
+        let name = format!("/robowire-bench-{mode}-{}", std::process::id());
+        let region = MappedRegion::create(&name, 10240, &CreateOptions::default()).unwrap();
+        let child =
+            Command::new(std::env::current_exe().unwrap()).env(ECHO_ENV, format!("{mode}:{name}")).spawn().unwrap();
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while region.load_u32(READY_OFFSET, Ordering::Acquire).unwrap() == 0 {
+            assert!(Instant::now() < deadline, "echo process did not start");
+            std::thread::yield_now();
+        }
+        Self { region, child }
+    }
+}
+
+impl Drop for Peer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn raw_roundtrip(region: &MappedRegion, cmd: &[u8], state: &mut [u8; 256]) {
+    region.write(0, cmd).unwrap();
+    region.store_u32(CMD_FLAG, 1, Ordering::Release).unwrap();
+    while region.load_u32(STATE_FLAG, Ordering::Acquire).unwrap() == 0 {
+        std::hint::spin_loop();
+    }
+    region.read(344, state).unwrap();
+    region.store_u32(STATE_FLAG, 0, Ordering::Release).unwrap();
+}
+
+fn flags_roundtrip(region: &MappedRegion) {
+    region.store_u32(CMD_FLAG, 1, Ordering::Release).unwrap();
+    while region.load_u32(STATE_FLAG, Ordering::Acquire).unwrap() == 0 {
+        std::hint::spin_loop();
+    }
+    region.store_u32(STATE_FLAG, 0, Ordering::Relaxed).unwrap();
+}
+
+fn facade_roundtrip(client: &mut SplineClient<&MappedRegion>, cmd: &SplineCommandBlock) {
+    client.write_command(cmd).unwrap();
+    loop {
+        if let Some(state) = client.try_read_state().unwrap() {
+            black_box(state);
+            return;
+        }
+        std::hint::spin_loop();
+    }
+}
+
+/// p50 and p99 of `n` individually timed calls, ns.
+fn percentiles(n: usize, mut f: impl FnMut()) -> (u64, u64) {
+    for _ in 0..1000 {
+        f();
+    }
+    let mut samples: Vec<u64> = (0..n)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_nanos() as u64
+        })
+        .collect();
+    samples.sort_unstable();
+    (samples[n / 2], samples[(n * 99).div_ceil(100) - 1])
+}
+
+fn main() {
+    if let Ok(spec) = std::env::var(ECHO_ENV) {
+        echo(&spec);
+        return;
+    }
+    let cmd = command();
+    let cmd_bytes = cmd.as_bytes()[..336].to_vec();
+    let mut criterion = Criterion::default().configure_from_args();
+    let mut meta = Vec::new();
+    {
+        let mut group = criterion.benchmark_group("spline_roundtrip");
+        let facade = Peer::start("facade");
+        let mut client = SplineClient::new(&facade.region).unwrap();
+        group.bench_function("facade", |b| b.iter(|| facade_roundtrip(&mut client, &cmd)));
+        let (p50, p99) = percentiles(20_000, || facade_roundtrip(&mut client, &cmd));
+        meta.push(format!("\"facade_p50_ns\":{p50},\"facade_p99_ns\":{p99}"));
+        drop(facade);
+
+        let raw = Peer::start("raw");
+        let mut state = [0u8; 256];
+        group.bench_function("raw_c_like", |b| b.iter(|| raw_roundtrip(&raw.region, &cmd_bytes, &mut state)));
+        let (p50, p99) = percentiles(20_000, || raw_roundtrip(&raw.region, &cmd_bytes, &mut state));
+        meta.push(format!("\"raw_p50_ns\":{p50},\"raw_p99_ns\":{p99}"));
+        drop(raw);
+
+        let flags = Peer::start("flags");
+        group.bench_function("flags_only", |b| b.iter(|| flags_roundtrip(&flags.region)));
+        let (p50, p99) = percentiles(20_000, || flags_roundtrip(&flags.region));
+        meta.push(format!("\"flags_p50_ns\":{p50},\"flags_p99_ns\":{p99}"));
+        group.finish();
+    }
+    criterion.final_summary();
+
+    let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
+    let sim = SplineSim::spawn(SplineSimConfig::private("bench")).unwrap();
+    std::thread::sleep(Duration::from_secs(seconds));
+    let stats = sim.stats();
+    drop(sim);
+    println!(
+        "spline daemon 1 kHz over {seconds} s: {} cycles, {} missed, lateness p50 {} µs p99 {} µs max {} µs",
+        stats.cycles, stats.missed_cycles, stats.lateness.p50_us, stats.lateness.p99_us, stats.lateness.max_us
+    );
+    let json = format!(
+        "{{\"spline_roundtrip\":{{{}}},\"spline_loop\":{{\"seconds\":{seconds},\"cycles\":{},\"missed\":{},\"p50_us\":{},\"p99_us\":{},\"max_us\":{}}}}}",
+        meta.join(","),
+        stats.cycles,
+        stats.missed_cycles,
+        stats.lateness.p50_us,
+        stats.lateness.p99_us,
+        stats.lateness.max_us
+    );
+    println!("{json}");
+    if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_SPLINE") {
+        std::fs::write(path, json).unwrap();
+    }
+}

@@ -6,9 +6,9 @@ use std::time::{Duration, Instant};
 
 use robowire_shm::{CreateOptions, MappedRegion, RegionError, SharedRegion, ShmError};
 use zsl_proto::shm::{
-    CMD_FLAG_CONTROL_OFFSET, CMD_LEGS_LEN, ConsumerIndex, IMU_SHM_SIZE, JointIndex, Leg, NavImu, SPLINE_SHM_SIZE,
-    STATE_FLAG_CONTROL_OFFSET, STATE_FLAG_OTHER_OFFSET, STATE_LEGS_LEN, STATE_OFFSET, SplineCommandBlock,
-    SplineStateBlock,
+    CMD_FLAG_CONTROL_OFFSET, CMD_LEGS_LEN, ConsumerIndex, IMU_SHM_SIZE, JointIndex, Leg, LegControl, NavImu,
+    SPLINE_SHM_SIZE, STATE_FLAG_CONTROL_OFFSET, STATE_FLAG_OTHER_OFFSET, STATE_LEGS_LEN, STATE_OFFSET,
+    SplineCommandBlock, SplineStateBlock,
 };
 use zsl_proto::zerocopy::{FromZeros, IntoBytes};
 
@@ -89,6 +89,8 @@ pub enum ImuError {
 }
 
 const FIELD_NAMES: [&str; 5] = ["p_des", "v_des", "kp", "kd", "t_ff"];
+/// Offset of `flags` in a `leg_control`.
+const LEG_FLAGS_OFFSET: usize = std::mem::offset_of!(LegControl, flags);
 
 fn check_len(region: &impl SharedRegion, needed: usize) -> Result<(), RegionError> {
     if region.len() < needed {
@@ -126,7 +128,9 @@ pub struct SplineClient<R: SharedRegion = MappedRegion> {
     region: R,
     consumer: ConsumerIndex,
     stall_after: Duration,
-    last_fresh: Instant,
+    /// The first poll that found no fresh state since the last fresh one: the stall clock runs
+    /// from here. Stamped once per gap, so the fresh path never reads the clock.
+    waiting_since: Option<Instant>,
     stalled: bool,
     counters: SplineClientCounters,
 }
@@ -150,7 +154,7 @@ impl<R: SharedRegion> SplineClient<R> {
             region,
             consumer: ConsumerIndex::Control,
             stall_after: DEFAULT_STALL_AFTER,
-            last_fresh: Instant::now(),
+            waiting_since: None,
             stalled: false,
             counters: SplineClientCounters::default(),
         })
@@ -182,9 +186,12 @@ impl<R: SharedRegion> SplineClient<R> {
         if let Some((leg, joint, field)) = command.first_non_finite() {
             return Err(SplineError::NonFinite { leg, joint, field: FIELD_NAMES[field] });
         }
-        let mut command = *command;
-        command.normalize();
-        self.region.write(0, &command.as_bytes()[..CMD_LEGS_LEN])?;
+        // Each leg's joints as given, its `flags` word always 1 (spec decision 7).
+        for (i, leg) in command.legs.iter().enumerate() {
+            let at = i * size_of::<LegControl>();
+            self.region.write(at, leg.joints.as_bytes())?;
+            self.region.store_u32(at + LEG_FLAGS_OFFSET, 1, Ordering::Relaxed)?;
+        }
         self.region.store_u32(CMD_FLAG_CONTROL_OFFSET, 1, Ordering::Release)?;
         self.counters.commands_written += 1;
         Ok(())
@@ -200,20 +207,24 @@ impl<R: SharedRegion> SplineClient<R> {
     /// The state, if the daemon published one since the last read.
     pub fn try_read_state(&mut self) -> Result<Option<SplineStateBlock>, SplineError> {
         if self.region.load_u32(self.state_flag(), Ordering::Acquire)? == 0 {
+            if self.waiting_since.is_none() {
+                self.waiting_since = Some(Instant::now());
+            }
             return Ok(None);
         }
         let mut state = SplineStateBlock::new_zeroed();
         self.region.read(STATE_OFFSET, &mut state.as_mut_bytes()[..STATE_LEGS_LEN])?;
         self.region.store_u32(self.state_flag(), 0, Ordering::Release)?;
         self.counters.states_read += 1;
-        self.last_fresh = Instant::now();
+        self.waiting_since = None;
         self.stalled = false;
         Ok(Some(state))
     }
 
     /// Waits for fresh state: spins briefly, then sleeps in short steps.
     ///
-    /// Crossing the stall bound (no fresh state for `stall_after`) returns
+    /// Crossing the stall bound (no fresh state for `stall_after` of polling, counted from the
+    /// first poll that found none) returns
     /// [`SplineError::DaemonStalled`] at once, the first time. While stalled, a call waits up to
     /// `timeout` for the daemon to come back and returns `DaemonStalled` again if it does not.
     /// A healthy daemon that is merely slower than `timeout` gives [`SplineError::Timeout`].
@@ -224,7 +235,7 @@ impl<R: SharedRegion> SplineClient<R> {
                 return Ok(state);
             }
             let now = Instant::now();
-            let since_fresh = now.saturating_duration_since(self.last_fresh);
+            let since_fresh = self.waiting_since.map_or(Duration::ZERO, |t| now.saturating_duration_since(t));
             if since_fresh >= self.stall_after && !self.stalled {
                 self.stalled = true;
                 self.counters.stalls += 1;
@@ -246,9 +257,9 @@ impl<R: SharedRegion> SplineClient<R> {
         }
     }
 
-    /// No fresh state for longer than the stall bound?
+    /// Polled for longer than the stall bound without fresh state?
     pub fn is_stalled(&self) -> bool {
-        self.last_fresh.elapsed() >= self.stall_after
+        self.waiting_since.is_some_and(|t| t.elapsed() >= self.stall_after)
     }
 
     /// Counters.
@@ -292,6 +303,10 @@ pub struct SplineDaemonCounters {
 pub struct SplineDaemon<R: SharedRegion = MappedRegion> {
     region: R,
     command: SplineCommandBlock,
+    /// Where a fresh command lands before it is checked.
+    incoming: SplineCommandBlock,
+    /// The command was cleared and no fresh one came since.
+    cleared: bool,
     missed: u32,
     clear_after: u32,
     counters: SplineDaemonCounters,
@@ -311,6 +326,8 @@ impl<R: SharedRegion> SplineDaemon<R> {
         Ok(Self {
             region,
             command: SplineCommandBlock::default(),
+            incoming: SplineCommandBlock::default(),
+            cleared: true,
             missed: 0,
             clear_after: DEFAULT_CLEAR_AFTER_CYCLES,
             counters: SplineDaemonCounters::default(),
@@ -333,11 +350,11 @@ impl<R: SharedRegion> SplineDaemon<R> {
     /// else the previous one, or nothing after the clear bound.
     pub fn take_command(&mut self) -> Result<CommandUpdate, SplineError> {
         if self.region.load_u32(CMD_FLAG_CONTROL_OFFSET, Ordering::Acquire)? != 0 {
-            let mut fresh = SplineCommandBlock::new_zeroed();
-            self.region.read(0, &mut fresh.as_mut_bytes()[..CMD_LEGS_LEN])?;
+            self.region.read(0, &mut self.incoming.as_mut_bytes()[..CMD_LEGS_LEN])?;
             self.region.store_u32(CMD_FLAG_CONTROL_OFFSET, 0, Ordering::Release)?;
-            if fresh.first_non_finite().is_none() {
-                self.command = fresh;
+            if self.incoming.first_non_finite().is_none() {
+                core::mem::swap(&mut self.command, &mut self.incoming);
+                self.cleared = false;
                 self.missed = 0;
                 self.counters.fresh += 1;
                 return Ok(CommandUpdate::Fresh);
@@ -356,8 +373,9 @@ impl<R: SharedRegion> SplineDaemon<R> {
 
     fn after_miss(&mut self, update: CommandUpdate) -> CommandUpdate {
         if self.missed >= self.clear_after {
-            if self.command != SplineCommandBlock::default() {
+            if !self.cleared {
                 self.command = SplineCommandBlock::default();
+                self.cleared = true;
                 self.counters.clears += 1;
             }
             self.counters.cleared += 1;
