@@ -302,9 +302,10 @@ pub struct SplineDaemonCounters {
 #[derive(Debug)]
 pub struct SplineDaemon<R: SharedRegion = MappedRegion> {
     region: R,
-    command: SplineCommandBlock,
-    /// Where a fresh command lands before it is checked.
-    incoming: SplineCommandBlock,
+    /// Double buffer: `buffers[active]` is the command in force; a fresh command lands in the
+    /// other one and becomes active once checked, without a copy.
+    buffers: [SplineCommandBlock; 2],
+    active: usize,
     /// The command was cleared and no fresh one came since.
     cleared: bool,
     missed: u32,
@@ -325,8 +326,8 @@ impl<R: SharedRegion> SplineDaemon<R> {
         check_len(&region, SPLINE_DATA_LEN)?;
         Ok(Self {
             region,
-            command: SplineCommandBlock::default(),
-            incoming: SplineCommandBlock::default(),
+            buffers: [SplineCommandBlock::default(); 2],
+            active: 0,
             cleared: true,
             missed: 0,
             clear_after: DEFAULT_CLEAR_AFTER_CYCLES,
@@ -350,10 +351,11 @@ impl<R: SharedRegion> SplineDaemon<R> {
     /// else the previous one, or nothing after the clear bound.
     pub fn take_command(&mut self) -> Result<CommandUpdate, SplineError> {
         if self.region.load_u32(CMD_FLAG_CONTROL_OFFSET, Ordering::Acquire)? != 0 {
-            self.region.read(0, &mut self.incoming.as_mut_bytes()[..CMD_LEGS_LEN])?;
+            let spare = 1 - self.active;
+            self.region.read(0, &mut self.buffers[spare].as_mut_bytes()[..CMD_LEGS_LEN])?;
             self.region.store_u32(CMD_FLAG_CONTROL_OFFSET, 0, Ordering::Release)?;
-            if self.incoming.first_non_finite().is_none() {
-                core::mem::swap(&mut self.command, &mut self.incoming);
+            if self.buffers[spare].first_non_finite().is_none() {
+                self.active = spare;
                 self.cleared = false;
                 self.missed = 0;
                 self.counters.fresh += 1;
@@ -374,7 +376,7 @@ impl<R: SharedRegion> SplineDaemon<R> {
     fn after_miss(&mut self, update: CommandUpdate) -> CommandUpdate {
         if self.missed >= self.clear_after {
             if !self.cleared {
-                self.command = SplineCommandBlock::default();
+                self.buffers[self.active] = SplineCommandBlock::default();
                 self.cleared = true;
                 self.counters.clears += 1;
             }
@@ -388,7 +390,7 @@ impl<R: SharedRegion> SplineDaemon<R> {
 
     /// The command in force.
     pub fn command(&self) -> &SplineCommandBlock {
-        &self.command
+        &self.buffers[self.active]
     }
 
     /// Publishes `state` and raises both readers' flags.
