@@ -186,11 +186,11 @@ impl<R: SharedRegion> SplineClient<R> {
         if let Some((leg, joint, field)) = command.first_non_finite() {
             return Err(SplineError::NonFinite { leg, joint, field: FIELD_NAMES[field] });
         }
-        // Each leg's joints as given, its `flags` word always 1 (spec decision 7).
-        for (i, leg) in command.legs.iter().enumerate() {
-            let at = i * size_of::<LegControl>();
-            self.region.write(at, leg.joints.as_bytes())?;
-            self.region.store_u32(at + LEG_FLAGS_OFFSET, 1, Ordering::Relaxed)?;
+        // The legs as given, then each leg's `flags` word set to 1 (spec decision 7); nothing
+        // is visible to the daemon before the control flag below.
+        self.region.write(0, command.legs.as_bytes())?;
+        for leg in 0..4 {
+            self.region.store_u32(leg * size_of::<LegControl>() + LEG_FLAGS_OFFSET, 1, Ordering::Relaxed)?;
         }
         self.region.store_u32(CMD_FLAG_CONTROL_OFFSET, 1, Ordering::Release)?;
         self.counters.commands_written += 1;

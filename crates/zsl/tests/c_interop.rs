@@ -6,7 +6,7 @@ use std::mem::{offset_of, size_of};
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use robowire_shm::CreateOptions;
@@ -14,8 +14,14 @@ use zsl::spline::SplineError;
 use zsl::{CommandUpdate, JointControl, JointFlags, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineDaemon};
 use zsl_proto::shm::{JointState, LegControl, LegState, NavImu, SplineData, SplineStateBlock};
 
-/// Builds tests/c/spline_peer.c with the system C compiler (`$CC`, else `cc`).
+/// Builds tests/c/spline_peer.c with the system C compiler (`$CC`, else `cc`), once for all
+/// tests of this file (they run in parallel and must not rebuild it under each other's feet).
 fn peer() -> PathBuf {
+    static PEER: OnceLock<PathBuf> = OnceLock::new();
+    PEER.get_or_init(build_peer).clone()
+}
+
+fn build_peer() -> PathBuf {
     let source = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/spline_peer.c");
     let out = std::env::temp_dir().join(format!("robowire-spline-peer-{}", std::process::id()));
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
