@@ -57,9 +57,11 @@ fn main() -> ExitCode {
 fn golden(bless: bool) -> anyhow::Result<()> {
     let kmc_path = xtask::golden::kmc::kmc_fixture_path();
     let unitree_path = xtask::golden::unitree::vectors_path();
+    let zsl1_path = xtask::golden::zsl1::frames_path();
     let suites = [
         ("kmc", xtask::golden::kmc::check_kmc(&kmc_path, bless)?),
         ("unitree", xtask::golden::unitree::check(&unitree_path)?),
+        ("zsl1", xtask::golden::zsl1::check(&zsl1_path)?),
     ];
     let mut failed = 0;
     let mut total = 0;
@@ -81,6 +83,11 @@ fn golden(bless: bool) -> anyhow::Result<()> {
         }
     }
     anyhow::ensure!(failed == 0, "{failed} of {total} golden checks failed");
-    println!("{total} golden checks passed ({}, {})", kmc_path.display(), unitree_path.display());
+    println!(
+        "{total} golden checks passed ({}, {}, {})",
+        kmc_path.display(),
+        unitree_path.display(),
+        zsl1_path.display()
+    );
     Ok(())
 }

@@ -2,7 +2,9 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod rules;
 pub mod shm;
+pub mod udp;
 
 pub use zerocopy;
 

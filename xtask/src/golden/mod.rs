@@ -4,6 +4,7 @@
 
 pub mod kmc;
 pub mod unitree;
+pub mod zsl1;
 
 use serde::Serialize;
 use serde_json::Value;
