@@ -12,6 +12,8 @@ use crate::lowlevel::{self, Kind};
 pub(crate) enum DecodeCommand {
     /// KMC chassis UART frames (0xA5, 0xB3, 0xAF). Exit status 1 if no frame was found.
     Kmc(KmcDecodeArgs),
+    /// A ZSL-1 / ZSL-1W UDP datagram, told by its length and magic, decoded strictly.
+    Zsl(crate::zsl_decode::ZslDecodeArgs),
     /// Unitree Go2 LowCmd (812-byte struct image, or a CDR payload with --cdr).
     Lowcmd(lowlevel::DecodeArgs),
     /// Unitree Go2 LowState (1180-byte struct image, or a CDR payload with --cdr).
@@ -69,6 +71,7 @@ pub(crate) struct KmcDecodeArgs {
 pub(crate) fn run(command: &DecodeCommand) -> anyhow::Result<ExitCode> {
     match command {
         DecodeCommand::Kmc(args) => decode_kmc(args),
+        DecodeCommand::Zsl(args) => crate::zsl_decode::run(args),
         DecodeCommand::Lowcmd(args) => lowlevel::decode(Kind::LowCmd, args),
         DecodeCommand::Lowstate(args) => lowlevel::decode(Kind::LowState, args),
         DecodeCommand::LowcmdHg(args) => lowlevel::decode(Kind::HgLowCmd, args),

@@ -8,6 +8,7 @@ mod kmc_cmd;
 mod lowlevel;
 mod shm_cmd;
 mod sim;
+mod zsl_decode;
 
 use std::process::ExitCode;
 
