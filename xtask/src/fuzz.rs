@@ -40,7 +40,19 @@ pub const TARGETS: &[Target] = &[
         check: lowcmd_proto::harness::image_decode,
     },
     Target { name: "lowcmd_cdr_decode", seeds: || unitree_seeds("cdr_hex"), check: lowcmd_proto::harness::cdr_decode },
+    Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::harness::datagram_decode },
 ];
+
+/// ZSL-1 seeds: every captured datagram.
+fn zsl1_seeds() -> Seeds {
+    let text = std::fs::read_to_string(crate::golden::zsl1::frames_path())?;
+    let entries: Vec<serde_json::Value> = serde_json::from_str(&text)?;
+    entries
+        .iter()
+        .enumerate()
+        .map(|(i, e)| Ok((format!("seed-{i:02}"), hex_decode(e["hex"].as_str().context("hex")?)?)))
+        .collect()
+}
 
 /// KMC seeds: each fixture frame of `direction` alone and all of them back to back, each with
 /// chunk-size byte 0 (1-byte chunks) and 7 (8-byte chunks).

@@ -2,6 +2,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+#[doc(hidden)]
+pub mod harness;
 pub mod rules;
 pub mod shm;
 pub mod udp;
