@@ -101,6 +101,22 @@ fn unitree_seeds(key: &str) -> Seeds {
     Ok(seeds)
 }
 
+/// A target's seeds: those made from the fixtures, plus any input committed under
+/// `fuzz/regressions/<target>/` (a crash the fuzzer found, kept once fixed). `cargo test`
+/// replays all of them.
+pub fn seeds_of(target: &Target) -> Seeds {
+    let mut seeds = (target.seeds)()?;
+    let dir = workspace_root().join("fuzz/regressions").join(target.name);
+    if let Ok(entries) = std::fs::read_dir(&dir) {
+        for entry in entries {
+            let path = entry?.path();
+            let name = format!("regression-{}", path.file_name().unwrap_or_default().to_string_lossy());
+            seeds.push((name, std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?));
+        }
+    }
+    Ok(seeds)
+}
+
 fn has_nightly() -> bool {
     Command::new("cargo").args(["+nightly", "--version"]).output().is_ok_and(|o| o.status.success())
 }
@@ -125,7 +141,7 @@ pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
     for target in targets {
         let corpus = fuzz_dir.join("corpus").join(target.name);
         std::fs::create_dir_all(&corpus)?;
-        for (name, input) in (target.seeds)()? {
+        for (name, input) in seeds_of(target)? {
             std::fs::write(corpus.join(name), input)?;
         }
         let mut command = Command::new("cargo");
@@ -167,23 +183,10 @@ mod tests {
     #[test]
     fn seed_corpus_replays() {
         for target in TARGETS {
-            let seeds = (target.seeds)().unwrap();
+            let seeds = seeds_of(target).unwrap();
             assert!(seeds.len() >= 4, "{}", target.name);
             for (_, input) in seeds {
                 (target.check)(&input);
-            }
-        }
-    }
-
-    /// Inputs committed under `fuzz/regressions/<target>/` (crashes the fuzzer found, once
-    /// fixed) are replayed too.
-    #[test]
-    fn committed_regressions_replay() {
-        for target in TARGETS {
-            let dir = workspace_root().join("fuzz/regressions").join(target.name);
-            let Ok(entries) = std::fs::read_dir(&dir) else { continue };
-            for entry in entries {
-                (target.check)(&std::fs::read(entry.unwrap().path()).unwrap());
             }
         }
     }

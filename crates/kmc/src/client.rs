@@ -8,7 +8,7 @@ use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME
 use robowire_serial::{LinkCounters, SerialLink, SerialPortOptions};
 
 use crate::KmcError;
-use crate::error::finite;
+use robowire_core::finite;
 
 /// Sends single frames to a KMC chassis and receives its responses.
 ///

@@ -14,8 +14,8 @@ use robowire_serial::{Backoff, LinkCounters, SerialError, SerialLink, SerialPort
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
-use crate::error::finite;
 use crate::{KmcError, realtime};
+use robowire_core::finite;
 
 /// Battery poll rate when [`DriverOptions::poll_battery`] is on, Hz.
 pub const BATTERY_POLL_HZ: f64 = 1.0;

@@ -4,21 +4,8 @@
 use std::io;
 
 use kmc_proto::EncodeError;
+use robowire_core::NonFinite;
 use robowire_serial::SerialError;
-
-/// An argument that must not reach the wire.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum ArgumentError {
-    /// NaN or an infinity.
-    #[error("{name} must be finite, got {value}")]
-    NonFinite {
-        /// The argument's name, with its unit.
-        name: &'static str,
-        /// What was passed.
-        value: f32,
-    },
-}
 
 /// Everything the KMC facade can fail with.
 #[derive(Debug, thiserror::Error)]
@@ -26,7 +13,7 @@ pub enum ArgumentError {
 pub enum KmcError {
     /// Refused before anything was queued or sent.
     #[error("invalid argument: {0}")]
-    Argument(#[from] ArgumentError),
+    Argument(#[from] NonFinite),
     /// A [`DriverOptions`](crate::DriverOptions) value out of range.
     #[error("invalid driver option {name}: {reason}")]
     Option {
@@ -70,9 +57,4 @@ pub enum KmcError {
     /// The driver thread or its runtime could not be created.
     #[error("cannot start the driver thread: {0}")]
     Thread(#[source] io::Error),
-}
-
-/// `value` if it is finite.
-pub(crate) fn finite(name: &'static str, value: f32) -> Result<f32, ArgumentError> {
-    if value.is_finite() { Ok(value) } else { Err(ArgumentError::NonFinite { name, value }) }
 }

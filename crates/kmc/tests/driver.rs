@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use kmc::{ArgumentError, ChassisFrame, Driver, DriverOptions, KmcError, LinkState};
+use kmc::{ChassisFrame, Driver, DriverOptions, KmcError, LinkState, NonFinite};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault, Received};
 
@@ -213,7 +213,7 @@ fn invalid_arguments_are_refused_before_anything_is_sent() {
     driver.set_command(0.2, 0.0).unwrap();
     for (v, w) in [(f32::NAN, 0.0), (0.0, f32::INFINITY), (f32::NEG_INFINITY, 1.0)] {
         let err = driver.set_command(v, w).unwrap_err();
-        assert!(matches!(err, KmcError::Argument(ArgumentError::NonFinite { .. })), "{err}");
+        assert!(matches!(err, KmcError::Argument(NonFinite { .. })), "{err}");
     }
     assert!(driver.set_command_curvature(0.1, f32::NAN).is_err());
     // A finite yaw rate so large that omega / v overflows is refused too.

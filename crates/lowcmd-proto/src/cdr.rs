@@ -123,73 +123,51 @@ impl Run {
     }
 }
 
-/// Copies image scalars into a zeroed body in as few runs as the layout allows; fills in
-/// DHEADERs. Call [`Encoder::finish`] after the walk.
-pub(crate) struct Encoder<'a> {
-    pub(crate) image: &'a [u8],
-    pub(crate) body: &'a mut [u8],
-    run: Run,
+/// Which way a [`Transcoder`] copies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Direction {
+    /// Struct image → CDR body; DHEADERs are written.
+    Encode,
+    /// CDR body → struct image; DHEADERs are checked.
+    Decode,
 }
 
-/// The walk left the buffers' bounds (a layout bug; never with the crate's own layouts).
-#[derive(Debug)]
-pub(crate) struct OutOfBounds;
-
-impl<'a> Encoder<'a> {
-    pub(crate) fn new(image: &'a [u8], body: &'a mut [u8]) -> Self {
-        Self { image, body, run: Run::default() }
-    }
-
-    fn copy(&mut self, run: &Run) -> Result<(), OutOfBounds> {
-        let src = self.image.get(run.image..run.image + run.len).ok_or(OutOfBounds)?;
-        self.body.get_mut(run.body..run.body + run.len).ok_or(OutOfBounds)?.copy_from_slice(src);
-        Ok(())
-    }
-
-    /// Copies the last pending run.
-    pub(crate) fn finish(mut self) -> Result<(), OutOfBounds> {
-        let run = core::mem::take(&mut self.run);
-        self.copy(&run)
-    }
-}
-
-impl Visitor for Encoder<'_> {
-    type Error = OutOfBounds;
-    fn scalar(&mut self, body: usize, image: usize, size: usize) -> Result<(), OutOfBounds> {
-        match self.run.push(body, image, size) {
-            Some(done) => self.copy(&done),
-            None => Ok(()),
-        }
-    }
-    fn array_header(&mut self, at: usize, len: u32, _: &'static str) -> Result<(), OutOfBounds> {
-        self.body.get_mut(at..at + 4).ok_or(OutOfBounds)?.copy_from_slice(&len.to_le_bytes());
-        Ok(())
-    }
-}
-
-/// Copies body scalars into a zeroed image in as few runs as the layout allows; checks
-/// DHEADERs. Call [`Decoder::finish`] after the walk.
-pub(crate) struct Decoder<'a> {
-    pub(crate) body: &'a [u8],
-    pub(crate) image: &'a mut [u8],
-    run: Run,
-}
-
-/// Why a body did not decode.
+/// Why a walk over a body failed.
 #[derive(Debug)]
 pub(crate) enum BodyError {
+    /// The walk left a buffer (a short body; never with the crate's own layouts when encoding).
     OutOfBounds,
+    /// An XCDR2 DHEADER disagrees with its array.
     ArrayHeader { field: &'static str, expected: u32, found: u32 },
 }
 
-impl<'a> Decoder<'a> {
-    pub(crate) fn new(body: &'a [u8], image: &'a mut [u8]) -> Self {
-        Self { body, image, run: Run::default() }
+/// Copies scalars between a struct image and a CDR body, in as few runs as the layout allows.
+/// Call [`Transcoder::finish`] after the walk to copy the last run.
+pub(crate) struct Transcoder<'a> {
+    from: &'a [u8],
+    to: &'a mut [u8],
+    direction: Direction,
+    run: Run,
+}
+
+impl<'a> Transcoder<'a> {
+    /// Image → zeroed body.
+    pub(crate) fn encoder(image: &'a [u8], body: &'a mut [u8]) -> Self {
+        Self { from: image, to: body, direction: Direction::Encode, run: Run::default() }
+    }
+
+    /// Body → zeroed image.
+    pub(crate) fn decoder(body: &'a [u8], image: &'a mut [u8]) -> Self {
+        Self { from: body, to: image, direction: Direction::Decode, run: Run::default() }
     }
 
     fn copy(&mut self, run: &Run) -> Result<(), BodyError> {
-        let src = self.body.get(run.body..run.body + run.len).ok_or(BodyError::OutOfBounds)?;
-        self.image.get_mut(run.image..run.image + run.len).ok_or(BodyError::OutOfBounds)?.copy_from_slice(src);
+        let (src, dst) = match self.direction {
+            Direction::Encode => (run.image, run.body),
+            Direction::Decode => (run.body, run.image),
+        };
+        let bytes = self.from.get(src..src + run.len).ok_or(BodyError::OutOfBounds)?;
+        self.to.get_mut(dst..dst + run.len).ok_or(BodyError::OutOfBounds)?.copy_from_slice(bytes);
         Ok(())
     }
 
@@ -200,7 +178,7 @@ impl<'a> Decoder<'a> {
     }
 }
 
-impl Visitor for Decoder<'_> {
+impl Visitor for Transcoder<'_> {
     type Error = BodyError;
     fn scalar(&mut self, body: usize, image: usize, size: usize) -> Result<(), BodyError> {
         match self.run.push(body, image, size) {
@@ -209,8 +187,16 @@ impl Visitor for Decoder<'_> {
         }
     }
     fn array_header(&mut self, at: usize, len: u32, field: &'static str) -> Result<(), BodyError> {
-        let bytes = self.body.get(at..at + 4).ok_or(BodyError::OutOfBounds)?;
-        let found = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-        if found == len { Ok(()) } else { Err(BodyError::ArrayHeader { field, expected: len, found }) }
+        match self.direction {
+            Direction::Encode => {
+                self.to.get_mut(at..at + 4).ok_or(BodyError::OutOfBounds)?.copy_from_slice(&len.to_le_bytes());
+                Ok(())
+            }
+            Direction::Decode => {
+                let bytes = self.from.get(at..at + 4).ok_or(BodyError::OutOfBounds)?;
+                let found = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+                if found == len { Ok(()) } else { Err(BodyError::ArrayHeader { field, expected: len, found }) }
+            }
+        }
     }
 }

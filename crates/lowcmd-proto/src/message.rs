@@ -3,7 +3,7 @@
 use robowire_core::BufferTooSmall;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
-use crate::cdr::{self, BodyError, CdrEncoding, Decoder, Encoder};
+use crate::cdr::{self, BodyError, CdrEncoding, Transcoder};
 use crate::crc::crc32_words_in_place;
 use crate::layout::StructLayout;
 use crate::{DecodeError, go2, hg};
@@ -132,7 +132,7 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         dst.fill(0);
         dst[..4].copy_from_slice(&encoding.header());
         let sealed = self.sealed();
-        let mut encoder = Encoder::new(sealed.as_bytes(), &mut dst[4..]);
+        let mut encoder = Transcoder::encoder(sealed.as_bytes(), &mut dst[4..]);
         let mut pos = 0;
         cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut encoder)
             .and_then(|()| encoder.finish())
@@ -153,7 +153,7 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         }
         let mut image = [0u8; MAX_IMAGE_LEN];
         let image = &mut image[..Self::IMAGE_LEN];
-        let mut decoder = Decoder::new(&bytes[4..], image);
+        let mut decoder = Transcoder::decoder(&bytes[4..], image);
         let mut pos = 0;
         cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut decoder)
             .and_then(|()| decoder.finish())

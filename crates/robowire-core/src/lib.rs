@@ -10,6 +10,27 @@ pub mod timing;
 pub use datagram::DatagramCodec;
 pub use stream::{DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};
 
+/// A float argument that must be finite is NaN or infinite. Every facade refuses such a value
+/// before anything is queued or sent.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("{name} must be finite, got {value}")]
+pub struct NonFinite {
+    /// The argument's name, with its unit.
+    pub name: &'static str,
+    /// What was passed.
+    pub value: f32,
+}
+
+/// `value` if it is finite, else [`NonFinite`] naming the argument.
+///
+/// ```
+/// assert_eq!(robowire_core::finite("velocity_mps", 0.5), Ok(0.5));
+/// assert!(robowire_core::finite("velocity_mps", f32::NAN).is_err());
+/// ```
+pub fn finite(name: &'static str, value: f32) -> Result<f32, NonFinite> {
+    if value.is_finite() { Ok(value) } else { Err(NonFinite { name, value }) }
+}
+
 /// The caller's buffer cannot hold what is to be written into it.
 ///
 /// Every encoder in robowire returns this (or wraps it) instead of panicking on a short buffer.

@@ -3,6 +3,8 @@
 //! "robot is running" test, the 11-call acknowledgement counter, the 6-datagram action clear,
 //! and the LowLevel position bounds. robowire additionally refuses NaN (spec decision 1).
 
+use robowire_core::{NonFinite, finite};
+
 use crate::udp::{Action, ControlMode, HighLevelCommand, Model, MotorCommand, ReturnCode};
 
 /// |v| at or below this counts as zero and is always allowed.
@@ -13,13 +15,8 @@ pub const ZERO_TOLERANCE: f64 = 1e-6;
 #[non_exhaustive]
 pub enum ArgumentError {
     /// NaN or an infinity (the vendor sends NaN; robowire does not).
-    #[error("{name} must be finite, got {value}")]
-    NonFinite {
-        /// Argument name.
-        name: &'static str,
-        /// Value given.
-        value: f32,
-    },
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
     /// |value| outside the allowed band (the vendor's 0x3013).
     #[error("{name} = {value} is outside the allowed |v| of 0 or {min}..={max}")]
     OutOfRange {
@@ -69,9 +66,7 @@ pub struct Range {
 impl Range {
     /// Checks `value` like the vendor (|v| as f64, 1e-6 tolerance), refusing NaN and infinities.
     pub fn check(&self, value: f32) -> Result<f32, ArgumentError> {
-        if !value.is_finite() {
-            return Err(ArgumentError::NonFinite { name: self.name, value });
-        }
+        finite(self.name, value)?;
         let v = f64::from(value).abs();
         if v <= ZERO_TOLERANCE || (self.min - ZERO_TOLERANCE <= v && v <= self.max + ZERO_TOLERANCE) {
             Ok(value)
@@ -131,9 +126,7 @@ pub fn check_motor_command(command: &MotorCommand) -> Result<(), ArgumentError> 
     for (name, arrays) in groups {
         for legs in arrays {
             for v in legs {
-                if !v.get().is_finite() {
-                    return Err(ArgumentError::NonFinite { name, value: v.get() });
-                }
+                finite(name, v.get())?;
             }
         }
     }
@@ -239,7 +232,7 @@ mod tests {
         assert!(vx.check(3.01).is_err());
         assert!(vy.check(0.09).is_err() && vy.check(1.0).is_ok());
         assert!(yaw.check(-0.02).is_ok() && yaw.check(0.019).is_err());
-        assert!(matches!(vx.check(f32::NAN), Err(ArgumentError::NonFinite { .. })), "robowire refuses NaN");
+        assert!(matches!(vx.check(f32::NAN), Err(ArgumentError::NonFinite(_))), "robowire refuses NaN");
         assert!(vx.check(f32::INFINITY).is_err());
         assert!(ATTITUDE_RANGES[0].check(0.6).is_ok() && ATTITUDE_RANGES[0].check(0.61).is_err());
         assert!(ATTITUDE_RANGES[3].check(0.000_01).is_ok(), "no lower bound");
@@ -262,7 +255,7 @@ mod tests {
         assert!(check_motor_command(&cmd).is_err(), "-0.65f fails too");
         cmd.q_des[2][1] = (-1.5).into();
         cmd.kp[2][3] = f32::NAN.into();
-        assert!(matches!(check_motor_command(&cmd), Err(ArgumentError::NonFinite { name: "kp", .. })));
+        assert!(matches!(check_motor_command(&cmd), Err(ArgumentError::NonFinite(NonFinite { name: "kp", .. }))));
     }
 
     #[test]
