@@ -2,6 +2,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod codec;
 #[doc(hidden)]
 pub mod harness;
 pub mod rules;

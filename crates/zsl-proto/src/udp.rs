@@ -52,6 +52,9 @@ pub enum DatagramError {
         /// The checksum word.
         found: u32,
     },
+    /// The output buffer is shorter than the datagram.
+    #[error(transparent)]
+    Buffer(#[from] robowire_core::BufferTooSmall),
 }
 
 /// The robot model, told by the command magic.
@@ -421,6 +424,14 @@ macro_rules! command_codec {
                 out
             }
 
+            /// Writes the datagram for `model` at the start of `buf`; returns its length.
+            pub fn encode_into(&self, model: Model, buf: &mut [u8]) -> Result<usize, DatagramError> {
+                let available = buf.len();
+                let out = buf.get_mut(..$len).ok_or(robowire_core::BufferTooSmall { needed: $len, available })?;
+                out.copy_from_slice(&self.encode(model));
+                Ok($len)
+            }
+
             /// Strict decoding: exact length, a known magic, the checksum of bytes 0..7.
             pub fn decode(bytes: &[u8]) -> Result<(Self, Model), DatagramError> {
                 let datagram = Self::read_from_bytes(bytes)
@@ -431,6 +442,16 @@ macro_rules! command_codec {
                     return Err(DatagramError::Checksum { expected, found: datagram.checksum.get() });
                 }
                 Ok((datagram, model))
+            }
+        }
+
+        impl crate::codec::CommandDatagram for $ty {
+            const LEN: usize = $len;
+            fn encode_into(&self, model: Model, buf: &mut [u8]) -> Result<usize, DatagramError> {
+                <$ty>::encode_into(self, model, buf)
+            }
+            fn decode(bytes: &[u8]) -> Result<(Self, Model), DatagramError> {
+                <$ty>::decode(bytes)
             }
         }
 
@@ -600,6 +621,22 @@ macro_rules! state_codec {
                 let mut out = [0u8; $len];
                 out.copy_from_slice(self.as_bytes());
                 out
+            }
+        }
+
+        impl crate::codec::StateDatagram for $ty {
+            const LEN: usize = $len;
+            fn decode_strict(bytes: &[u8]) -> Result<Self, DatagramError> {
+                <$ty>::decode_strict(bytes)
+            }
+            fn update_lenient(&mut self, bytes: &[u8]) -> Result<LenientUpdate, DatagramError> {
+                <$ty>::update_lenient(self, bytes)
+            }
+            fn encode_into(&self, buf: &mut [u8]) -> Result<usize, DatagramError> {
+                let available = buf.len();
+                let out = buf.get_mut(..$len).ok_or(robowire_core::BufferTooSmall { needed: $len, available })?;
+                out.copy_from_slice(self.as_bytes());
+                Ok($len)
             }
         }
 

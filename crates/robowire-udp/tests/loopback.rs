@@ -1,0 +1,119 @@
+//! The link on loopback: typed send and receive, foreign sources, decode errors, bind errors.
+//! 127.0.0.2 (also loopback on Linux) plays the foreign host.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::time::Duration;
+
+use robowire_core::DatagramCodec;
+use robowire_udp::{LinkStats, UdpError, UdpLink};
+
+/// Messages are a little-endian u32; anything else is a decode error.
+#[derive(Clone, Default)]
+struct Word;
+
+#[derive(Debug, PartialEq, thiserror::Error)]
+#[error("{0} bytes, 4 expected")]
+struct BadLength(usize);
+
+impl DatagramCodec for Word {
+    type Outgoing = u32;
+    type Incoming = u32;
+    type Error = BadLength;
+    const MAX_DATAGRAM_LEN: usize = 4;
+    fn encode(&mut self, m: &u32, buf: &mut [u8]) -> Result<usize, BadLength> {
+        let available = buf.len();
+        buf.get_mut(..4).ok_or(BadLength(available))?.copy_from_slice(&m.to_le_bytes());
+        Ok(4)
+    }
+    fn decode(&mut self, d: &[u8]) -> Result<u32, BadLength> {
+        Ok(u32::from_le_bytes(d.try_into().map_err(|_| BadLength(d.len()))?))
+    }
+}
+
+fn peer() -> UdpSocket {
+    let s = UdpSocket::bind("127.0.0.1:0").unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
+    s
+}
+
+async fn link_to(peer: &UdpSocket) -> UdpLink<Word> {
+    UdpLink::bind("127.0.0.1:0".parse().unwrap(), peer.local_addr().unwrap(), Word).await.unwrap()
+}
+
+async fn recv(link: &mut UdpLink<Word>) -> Result<u32, UdpError<BadLength>> {
+    tokio::time::timeout(Duration::from_secs(2), link.recv()).await.expect("a datagram within 2 s")
+}
+
+#[tokio::test]
+async fn typed_messages_both_ways() {
+    let robot = peer();
+    let mut link = link_to(&robot).await;
+    link.send(&0xA55A_0102).await.unwrap();
+    let mut buf = [0u8; 16];
+    let (n, from) = robot.recv_from(&mut buf).unwrap();
+    assert_eq!(&buf[..n], &0xA55A_0102u32.to_le_bytes());
+    assert_eq!(from, link.local_addr().unwrap(), "sent from the bound socket");
+
+    robot.send_to(&7u32.to_le_bytes(), from).unwrap();
+    assert_eq!(recv(&mut link).await.unwrap(), 7);
+    assert_eq!(link.stats(), LinkStats { sent: 1, received: 1, ..LinkStats::default() });
+}
+
+#[tokio::test]
+async fn foreign_sources_are_dropped_and_counted_decode_errors_reported() {
+    let robot = peer();
+    let mut link = link_to(&robot).await;
+    let to = link.local_addr().unwrap();
+    let spoofer = UdpSocket::bind("127.0.0.2:0").expect("127.0.0.2 is loopback on Linux");
+    spoofer.send_to(&1u32.to_le_bytes(), to).unwrap();
+    // Another port on the robot's IP is the robot: the source port is not compared.
+    let robot_other_port = peer();
+    robot_other_port.send_to(&[1, 2, 3], to).unwrap();
+    robot.send_to(&2u32.to_le_bytes(), to).unwrap();
+
+    assert!(matches!(recv(&mut link).await, Err(UdpError::Decode(BadLength(3)))));
+    assert_eq!(recv(&mut link).await.unwrap(), 2, "the spoofed 1 never arrives");
+    let stats = link.stats();
+    assert_eq!((stats.received, stats.decode_errors, stats.foreign_dropped), (2, 1, 1));
+}
+
+#[tokio::test]
+async fn an_over_long_datagram_is_a_decode_error_not_a_truncation() {
+    let robot = peer();
+    let mut link = link_to(&robot).await;
+    robot.send_to(&[0; 5], link.local_addr().unwrap()).unwrap();
+    assert!(matches!(recv(&mut link).await, Err(UdpError::Decode(BadLength(5)))));
+}
+
+#[tokio::test]
+async fn split_halves_work_from_two_tasks() {
+    let robot = peer();
+    let link = link_to(&robot).await;
+    let local = link.local_addr().unwrap();
+    let stats = link.stats_handle();
+    let (mut tx, mut rx) = link.into_split();
+    let receiving = tokio::spawn(async move { rx.recv().await.unwrap() });
+    tx.send(&9).await.unwrap();
+    let mut buf = [0u8; 8];
+    let (_, from) = robot.recv_from(&mut buf).unwrap();
+    assert_eq!(from, local);
+    robot.send_to(&10u32.to_le_bytes(), local).unwrap();
+    assert_eq!(tokio::time::timeout(Duration::from_secs(2), receiving).await.unwrap().unwrap(), 10);
+    assert_eq!((stats.get().sent, stats.get().received), (1, 1));
+}
+
+#[tokio::test]
+async fn a_bind_failure_names_the_address_and_lists_the_hosts_ipv4_addresses() {
+    let taken = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap();
+    let err = UdpLink::bind(addr, addr, Word).await.unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, UdpError::Bind { addr: a, .. } if a == addr), "{text}");
+    assert!(text.contains(&addr.to_string()), "{text}");
+    assert!(text.contains("127.0.0.1"), "loopback is among the host's addresses: {text}");
+
+    // An address this host does not have: the classic wrong `local_ip`.
+    let foreign: SocketAddr = "192.0.2.1:43988".parse().unwrap();
+    let err = UdpLink::bind(foreign, addr, Word).await.unwrap_err();
+    assert!(err.to_string().starts_with("cannot bind UDP 192.0.2.1:43988"), "{err}");
+}
