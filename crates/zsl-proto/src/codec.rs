@@ -145,9 +145,11 @@ mod tests {
         let (command, model) = dog.decode(&buf[..n]).unwrap();
         assert_eq!((command.control_mode(), command.magic(), model), (ControlMode::Stand, 0x5AA6, Model::Zsl1W));
 
-        let mut state = HighLevelState::default();
-        state.header = crate::udp::HIGH_LEVEL_STATE_HEADER;
-        state.control_mode = 1.into();
+        let state = HighLevelState {
+            header: crate::udp::HIGH_LEVEL_STATE_HEADER,
+            control_mode: 1.into(),
+            ..HighLevelState::default()
+        };
         let n = dog.encode(&state, &mut buf).unwrap();
         assert_eq!(client.decode(&buf[..n]).unwrap().state, state);
         assert_eq!(client.decode(&buf[..n + 1]), Err(DatagramError::Length { expected: 560, found: 561 }));
@@ -160,9 +162,11 @@ mod tests {
     #[test]
     fn lenient_client_merges_a_short_datagram_into_the_previous_state() {
         let mut client = LowLevelClientCodec::new(Model::Zsl1, StateDecoding::Lenient);
-        let mut full = LowLevelState::default();
-        full.magic = crate::udp::MAGIC_ZSL1.into();
-        full.rpy = [1.0.into(), 2.0.into(), 3.0.into()];
+        let full = LowLevelState {
+            magic: crate::udp::MAGIC_ZSL1.into(),
+            rpy: [1.0.into(), 2.0.into(), 3.0.into()],
+            ..LowLevelState::default()
+        };
         client.decode(&full.encode()).unwrap();
         let received = client.decode(&[0, 0, 0, 0]).unwrap();
         assert_eq!(received.update, LenientUpdate { len: 4, short: true, header_ok: false });
