@@ -1,6 +1,8 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+pub mod dog;
+mod joints;
 pub mod kmc;
 pub mod pty;
 pub mod spline;

@@ -11,6 +11,8 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use robowire_core::timing::{LatenessRing, LatenessSummary};
+
+use crate::joints::{JointModel, PdTarget};
 use robowire_shm::CreateOptions;
 use zsl::spline::{ImuSample, ImuWriter, monotonic_ns};
 use zsl::{CommandUpdate, SplineDaemon, SplineDaemonCounters};
@@ -164,40 +166,25 @@ impl Drop for SplineSim {
     }
 }
 
-/// Joint model: inertia, viscous damping, torque limit.
-const INERTIA_KGM2: f32 = 0.02;
-const DAMPING_NMS: f32 = 0.05;
-const TORQUE_LIMIT_NM: f32 = 45.0;
-
-/// Positions and velocities of the 16 joints, starting in the lying pose.
-struct JointModel {
-    p: [[f32; 4]; 4],
-    v: [[f32; 4]; 4],
-    t: [[f32; 4]; 4],
+/// The spline daemon's view of the shared joint model.
+trait SplineJoints {
+    fn step_command(&mut self, command: &zsl::SplineCommandBlock, dt: f32);
+    fn state(&self, command: &zsl::SplineCommandBlock, fault_bits: &[[u32; 4]; 4]) -> SplineStateBlock;
 }
 
-impl JointModel {
-    fn lying() -> Self {
-        let leg = [LYING_POSE_RAD[0], LYING_POSE_RAD[1], LYING_POSE_RAD[2], 0.0];
-        Self { p: [leg; 4], v: [[0.0; 4]; 4], t: [[0.0; 4]; 4] }
-    }
-
-    /// One step of `dt` seconds under `command` (semi-implicit Euler).
-    fn step(&mut self, command: &zsl::SplineCommandBlock, dt: f32) {
-        for leg in Leg::ALL {
-            for joint in JointIndex::ALL {
-                let (l, j) = (leg.index(), joint as usize);
-                let c = command.joint(leg, joint);
-                let torque = (c.kp.get() * (c.p_des.get() - self.p[l][j])
-                    + c.kd.get() * (c.v_des.get() - self.v[l][j])
-                    + c.t_ff.get())
-                .clamp(-TORQUE_LIMIT_NM, TORQUE_LIMIT_NM);
-                let acc = (torque - DAMPING_NMS * self.v[l][j]) / INERTIA_KGM2;
-                self.v[l][j] += acc * dt;
-                self.p[l][j] = (self.p[l][j] + self.v[l][j] * dt).clamp(-std::f32::consts::PI, std::f32::consts::PI);
-                self.t[l][j] = torque;
+impl SplineJoints for JointModel {
+    /// One step of `dt` seconds under `command`.
+    fn step_command(&mut self, command: &zsl::SplineCommandBlock, dt: f32) {
+        self.step(dt, |leg, joint| {
+            let c = command.joint(Leg::ALL[leg], JointIndex::ALL[joint]);
+            PdTarget {
+                q_rad: c.p_des.get(),
+                qd_radps: c.v_des.get(),
+                kp: c.kp.get(),
+                kd: c.kd.get(),
+                tau_ff_nm: c.t_ff.get(),
             }
-        }
+        });
     }
 
     fn state(&self, command: &zsl::SplineCommandBlock, fault_bits: &[[u32; 4]; 4]) -> SplineStateBlock {
@@ -207,13 +194,13 @@ impl JointModel {
                 let (l, j) = (leg.index(), joint as usize);
                 let c = command.joint(leg, joint);
                 let enabled = c.kp.get() != 0.0 || c.kd.get() != 0.0;
-                let temperature = 30 + (self.t[l][j].abs() / 3.0) as i16;
+                let temperature = 30 + (self.tau_nm[l][j].abs() / 3.0) as i16;
                 let bits = if enabled { JointFlags::ENABLED } else { 0 } | fault_bits[l][j];
                 let s = state.joint_mut(leg, joint);
                 s.flags = JointFlags::new(48, temperature, bits).0.into();
-                s.p = self.p[l][j].into();
-                s.v = self.v[l][j].into();
-                s.t = self.t[l][j].into();
+                s.p = self.q_rad[l][j].into();
+                s.v = self.qd_radps[l][j].into();
+                s.t = self.tau_nm[l][j].into();
             }
         }
         state
@@ -230,7 +217,7 @@ fn run(
 ) {
     let period = config.period;
     let dt = period.as_secs_f32();
-    let mut model = JointModel::lying();
+    let mut model = JointModel::at(LYING_POSE_RAD);
     let mut next = Instant::now() + period;
     while !stop.load(Ordering::Relaxed) {
         let now = Instant::now();
@@ -246,7 +233,7 @@ fn run(
             // Fresh, repeated or cleared: the daemon's command is what the motors get. (Region
             // errors cannot happen: the object is ours and large enough.)
             let _update: Result<CommandUpdate, _> = daemon.take_command();
-            model.step(daemon.command(), dt);
+            model.step_command(daemon.command(), dt);
             let fault_bits = lock(shared).fault_bits;
             let state = model.state(daemon.command(), &fault_bits);
             let _ = daemon.publish_state(&state);

@@ -286,4 +286,9 @@ impl<C: DatagramCodec> UdpReceiver<C> {
     pub fn stats(&self) -> LinkStats {
         self.counters.snapshot()
     }
+
+    /// The codec, for codecs that keep state (to reset it after a timeout, say).
+    pub fn codec_mut(&mut self) -> &mut C {
+        &mut self.codec
+    }
 }

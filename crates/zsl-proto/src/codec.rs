@@ -11,7 +11,7 @@ use crate::udp::{
 };
 
 /// A command datagram: the magic and checksum are written by the encoder.
-pub trait CommandDatagram: Copy + Default + Send + 'static {
+pub trait CommandDatagram: Copy + Default + Send + Sync + 'static {
     /// Datagram length in bytes.
     const LEN: usize;
     /// Writes the datagram for `model` at the start of `buf`; returns its length.
@@ -79,6 +79,11 @@ impl<C, S: Default> ClientCodec<C, S> {
     /// The model whose magic the commands carry.
     pub fn model(&self) -> Model {
         self.model
+    }
+
+    /// Forgets the merged state: the next short datagram updates a prefix of zeros.
+    pub fn reset(&mut self) {
+        self.state = S::default();
     }
 }
 

@@ -295,6 +295,20 @@ pub struct MotorCommand {
     pub tau_ff: [[F32; 4]; 3],
 }
 
+impl MotorCommand {
+    /// A PD hold: position targets `q_des_rad[joint][leg]` (abad, hip, knee × FR, FL, RR, RL)
+    /// with one `kp` and `kd` per joint; zero velocity targets and feed-forward torques.
+    pub fn pd_hold(q_des_rad: [[f32; 4]; 3], kp: [f32; 3], kd: [f32; 3]) -> Self {
+        let f = |legs: [f32; 4]| legs.map(F32::new);
+        Self {
+            q_des: q_des_rad.map(f),
+            kp: kp.map(|k| [F32::new(k); 4]),
+            kd: kd.map(|k| [F32::new(k); 4]),
+            ..Self::default()
+        }
+    }
+}
+
 /// LowLevel command, client → dog, 248 bytes (spec §7.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
 #[repr(C)]
@@ -466,6 +480,13 @@ impl Default for HighLevelCommand {
     /// The idle command: every field zero (mode 0, no action, flag 0).
     fn default() -> Self {
         Self::new_zeroed()
+    }
+}
+
+impl LowLevelCommand {
+    /// The command carrying `motor` (magic and checksum are written when encoded).
+    pub fn new(motor: MotorCommand) -> Self {
+        Self { motor, ..Self::default() }
     }
 }
 

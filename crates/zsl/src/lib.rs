@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 pub mod spline;
+pub mod udp;
 
 pub use spline::{
     CommandUpdate, ImuError, ImuReader, ImuSample, ImuWriter, SplineClient, SplineClientCounters, SplineDaemon,

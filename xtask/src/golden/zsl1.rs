@@ -74,17 +74,8 @@ fn command_for_call(api: &str) -> Option<HighLevelCommand> {
         c.mode = 0.into();
         return Some(c);
     }
-    let call = api.split("HighLevel.").nth(1)?;
-    let (name, rest) = call.split_once('(')?;
-    let args: Vec<f32> = rest
-        .split(')')
-        .next()?
-        .split(',')
-        .map(str::trim)
-        .filter(|a| !a.is_empty())
-        .map(|a| if a == "nan" { Some(f32::NAN) } else { a.parse().ok() })
-        .collect::<Option<_>>()?;
-    let arg = |i: usize| args.get(i).copied();
+    let (name, args, n) = zsl_proto::harness::vendor_call(api)?;
+    let arg = |i: usize| (i < n).then(|| args[i]);
     let mut command = match name {
         "standUp" => HighLevelCommand::stand_up(),
         "lieDown" => HighLevelCommand::lie_down(),
@@ -185,9 +176,13 @@ fn check_low_level_command(entry: &Value, bytes: &[u8], c: &mut Checker) {
     if command.encode(model) != bytes {
         c.problems.push("does not re-encode byte for byte".into());
     }
-    if entry["api"].as_str().is_some_and(|a| a.contains("idle stream"))
-        && LowLevelCommand::default().encode(Model::Zsl1) != bytes
+    let api = entry["api"].as_str().unwrap_or_default();
+    if let Some(motor) = zsl_proto::harness::fixture_motor_command(api)
+        && LowLevelCommand::new(motor).encode(Model::Zsl1) != bytes
     {
+        c.problems.push("the command the call describes encodes differently".into());
+    }
+    if api.contains("idle stream") && LowLevelCommand::default().encode(Model::Zsl1) != bytes {
         c.problems.push("the idle command encodes differently".into());
     }
 }

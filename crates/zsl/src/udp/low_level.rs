@@ -1,0 +1,157 @@
+//! The LowLevel client: twelve motors, position/velocity/PD/torque commands.
+
+use std::time::Duration;
+
+use tokio::sync::watch;
+use zsl_proto::rules::check_motor_command;
+use zsl_proto::udp::{LowLevelCommand, LowLevelState, MotorCommand, MotorState};
+use zsl_proto::zerocopy::little_endian::F32;
+
+use super::core::{CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile};
+use super::snapshot::Imu;
+
+pub(super) struct LowLevelProfile;
+
+impl Profile for LowLevelProfile {
+    type Command = LowLevelCommand;
+    type State = LowLevelState;
+    type SendState = ();
+
+    fn before_send(_: &mut LowLevelCommand, (): &mut (), _: Option<&LowLevelState>) -> bool {
+        true
+    }
+
+    /// Velocity targets become 0: the PD terms hold the last position, no joint is driven on.
+    /// Feed-forward torques stay (they may be holding the body up).
+    fn stop_motion(latched: &mut LowLevelCommand) {
+        latched.motor.qd_des = [[F32::new(0.0); 4]; 3];
+    }
+}
+
+/// The ZSL-1 LowLevel client (the vendor's `LowLevel`). Needs a tokio runtime; the stream and
+/// the receive loop run as two tasks, stopped on drop.
+///
+/// Streams the all-zero idle command (kp = kd = 0: nothing driven) until the first
+/// [`send_motor_command`](Self::send_motor_command), then the latched command every 2 ms.
+pub struct LowLevel {
+    client: Client<LowLevelProfile>,
+}
+
+impl std::fmt::Debug for LowLevel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LowLevel")
+            .field("local", &self.core().local_addr())
+            .field("dog", &self.core().options.dog)
+            .field("connection", &self.connection())
+            .finish_non_exhaustive()
+    }
+}
+
+fn floats<const N: usize>(v: &[F32; N]) -> [f32; N] {
+    v.map(F32::get)
+}
+
+impl LowLevel {
+    /// Binds `options.local` and starts streaming the idle command to `options.dog`
+    /// (use [`ClientOptions::low_level`]).
+    pub async fn connect(options: ClientOptions) -> Result<Self, ConnectError> {
+        Ok(Self { client: Client::start(options).await? })
+    }
+
+    fn core(&self) -> &Core<LowLevelProfile> {
+        &self.client.core
+    }
+
+    /// `sendMotorCmd`: all 60 floats must be finite and the positions within the vendor's
+    /// bounds (abad −0.7…0.7, hip −1.15…3.0, knee −2.9…−0.65 rad, compared as f64). On error
+    /// nothing changes and the previous command keeps streaming (the vendor's −1).
+    pub async fn send_motor_command(&self, command: &MotorCommand) -> Result<(), CallError> {
+        check_motor_command(command)?;
+        self.core().submit(|latched| latched.motor = *command).await
+    }
+
+    /// `getMotorState()`: positions, velocities, torques (`None` before the first state and
+    /// after a timeout).
+    pub fn motor_state(&self) -> Option<MotorState> {
+        self.core().read(|s| s.motor)
+    }
+
+    /// `haveMotorData()`: the last state carried the magic `0x5AA5`.
+    pub fn has_motor_data(&self) -> bool {
+        self.core().read(LowLevelState::has_motor_data).unwrap_or(false)
+    }
+
+    /// The whole state as received.
+    pub fn state(&self) -> Option<LowLevelState> {
+        self.core().read(|s| *s)
+    }
+
+    /// `getQuaternion()`: w, x, y, z.
+    pub fn quaternion(&self) -> Option<[f32; 4]> {
+        self.core().read(|s| floats(&s.quaternion))
+    }
+
+    /// `getRPY()`: rad.
+    pub fn rpy(&self) -> Option<[f32; 3]> {
+        self.core().read(|s| floats(&s.rpy))
+    }
+
+    /// `getBodyAcc()`: m/s².
+    pub fn body_acc(&self) -> Option<[f32; 3]> {
+        self.core().read(|s| floats(&s.acc))
+    }
+
+    /// `getBodyGyro()`: rad/s.
+    pub fn body_gyro(&self) -> Option<[f32; 3]> {
+        self.core().read(|s| floats(&s.gyro))
+    }
+
+    /// The IMU, typed.
+    pub fn imu(&self) -> Option<Imu> {
+        self.core().read(|s| s.into())
+    }
+
+    /// State arrived within the watchdog timeout.
+    pub fn check_connection(&self) -> bool {
+        self.connection() == Connection::Connected
+    }
+
+    /// The connection now.
+    pub fn connection(&self) -> Connection {
+        self.core().connection()
+    }
+
+    /// Connection events.
+    pub fn connection_events(&self) -> watch::Receiver<Connection> {
+        self.core().connection_events()
+    }
+
+    /// Every accepted state, as it arrives (`None` after a timeout).
+    pub fn state_updates(&self) -> watch::Receiver<Option<LowLevelState>> {
+        self.core().state.subscribe()
+    }
+
+    /// Waits until a state satisfies `accept`, up to `timeout`.
+    pub async fn wait_for_state(
+        &self,
+        timeout: Duration,
+        accept: impl Fn(&LowLevelState) -> bool,
+    ) -> Option<LowLevelState> {
+        self.core().wait_for(timeout, accept).await
+    }
+
+    /// The command being streamed now.
+    pub async fn latched_command(&self) -> LowLevelCommand {
+        self.core().latched().await
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> ClientStats {
+        self.core().stats()
+    }
+
+    /// The bound local address.
+    pub fn local_addr(&self) -> std::net::SocketAddr {
+        self.core().local_addr()
+    }
+}
