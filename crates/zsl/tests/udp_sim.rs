@@ -1,0 +1,260 @@
+//! The HighLevel and LowLevel clients against robowire's dog simulator and scripted peers on
+//! loopback: motion, argument checks, the watchdog and reconnect, source filtering, faults,
+//! lenient decoding, both interfaces at once. 127.0.0.2 (loopback on Linux) plays a foreign host.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::time::Duration;
+
+use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
+use zsl::udp::{
+    CallError, ClientOptions, Connection, ControlMode, HighLevel, HighLevelState, LowLevel, MotorCommand, ReturnCode,
+};
+use zsl_proto::rules::ArgumentError;
+use zsl_proto::udp::HIGH_LEVEL_STATE_HEADER;
+
+const WAIT: Duration = Duration::from_secs(3);
+
+fn options_to(dog: SocketAddr) -> ClientOptions {
+    ClientOptions { dog, ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) }
+}
+
+async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
+    let client = HighLevel::connect(options).await.unwrap();
+    assert!(client.wait_connected(WAIT).await, "state from the simulator");
+    // The dog starts lying (51); the client's idle stream (mode 0) makes it passive at once.
+    let mode = client.control_mode().unwrap();
+    assert!(matches!(mode, ControlMode::LieDown | ControlMode::Passive), "the simulated dog lies: {mode:?}");
+    client.stand_up().await.unwrap();
+    assert!(client.wait_for_mode(ControlMode::Stand, WAIT).await.is_some());
+    wait_until(|| sim.snapshot().dog.activity() == Activity::Standing).await;
+    client
+}
+
+async fn wait_until(done: impl Fn() -> bool) {
+    for _ in 0..300 {
+        if done() {
+            return;
+        }
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    panic!("condition not reached within 3 s");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn stands_walks_and_lies_down_on_the_simulator() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
+    let start = client.position().unwrap();
+
+    client.move_velocity(0.5, 0.0, 0.0).await.unwrap();
+    assert!(client.wait_for_mode(ControlMode::Move, WAIT).await.is_some());
+    let moving = client.wait_for_state(WAIT, |s| s.body_velocity[0].get() > 0.45).await;
+    assert!(moving.is_some(), "the body reaches the commanded speed");
+    assert_eq!(
+        client.lie_down().await.map_err(|e| e.return_code()),
+        Err(ReturnCode::SwitchFailed),
+        "lying down while walking is refused (robot is running)"
+    );
+    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
+    assert!(client.wait_for_state(WAIT, |s| s.body_velocity[0].get().abs() < 0.05).await.is_some());
+    let walked = client.position().unwrap()[0] - start[0];
+    assert!(walked > 0.1, "the dog moved forward: {walked} m");
+
+    client.lie_down().await.unwrap();
+    assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());
+    wait_until(|| sim.snapshot().dog.activity() == Activity::Lying).await;
+    let body = client.body().unwrap();
+    assert!(body.battery_percent <= 100 && body.error == ReturnCode::Queued);
+    let stats = client.stats();
+    assert_eq!((stats.link.decode_errors, stats.link.foreign_dropped, stats.disconnects), (0, 0, 0));
+    assert!(stats.link.sent > 100, "the 2 ms stream runs: {stats:?}");
+    assert_eq!(sim.snapshot().high_level.invalid, 0, "every command decoded strictly on the dog");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn arguments_are_checked_before_anything_is_sent() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
+    let latched = client.latched_command().await;
+    let refused = |r: Result<(), CallError>| matches!(r, Err(CallError::Argument(_)));
+    for (vx, vy, wz) in [
+        (0.04, 0.0, 0.0),
+        (3.01, 0.0, 0.0),
+        (0.0, 0.05, 0.0),
+        (0.0, 1.01, 0.0),
+        (0.0, 0.0, 0.019),
+        (f32::NAN, 0.0, 0.0),
+        (0.0, f32::INFINITY, 0.0),
+        (0.0, 0.0, f32::NEG_INFINITY),
+    ] {
+        let result = client.move_velocity(vx, vy, wz).await;
+        assert!(refused(result), "move({vx}, {vy}, {wz}) is refused");
+    }
+    assert!(matches!(
+        client.move_velocity(f32::NAN, 0.0, 0.0).await,
+        Err(CallError::Argument(ArgumentError::NonFinite(_)))
+    ));
+    assert!(refused(client.attitude_control(0.0, 0.61, 0.0, 0.0).await));
+    assert!(refused(client.two_leg_stand(0.1, 0.0).await));
+    assert_eq!(client.latched_command().await, latched, "nothing was latched");
+    assert_eq!(client.move_velocity(f32::NAN, 0.0, 0.0).await.unwrap_err().return_code(), ReturnCode::SpeedTooLarge);
+
+    // The band edges are inside; |v| ≤ 1e-6 is zero.
+    for (vx, vy, wz) in [(0.05, 0.1, 0.02), (-3.0, -1.0, -3.0), (1e-6, 0.0, -1e-6)] {
+        client.move_velocity(vx, vy, wz).await.unwrap_or_else(|e| panic!("move({vx}, {vy}, {wz}): {e}"));
+    }
+    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let watchdog = Duration::from_millis(300);
+    let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(watchdog)).await;
+    let mut events = client.connection_events();
+    assert_eq!(*events.borrow_and_update(), Connection::Connected);
+    client.move_velocity(0.5, 0.0, 0.3).await.unwrap();
+
+    sim.inject(DogFault::Silence);
+    tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
+    assert_eq!(*events.borrow_and_update(), Connection::Disconnected);
+    assert!(!client.check_connection());
+    assert_eq!(client.state(), None, "no state instead of stale or zero values");
+    let latched = client.latched_command().await;
+    assert_eq!(latched.control_mode(), ControlMode::Move, "same mode");
+    assert_eq!((latched.vx.get(), latched.yaw_rate.get()), (0.0, 0.0), "the latched motion became a stop");
+    let sent = client.stats().link.sent;
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    assert!(client.stats().link.sent > sent, "the stop keeps streaming while disconnected");
+
+    sim.clear_faults();
+    tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
+    assert_eq!(*events.borrow_and_update(), Connection::Connected);
+    assert!(client.wait_connected(WAIT).await);
+    let stats = client.stats();
+    assert_eq!((stats.disconnects, stats.reconnects), (1, 1));
+    assert_eq!(client.latched_command().await.vx.get(), 0.0, "a stale motion never resumes");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_default_watchdog_is_the_vendors_three_seconds() {
+    assert_eq!(ClientOptions::default().watchdog, Duration::from_secs(3));
+    assert_eq!(ClientOptions::default().dog, "192.168.234.1:43997".parse().unwrap());
+    assert_eq!(ClientOptions::default().local.port(), 43988);
+}
+
+fn state(mode: u32) -> Vec<u8> {
+    HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: mode.into(), ..HighLevelState::default() }
+        .encode()
+        .to_vec()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog() {
+    let dog = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let spoofer = UdpSocket::bind("127.0.0.2:0").expect("127.0.0.2 is loopback on Linux");
+    let client = HighLevel::connect(options_to(dog.local_addr().unwrap()).with_watchdog(Duration::from_millis(300)))
+        .await
+        .unwrap();
+    let to = client.local_addr();
+    for _ in 0..20 {
+        spoofer.send_to(&state(21), to).unwrap();
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    assert_eq!(client.state(), None, "a spoofed state never lands");
+    assert_eq!(client.connection(), Connection::Disconnected, "nor keeps the connection alive");
+    assert_eq!(client.stats().link.foreign_dropped, 20);
+
+    dog.send_to(&state(1), to).unwrap();
+    assert!(client.wait_connected(WAIT).await);
+    assert_eq!(client.control_mode(), Some(ControlMode::Stand));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
+    let dog = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let client = HighLevel::connect(options_to(dog.local_addr().unwrap())).await.unwrap();
+    let to = client.local_addr();
+    dog.send_to(&[], to).unwrap();
+    tokio::time::timeout(WAIT, client.connection_events().wait_for(|c| *c == Connection::Connected))
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(client.state(), None, "a 0-byte datagram feeds the watchdog, it is not a state");
+
+    dog.send_to(&state(18), to).unwrap();
+    assert!(client.wait_for_mode(ControlMode::Move, WAIT).await.is_some());
+    let mut short = vec![0xde, 0xad, 0xbe, 0xef];
+    short.extend_from_slice(&1.0f32.to_le_bytes());
+    dog.send_to(&short, to).unwrap();
+    let merged = client.wait_for_state(WAIT, |s| s.quaternion[0].get() == 1.0).await.unwrap();
+    assert_eq!(merged.mode(), ControlMode::Move, "the rest of the state is kept");
+    dog.send_to(&[0u8; 561], to).unwrap();
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    let stats = client.stats();
+    assert_eq!((stats.states, stats.short_states, stats.header_anomalies), (3, 2, 1), "{stats:?}");
+    assert_eq!(stats.link.decode_errors, 1, "longer than the state is an error");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn faults_error_word_garbage_and_sdk_mismatch() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(Duration::from_millis(300))).await;
+
+    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+    assert!(client.wait_for_state(WAIT, |s| s.error() == ReturnCode::MotorFault).await.is_some());
+    assert!(matches!(client.jump().await, Err(CallError::SelfCheck(ReturnCode::MotorFault))));
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    assert_eq!(client.latched_command().await.control_mode(), ControlMode::Passive, "the stream forces passive");
+    wait_until(|| sim.snapshot().dog.mode() == ControlMode::Passive).await;
+    sim.clear_faults();
+
+    sim.inject(DogFault::Garbage);
+    tokio::time::timeout(WAIT, client.connection_events().wait_for(|c| *c == Connection::Disconnected))
+        .await
+        .unwrap()
+        .unwrap();
+    assert!(client.stats().link.decode_errors > 10, "junk is counted, not taken as state");
+    sim.clear_faults();
+    assert!(client.wait_connected(WAIT).await);
+
+    sim.inject(DogFault::SdkMismatch);
+    assert!(client.wait_for_state(WAIT, |s| s.sdk_mismatch.get() == 1).await.is_some());
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    assert!(client.halted().await, "the stream stops for good, like the vendor's");
+    assert!(matches!(client.stand_up().await, Err(CallError::SdkMismatch)));
+    let commands = sim.snapshot().high_level.commands;
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    assert_eq!(sim.snapshot().high_level.commands, commands, "nothing more is sent");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn high_level_and_low_level_at_once_on_different_local_ports() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let high = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
+    let low_options = ClientOptions { dog: sim.low_level_addr(), ..options_to(sim.low_level_addr()) };
+    let low = LowLevel::connect(low_options).await.unwrap();
+    assert_ne!(high.local_addr(), low.local_addr());
+    assert!(high.wait_connected(WAIT).await);
+    assert!(low.wait_for_state(WAIT, |_| true).await.is_some());
+    assert!(low.has_motor_data());
+
+    let refused = low.send_motor_command(&MotorCommand::default()).await;
+    assert!(matches!(refused, Err(CallError::Argument(ArgumentError::Position { .. }))), "knee 0 is out of range");
+
+    let stand = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
+    low.send_motor_command(&stand).await.unwrap();
+    let near = |legs: &[zsl_proto::zerocopy::little_endian::F32; 4], target: f32| {
+        legs.iter().all(|q| (q.get() - target).abs() < 0.02)
+    };
+    let reached = low.wait_for_state(WAIT, |s| near(&s.motor.q[1], 0.8) && near(&s.motor.q[2], -1.5)).await;
+    assert!(reached.is_some(), "the PD joints reach the targets: {:?}", low.motor_state());
+    assert!(
+        high.wait_for_state(WAIT, |s| (s.joint_angle[2][0].get() + 1.5).abs() < 0.02).await.is_some(),
+        "the HighLevel state shows the same joints"
+    );
+    let mut nan = stand;
+    nan.kp[0][0] = f32::NAN.into();
+    assert!(matches!(low.send_motor_command(&nan).await, Err(CallError::Argument(ArgumentError::NonFinite(_)))));
+    assert_eq!(low.latched_command().await.motor, stand);
+}
