@@ -39,6 +39,8 @@ const WHEEL_RADIUS_M: f32 = 0.08;
 const VELOCITY_TAU_S: f32 = 0.15;
 /// A LowLevel command keeps the motors under LowLevel control this long, s.
 const LOW_LEVEL_HOLD_S: f32 = 0.1;
+/// Without a HighLevel command for this long the dog stops walking (it keeps its mode), s.
+pub const COMMAND_TIMEOUT_S: f32 = 0.5;
 
 /// What the body is doing (the mode says what was asked).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,6 +102,7 @@ pub struct DogModel {
     /// Seconds left in the current transition or trick.
     remaining_s: f32,
     command: HighLevelCommand,
+    command_age_s: f32,
     low_level: Option<LowLevelCommand>,
     low_level_age_s: f32,
     joints: JointModel,
@@ -124,6 +127,7 @@ impl DogModel {
             activity: Activity::Lying,
             remaining_s: 0.0,
             command: HighLevelCommand::lie_down(),
+            command_age_s: 0.0,
             low_level: None,
             low_level_age_s: 0.0,
             joints: JointModel::at(LYING_POSE_RAD),
@@ -218,10 +222,18 @@ impl DogModel {
 
     /// A HighLevel command arrived (decoded strictly; `model` from its magic). Returns whether it
     /// changed what the dog was told to do.
+    ///
+    /// The idle stream a client sends before its first call (mode 0, no action, flag 0) is no
+    /// request: the dog keeps doing what it did (robowire's reading of the flag word, which the
+    /// vendor sets to 1 on every call that asks for something).
     pub fn on_high_level(&mut self, command: &HighLevelCommand, model: Model) -> bool {
         if model != self.model {
             // robowire's reading of spec §10: the robot flags the other model's magic.
             self.faults.sdk_mismatch = true;
+        }
+        self.command_age_s = 0.0;
+        if command.flag.get() == 0 && command.mode.get() == 0 && command.action.get() == 0 {
+            return false;
         }
         let same = |a: &HighLevelCommand| {
             (a.mode, a.action, a.vx, a.vy, a.roll_rate, a.pitch_rate, a.yaw_rate, a.height_rate)
@@ -303,6 +315,7 @@ impl DogModel {
     /// Advances the robot by `dt_s` seconds.
     pub fn step(&mut self, dt_s: f32) {
         self.low_level_age_s += dt_s;
+        self.command_age_s += dt_s;
         if self.low_level.is_some() && self.low_level_age_s > LOW_LEVEL_HOLD_S {
             self.low_level = None;
             if self.activity == Activity::LowLevel {
@@ -337,7 +350,9 @@ impl DogModel {
 
     fn step_body(&mut self, dt: f32) {
         let c = &self.command;
+        let stale = self.command_age_s > COMMAND_TIMEOUT_S;
         let target = match self.activity {
+            _ if stale => [0.0; 3],
             Activity::Walking => [c.vx.get(), c.vy.get(), c.yaw_rate.get()],
             Activity::TwoLegStand => [c.vx.get(), 0.0, c.yaw_rate.get()],
             Activity::Trick(Action::FrontJump) => [0.5, 0.0, 0.0],
@@ -359,7 +374,7 @@ impl DogModel {
             self.wheel_rad += vx / WHEEL_RADIUS_M * dt;
         }
         // Attitude: roll and pitch follow the commanded rates within ±0.4 rad; elsewhere level.
-        let rates = if self.activity == Activity::Attitude {
+        let rates = if self.activity == Activity::Attitude && !stale {
             [c.roll_rate.get(), c.pitch_rate.get()].map(|r| if r.is_finite() { r } else { 0.0 })
         } else {
             [-self.rpy_rad[0] * 4.0, -self.rpy_rad[1] * 4.0]
@@ -380,7 +395,7 @@ impl DogModel {
             Activity::Trick(Action::Jump | Action::FrontJump | Action::Backflip) => STANDING_HEIGHT_M + 0.15,
             _ => STANDING_HEIGHT_M,
         };
-        let rate = if self.activity == Activity::Attitude { c.height_rate.get() } else { 0.0 };
+        let rate = if self.activity == Activity::Attitude && !stale { c.height_rate.get() } else { 0.0 };
         let rate = if rate.is_finite() { rate } else { 0.0 };
         let z = self.position_m[2] + rate * dt + (height - self.position_m[2]) * (dt / 0.3).min(1.0);
         self.position_m[2] = z.clamp(0.05, 0.45);
@@ -731,7 +746,17 @@ fn send_state(socket: &UdpSocket, s: &mut Shared, high: bool, buf: &mut [u8]) {
 mod tests {
     use super::*;
 
+    /// `seconds` of a client streaming the latched command every 2 ms.
     fn run_for(dog: &mut DogModel, seconds: f32) {
+        for _ in 0..(seconds / 0.002) as usize {
+            let (command, model) = (dog.command, dog.model);
+            dog.on_high_level(&command, model);
+            dog.step(0.002);
+        }
+    }
+
+    /// `seconds` without any command.
+    fn run_silent(dog: &mut DogModel, seconds: f32) {
         for _ in 0..(seconds / 0.002) as usize {
             dog.step(0.002);
         }
@@ -777,6 +802,21 @@ mod tests {
     }
 
     #[test]
+    fn the_idle_stream_is_no_request_and_a_silent_client_stops_the_walk() {
+        let mut dog = DogModel::new(Model::Zsl1);
+        assert!(!dog.on_high_level(&HighLevelCommand::default(), Model::Zsl1));
+        assert_eq!(dog.mode(), ControlMode::LieDown);
+        dog.on_high_level(&HighLevelCommand::stand_up(), Model::Zsl1);
+        run_for(&mut dog, 1.3);
+        dog.on_high_level(&HighLevelCommand::move_velocity(0.5, 0.0, 0.0), Model::Zsl1);
+        run_for(&mut dog, 0.4);
+        assert!(dog.velocity()[0] > 0.4);
+        run_silent(&mut dog, 1.0);
+        assert!(dog.velocity()[0] < 0.05, "no command for 0.5 s: the dog stops");
+        assert_eq!(dog.mode(), ControlMode::Move);
+    }
+
+    #[test]
     fn low_level_pd_moves_the_joints() {
         let mut dog = DogModel::new(Model::Zsl1);
         let stand = LowLevelCommand::new(zsl_proto::udp::MotorCommand::pd_hold(
@@ -791,7 +831,7 @@ mod tests {
         let state = dog.low_level_state();
         assert!((state.motor.q[2][0].get() + 1.5).abs() < 0.01, "{:?}", state.motor.q);
         assert_eq!(dog.activity(), Activity::LowLevel);
-        run_for(&mut dog, 0.2);
+        run_silent(&mut dog, 0.2);
         assert_eq!(dog.activity(), Activity::Passive, "motors released when LowLevel commands stop");
     }
 }

@@ -3,6 +3,7 @@
 
 mod decode;
 mod demo;
+mod dog_cmd;
 mod hex;
 mod kmc_cmd;
 mod lowlevel;
@@ -31,6 +32,8 @@ enum Command {
     Sim(sim::SimCommand),
     /// Talk to a KMC wheeled chassis over a serial port.
     Kmc(kmc_cmd::KmcArgs),
+    /// Drive a ZsiBot ZSL-1 / ZSL-1W over UDP (HighLevel: stand, walk, tricks, status).
+    Dog(dog_cmd::DogArgs),
     /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
     #[command(subcommand)]
     Shm(shm_cmd::ShmCommand),
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => demo::run(&args),
         Command::Sim(command) => sim::run(command),
         Command::Kmc(args) => kmc_cmd::run(args),
+        Command::Dog(args) => dog_cmd::run(args),
         Command::Shm(command) => shm_cmd::run(&command),
         Command::Decode(command) => decode::run(&command),
         Command::Encode(command) => decode::run_encode(&command),

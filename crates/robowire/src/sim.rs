@@ -14,6 +14,30 @@ pub(crate) enum SimCommand {
     Kmc(KmcSimArgs),
     /// The ZSL-1 spline daemon: a 1 kHz loop on /spline_shm and /imu_shm with a PD joint model.
     Spline(SplineSimArgs),
+    /// A ZSL-1 / ZSL-1W dog on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
+    Dog(DogSimArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct DogSimArgs {
+    /// Address to listen on (both ports).
+    #[arg(long, default_value = "127.0.0.1")]
+    bind: std::net::IpAddr,
+    /// Send state here instead of to the address the commands come from.
+    #[arg(long)]
+    client: Option<std::net::SocketAddr>,
+    /// Robot model.
+    #[arg(long, value_enum, default_value = "zsl-1")]
+    model: crate::dog_cmd::ModelArg,
+    /// HighLevel port (0: any free port).
+    #[arg(long, default_value_t = zsl_proto::udp::HIGH_LEVEL_PORT)]
+    high_level_port: u16,
+    /// LowLevel port (0: any free port).
+    #[arg(long, default_value_t = zsl_proto::udp::LOW_LEVEL_PORT)]
+    low_level_port: u16,
+    /// Print the simulator's state every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
 }
 
 #[derive(Debug, Args)]
@@ -53,6 +77,7 @@ pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
     match command {
         SimCommand::Kmc(args) => run_kmc(&args),
         SimCommand::Spline(args) => run_spline(&args),
+        SimCommand::Dog(args) => run_dog(&args),
     }
 }
 
@@ -136,6 +161,47 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
             s.responses_sent,
             s.decoder.skipped_bytes,
             s.decoder.rejected_candidates
+        );
+    })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
+    use robowire_sim::dog::{DogSim, DogSimConfig};
+    let config = DogSimConfig {
+        bind: args.bind,
+        high_level_port: args.high_level_port,
+        low_level_port: args.low_level_port,
+        client: args.client,
+        model: args.model.into(),
+        ..DogSimConfig::default()
+    };
+    let sim = DogSim::spawn(config).context("starting the dog simulator")?;
+    // The first line is the two addresses, alone, for scripts.
+    println!("{} {}", sim.high_level_addr(), sim.low_level_addr());
+    eprintln!(
+        "{:?} dog simulator: HighLevel on {}, LowLevel on {}, state at 500 Hz to {}. Try: robowire dog --dog-ip {} stand. Ctrl-C stops.",
+        sim.snapshot().dog.model(),
+        sim.high_level_addr(),
+        sim.low_level_addr(),
+        args.client.map_or("the address commands come from".to_string(), |c| c.to_string()),
+        args.bind
+    );
+    until_ctrl_c(args.report_every_s, || {
+        let s = sim.snapshot();
+        let [x, y, z] = s.dog.position_m();
+        eprintln!(
+            "mode {:>2} {:?} | pos {x:+.2} {y:+.2} {z:+.2} m yaw {:+.2} rad | battery {:.1} % | HL cmds {} invalid {} states {} | LL cmds {} invalid {} states {}",
+            s.dog.mode().raw(),
+            s.dog.activity(),
+            s.dog.yaw_rad(),
+            s.dog.battery_percent(),
+            s.high_level.commands,
+            s.high_level.invalid,
+            s.high_level.states_sent,
+            s.low_level.commands,
+            s.low_level.invalid,
+            s.low_level.states_sent
         );
     })?;
     Ok(ExitCode::SUCCESS)
