@@ -36,7 +36,7 @@ pub const LYING_HEIGHT_M: f32 = 0.10;
 /// Wheel radius of the ZSL-1W, m (foot joint angle integrates forward speed).
 const WHEEL_RADIUS_M: f32 = 0.08;
 /// Time constant of the body's velocity response, s.
-const VELOCITY_TAU_S: f32 = 0.15;
+const VELOCITY_TAU_S: f32 = 0.08;
 /// A LowLevel command keeps the motors under LowLevel control this long, s.
 const LOW_LEVEL_HOLD_S: f32 = 0.1;
 /// Without a HighLevel command for this long the dog stops walking (it keeps its mode), s.
@@ -299,6 +299,16 @@ impl DogModel {
         true
     }
 
+    /// Standing again after getting up or a trick: take up what the latched command asks for.
+    fn settle_upright(&mut self) {
+        self.activity = match (self.command.control_mode(), self.command.action_code()) {
+            (ControlMode::Move, _) => Activity::Walking,
+            (ControlMode::Action, Action::TwoLegStand) => Activity::TwoLegStand,
+            (ControlMode::Action, Action::None) => Activity::Attitude,
+            _ => Activity::Standing,
+        };
+    }
+
     fn begin(&mut self, activity: Activity, duration_s: f32) {
         self.activity = activity;
         self.remaining_s = duration_s;
@@ -328,11 +338,11 @@ impl DogModel {
         self.remaining_s = (self.remaining_s - dt_s).max(0.0);
         if self.remaining_s == 0.0 {
             match self.activity {
-                Activity::StandingUp => self.activity = Activity::Standing,
+                Activity::StandingUp => self.settle_upright(),
                 Activity::LyingDown => self.activity = Activity::Lying,
                 Activity::Trick(_) => {
                     self.tricks_done += 1;
-                    self.activity = Activity::Standing;
+                    self.settle_upright();
                 }
                 _ => {}
             }
@@ -386,7 +396,10 @@ impl DogModel {
         }
         self.rpy_rate_radps[2] = wz;
         let height = match self.activity {
-            Activity::Lying | Activity::Passive | Activity::LyingDown => LYING_HEIGHT_M,
+            Activity::Lying | Activity::Passive => LYING_HEIGHT_M,
+            // Getting up and lying down take their whole duration.
+            Activity::StandingUp => STANDING_HEIGHT_M - (STANDING_HEIGHT_M - LYING_HEIGHT_M) * self.remaining_s / 1.2,
+            Activity::LyingDown => LYING_HEIGHT_M + (STANDING_HEIGHT_M - LYING_HEIGHT_M) * self.remaining_s / 1.0,
             Activity::LowLevel => {
                 // Height from the mean knee angle: bent knees, low body.
                 let knee = self.joints.q_rad.iter().map(|leg| leg[2]).sum::<f32>() / 4.0;
@@ -397,7 +410,7 @@ impl DogModel {
         };
         let rate = if self.activity == Activity::Attitude && !stale { c.height_rate.get() } else { 0.0 };
         let rate = if rate.is_finite() { rate } else { 0.0 };
-        let z = self.position_m[2] + rate * dt + (height - self.position_m[2]) * (dt / 0.3).min(1.0);
+        let z = self.position_m[2] + rate * dt + (height - self.position_m[2]) * (dt / 0.1).min(1.0);
         self.position_m[2] = z.clamp(0.05, 0.45);
     }
 

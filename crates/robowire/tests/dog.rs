@@ -108,3 +108,12 @@ fn a_taken_local_port_names_the_address_and_lists_host_addresses() {
     assert!(err.contains(&format!("cannot bind UDP 127.0.0.1:{local}")), "{err}");
     assert!(err.contains("this host's IPv4 addresses: ") && err.contains("127.0.0.1"), "{err}");
 }
+
+#[test]
+fn demo_drives_the_simulated_dog_and_checks_what_it_saw() {
+    let out = robowire().args(["demo", "--only", "dog"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("dog: walks a square and returns to the start"), "{stdout}");
+    assert!(stdout.contains("demo passed"), "{stdout}");
+}

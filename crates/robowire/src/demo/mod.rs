@@ -1,6 +1,7 @@
 //! `robowire demo`: every simulated device, driven through its client API, with checks that
 //! what was commanded was observed.
 
+mod dog;
 mod kmc;
 mod spline;
 
@@ -23,6 +24,8 @@ pub(crate) struct DemoArgs {
 enum Device {
     /// KMC wheeled chassis on a pseudo-terminal.
     Kmc,
+    /// ZSL-1 on loopback UDP (the HighLevel client).
+    Dog,
     /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).
     Spline,
 }
@@ -50,6 +53,10 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     let mut checks = Vec::new();
     if args.only.is_none_or(|d| d == Device::Kmc) {
         checks.extend(kmc::run(args.duration)?);
+    }
+    if args.only.is_none_or(|d| d == Device::Dog) {
+        println!();
+        checks.extend(dog::run(args.duration)?);
     }
     if args.only.is_none_or(|d| d == Device::Spline) {
         println!();
