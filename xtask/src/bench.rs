@@ -12,7 +12,8 @@ use serde_json::Value;
 use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
-const BENCHES: &[(&str, &str)] = &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline")];
+const BENCHES: &[(&str, &str)] =
+    &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline"), ("zsl", "udp")];
 
 /// One row of the table.
 #[derive(Debug, Serialize)]
@@ -50,6 +51,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     std::fs::create_dir_all(&target)?;
     let meta_path = target.join("bench-meta.json");
     let spline_meta_path = target.join("bench-meta-spline.json");
+    let udp_meta_path = target.join("bench-meta-zsl-udp.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -61,6 +63,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .args(times)
             .env("ROBOWIRE_BENCH_META", &meta_path)
             .env("ROBOWIRE_BENCH_META_SPLINE", &spline_meta_path)
+            .env("ROBOWIRE_BENCH_META_ZSL_UDP", &udp_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -106,6 +109,9 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let spline: Value =
         serde_json::from_str(&std::fs::read_to_string(&spline_meta_path).context("spline bench metadata")?)?;
     rows.extend(spline_rows(&spline)?);
+    let udp: Value =
+        serde_json::from_str(&std::fs::read_to_string(&udp_meta_path).context("ZSL-1 UDP bench metadata")?)?;
+    rows.extend(zsl_udp_rows(&criterion, &udp)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
@@ -209,6 +215,54 @@ fn spline_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         target: "p50 ≤ 20 µs, p99 ≤ 100 µs".into(),
         met: Some(p50 <= 20 && p99 <= 100),
     });
+    Ok(rows)
+}
+
+/// Rows of the ZSL-1 UDP benchmarks: codec, call-to-wire latency, round trip via the simulator.
+fn zsl_udp_rows(criterion: &Path, meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let group = "zsl_udp_codec";
+    let mut rows = Vec::new();
+    for (bench, label, copy) in [
+        ("hl_command_encode_40B", "ZSL-1 HighLevel command encode (40 B, checksum)", "memcpy_40B"),
+        ("hl_command_decode_40B", "ZSL-1 HighLevel command decode, strict", "memcpy_40B"),
+        ("hl_state_decode_strict_560B", "ZSL-1 HighLevel state decode, strict (560 B)", "memcpy_560B"),
+        ("hl_state_update_lenient_560B", "ZSL-1 HighLevel state decode, lenient", "memcpy_560B"),
+        ("ll_command_encode_248B", "ZSL-1 LowLevel command encode (248 B)", "memcpy_248B"),
+        ("ll_command_decode_248B", "ZSL-1 LowLevel command decode, strict", "memcpy_248B"),
+        ("ll_state_decode_strict_272B", "ZSL-1 LowLevel state decode, strict (272 B)", "memcpy_272B"),
+    ] {
+        let (ns, base) = (mean_ns(criterion, group, bench)?, mean_ns(criterion, group, copy)?);
+        rows.push(Row {
+            path: label.into(),
+            figure: format!("{ns:.1} ns"),
+            baseline: format!("{}: {base:.1} ns", copy.replace('_', " ")),
+            ratio: format!("{:.1}×", ns / base),
+            target: "–".into(),
+            met: None,
+        });
+    }
+    let us = |key: &str| meta[key].as_f64().map(|ns| ns / 1e3).with_context(|| format!("zsl udp meta {key}"));
+    let raw50 = us("raw_echo_p50_ns")?;
+    let (wire50, wire99) = (us("call_to_wire_p50_ns")?, us("call_to_wire_p99_ns")?);
+    rows.push(Row {
+        path: "ZSL-1 call to wire: move() → datagram at the dog's socket".into(),
+        figure: format!("p50 {wire50:.1} µs, p99 {wire99:.1} µs"),
+        baseline: format!("raw UDP echo round trip p50 {raw50:.1} µs (vendor client: ~1840 µs)"),
+        ratio: format!("{:.2}× raw echo", wire50 / raw50),
+        target: "p50 ≤ 50 µs".into(),
+        met: Some(wire50 <= 50.0),
+    });
+    for pct in ["p50", "p99"] {
+        let (trip, raw) = (us(&format!("round_trip_{pct}_ns"))?, us(&format!("raw_echo_{pct}_ns"))?);
+        rows.push(Row {
+            path: format!("ZSL-1 command → state round trip via the simulator, {pct}"),
+            figure: format!("{trip:.1} µs"),
+            baseline: format!("raw UDP echo round trip: {raw:.1} µs"),
+            ratio: format!("{:.2}×", trip / raw),
+            target: if pct == "p50" { "≤ 1.5× raw" } else { "–" }.into(),
+            met: (pct == "p50").then_some(trip <= 1.5 * raw),
+        });
+    }
     Ok(rows)
 }
 

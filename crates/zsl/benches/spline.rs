@@ -20,6 +20,9 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
+
+mod common;
+use common::{percentiles, time_each};
 use robowire_shm::{CreateOptions, MappedRegion, SharedRegion};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
 use zsl::{
@@ -133,25 +136,6 @@ fn facade_roundtrip(client: &mut SplineClient<&MappedRegion>, cmd: &SplineComman
         }
         std::hint::spin_loop();
     }
-}
-
-/// Appends `n` individually timed calls of `f` to `samples` (after a short warm-up), ns.
-fn time_each(samples: &mut Vec<u64>, n: usize, mut f: impl FnMut()) {
-    for _ in 0..200 {
-        f();
-    }
-    samples.extend((0..n).map(|_| {
-        let start = Instant::now();
-        f();
-        start.elapsed().as_nanos() as u64
-    }));
-}
-
-/// p50 and p99 of `samples`, ns.
-fn percentiles(mut samples: Vec<u64>) -> (u64, u64) {
-    samples.sort_unstable();
-    let n = samples.len();
-    (samples[n / 2], samples[(n * 99).div_ceil(100) - 1])
 }
 
 /// Per-round-trip percentiles of the three variants, measured in interleaved rounds so that a
