@@ -50,6 +50,11 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
     assert!(client.wait_for_mode(ControlMode::Move, WAIT).await.is_some());
     let moving = client.wait_for_state(WAIT, |s| s.body_velocity[0].get() > 0.45).await;
     assert!(moving.is_some(), "the body reaches the commanded speed");
+    let walking = client.position().unwrap()[0];
+    assert!(
+        client.wait_for_state(WAIT, |s| s.position[0].get() > walking + 0.1).await.is_some(),
+        "the position integrates the walk"
+    );
     assert_eq!(
         client.lie_down().await.map_err(|e| e.return_code()),
         Err(ReturnCode::SwitchFailed),
@@ -59,6 +64,8 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
     assert!(client.wait_for_state(WAIT, |s| s.body_velocity[0].get().abs() < 0.05).await.is_some());
     let walked = client.position().unwrap()[0] - start[0];
     assert!(walked > 0.1, "the dog moved forward: {walked} m");
+    let sideways = client.position().unwrap()[1] - start[1];
+    assert!(sideways.abs() < 0.01, "straight ahead: {sideways} m sideways");
 
     client.lie_down().await.unwrap();
     assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());

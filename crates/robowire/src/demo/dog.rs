@@ -236,7 +236,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     );
     checks.push(Check::new(
         "dog: silence noticed, walk stopped, reconnected",
-        lost && latched_vx == 0.0 && back && stopped && noticed < watchdog + Duration::from_millis(200),
+        lost && latched_vx == 0.0 && back && stopped && noticed < watchdog + Duration::from_millis(500),
         format!("after {:.0} ms (watchdog {} ms)", noticed.as_secs_f64() * 1e3, watchdog.as_millis()),
     ));
 
