@@ -265,3 +265,22 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
     assert!(matches!(low.send_motor_command(&nan).await, Err(CallError::Argument(ArgumentError::NonFinite(_)))));
     assert_eq!(low.latched_command().await.motor, stand);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_zsl1w_crawls_and_its_wheels_turn() {
+    let config = DogSimConfig { model: zsl::udp::Model::Zsl1W, ..DogSimConfig::loopback() };
+    let sim = DogSim::spawn(config).unwrap();
+    let options = options_to(sim.high_level_addr()).with_model(zsl::udp::Model::Zsl1W);
+    let client = standing_dog(&sim, options).await;
+    client.crawl(0.5, 0.0, 0.0).await.unwrap();
+    let rolling = client.wait_for_state(WAIT, |s| s.joint_angle[3][0].get() > 1.0).await;
+    assert!(rolling.is_some(), "the foot (wheel) joints integrate the forward speed");
+    assert_eq!(client.latched_command().await.action_code(), zsl::udp::Action::Crawl);
+    client.cancel_crawl().await.unwrap();
+    assert_eq!(client.latched_command().await.action_code(), zsl::udp::Action::None);
+    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
+    assert_eq!(client.state().unwrap().sdk_mismatch.get(), 0, "the right magic raises no mismatch");
+
+    let zsl1 = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
+    assert!(matches!(zsl1.crawl(0.5, 0.0, 0.0).await, Err(CallError::WrongModel { .. })));
+}
