@@ -200,7 +200,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
         DogCommand::Status { json } => {
             let state = dog.state().context("the connection dropped before a state arrived")?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&status_json(&state))?);
+                println!("{}", serde_json::to_string_pretty(&crate::zsl_decode::high_level_state_json(&state))?);
             } else {
                 print_status(&state);
             }
@@ -320,22 +320,4 @@ fn print_status(s: &HighLevelState) {
     for (name, joint) in ["abad", "hip", "knee", "foot"].iter().zip(&s.joint_angle) {
         println!("{name:<5} rad FR FL RR RL  {}", v(joint));
     }
-}
-
-fn status_json(s: &HighLevelState) -> serde_json::Value {
-    let v = |a: &[zsl_proto::zerocopy::little_endian::F32]| a.iter().map(|x| x.get()).collect::<Vec<_>>();
-    serde_json::json!({
-        "mode": s.control_mode.get(),
-        "battery_percent": s.battery_percent.get(),
-        "error_word": s.error_word.get(),
-        "sdk_mismatch": s.sdk_mismatch.get(),
-        "position_m": v(&s.position),
-        "body_velocity_mps": v(&s.body_velocity),
-        "world_velocity_mps": v(&s.world_velocity),
-        "rpy_rad": v(&s.rpy),
-        "quaternion_wxyz": v(&s.quaternion),
-        "gyro_radps": v(&s.gyro),
-        "acc_mps2": v(&s.acc),
-        "joint_angle_rad": { "abad": v(&s.joint_angle[0]), "hip": v(&s.joint_angle[1]), "knee": v(&s.joint_angle[2]), "foot": v(&s.joint_angle[3]) },
-    })
 }

@@ -82,30 +82,7 @@ fn decode(bytes: &[u8]) -> anyhow::Result<Value> {
             o.insert("checksum".into(), c.checksum().into());
             Value::Object(o)
         }
-        HighLevelState::LEN => {
-            let s = HighLevelState::decode_strict(bytes)?;
-            let joints =
-                |a: &[[F32; 4]; 4]| json!({"abad": fs(&a[0]), "hip": fs(&a[1]), "knee": fs(&a[2]), "foot": fs(&a[3])});
-            json!({
-                "datagram": "high_level_state",
-                "mode": s.control_mode.get(),
-                "mode_name": format!("{:?}", s.mode()),
-                "battery_percent": s.battery_percent.get(),
-                "error_word": s.error_word.get(),
-                "error_name": format!("{:?}", s.error()),
-                "sdk_mismatch": s.sdk_mismatch.get(),
-                "quaternion_wxyz": fs(&s.quaternion),
-                "gyro_radps": fs(&s.gyro),
-                "acc_mps2": fs(&s.acc),
-                "rpy_rad": fs(&s.rpy),
-                "body_velocity_mps": fs(&s.body_velocity),
-                "world_velocity_mps": fs(&s.world_velocity),
-                "position_m": fs(&s.position),
-                "joint_angle_rad": joints(&s.joint_angle),
-                "joint_velocity_radps": joints(&s.joint_velocity),
-                "joint_torque_nm": joints(&s.joint_torque),
-            })
-        }
+        HighLevelState::LEN => high_level_state_json(&HighLevelState::decode_strict(bytes)?),
         LowLevelState::LEN => {
             let s = LowLevelState::decode_strict(bytes)?;
             let mut o = Map::new();
@@ -135,4 +112,28 @@ pub(crate) fn run(args: &ZslDecodeArgs) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&value)?);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A HighLevel state as JSON (the `robowire decode zsl` and `robowire dog status --json` schema).
+pub(crate) fn high_level_state_json(s: &HighLevelState) -> Value {
+    let joints = |a: &[[F32; 4]; 4]| json!({"abad": fs(&a[0]), "hip": fs(&a[1]), "knee": fs(&a[2]), "foot": fs(&a[3])});
+    json!({
+        "datagram": "high_level_state",
+        "mode": s.control_mode.get(),
+        "mode_name": format!("{:?}", s.mode()),
+        "battery_percent": s.battery_percent.get(),
+        "error_word": s.error_word.get(),
+        "error_name": format!("{:?}", s.error()),
+        "sdk_mismatch": s.sdk_mismatch.get(),
+        "quaternion_wxyz": fs(&s.quaternion),
+        "gyro_radps": fs(&s.gyro),
+        "acc_mps2": fs(&s.acc),
+        "rpy_rad": fs(&s.rpy),
+        "body_velocity_mps": fs(&s.body_velocity),
+        "world_velocity_mps": fs(&s.world_velocity),
+        "position_m": fs(&s.position),
+        "joint_angle_rad": joints(&s.joint_angle),
+        "joint_velocity_radps": joints(&s.joint_velocity),
+        "joint_torque_nm": joints(&s.joint_torque),
+    })
 }

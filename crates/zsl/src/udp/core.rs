@@ -446,3 +446,64 @@ fn on_state<P: Profile>(core: &Core<P>, received: &StateReceived<P::State>) {
         }
     });
 }
+
+/// The accessors HighLevel and LowLevel share, over `self.core()`.
+macro_rules! client_accessors {
+    ($state:ty, $command:ty) => {
+        /// The whole state as received (`None` before the first state and after a timeout).
+        pub fn state(&self) -> Option<$state> {
+            self.core().read(|s| *s)
+        }
+
+        /// `checkConnect()`: state arrived within the watchdog timeout.
+        pub fn check_connection(&self) -> bool {
+            self.connection() == Connection::Connected
+        }
+
+        /// The connection now.
+        pub fn connection(&self) -> Connection {
+            self.core().connection()
+        }
+
+        /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
+        pub fn connection_events(&self) -> tokio::sync::watch::Receiver<Connection> {
+            self.core().connection_events()
+        }
+
+        /// Every accepted state, as it arrives (`None` after a timeout).
+        pub fn state_updates(&self) -> tokio::sync::watch::Receiver<Option<$state>> {
+            self.core().state.subscribe()
+        }
+
+        /// Waits until a state satisfies `accept`, up to `timeout`.
+        pub async fn wait_for_state(
+            &self,
+            timeout: std::time::Duration,
+            accept: impl Fn(&$state) -> bool,
+        ) -> Option<$state> {
+            self.core().wait_for(timeout, accept).await
+        }
+
+        /// Waits for state, up to `timeout`; whether the client is connected.
+        pub async fn wait_connected(&self, timeout: std::time::Duration) -> bool {
+            self.core().wait_for(timeout, |_| true).await.is_some()
+        }
+
+        /// The command being streamed now.
+        pub async fn latched_command(&self) -> $command {
+            self.core().latched().await
+        }
+
+        /// Counters: link, state anomalies, disconnects, stream lateness.
+        pub fn stats(&self) -> ClientStats {
+            self.core().stats()
+        }
+
+        /// The bound local address.
+        pub fn local_addr(&self) -> std::net::SocketAddr {
+            self.core().local_addr()
+        }
+    };
+}
+
+pub(super) use client_accessors;

@@ -3,7 +3,6 @@
 use std::sync::Mutex;
 use std::time::Duration;
 
-use tokio::sync::watch;
 use zsl_proto::codec::StateReceived;
 use zsl_proto::rules::{
     ATTITUDE_RANGES, AckCounter, ActionClear, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running,
@@ -14,7 +13,9 @@ use zsl_proto::udp::{
 };
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::core::{CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile};
+use super::core::{
+    CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile, client_accessors,
+};
 use super::snapshot::{BodyState, Imu, LegJoints};
 
 pub(super) struct HighLevelProfile;
@@ -315,8 +316,6 @@ impl HighLevel {
     }
 
     getters! {
-        /// The whole state as received (`None` before the first state and after a timeout).
-        state -> HighLevelState = |s| *s;
         /// `getQuaternion()`: w, x, y, z.
         quaternion -> [f32; 4] = |s| floats(&s.quaternion);
         /// `getRPY()`: roll, pitch, yaw, rad.
@@ -369,62 +368,15 @@ impl HighLevel {
         joints -> LegJoints = |s| s.into();
     }
 
-    /// `checkConnect()`: state arrived within the watchdog timeout.
-    pub fn check_connection(&self) -> bool {
-        self.connection() == Connection::Connected
-    }
-
-    /// The connection now.
-    pub fn connection(&self) -> Connection {
-        self.core().connection()
-    }
-
-    /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
-    pub fn connection_events(&self) -> watch::Receiver<Connection> {
-        self.core().connection_events()
-    }
-
-    /// Every accepted state, as it arrives (`None` after a timeout).
-    pub fn state_updates(&self) -> watch::Receiver<Option<HighLevelState>> {
-        self.core().state.subscribe()
-    }
-
-    /// Waits for state, up to `timeout`; whether the client is connected.
-    pub async fn wait_connected(&self, timeout: Duration) -> bool {
-        self.core().wait_for(timeout, |_| true).await.is_some()
-    }
+    client_accessors!(HighLevelState, HighLevelCommand);
 
     /// Waits until the robot reports `mode`, up to `timeout`.
     pub async fn wait_for_mode(&self, mode: ControlMode, timeout: Duration) -> Option<HighLevelState> {
         self.core().wait_for(timeout, |s| s.mode() == mode).await
     }
 
-    /// Waits until a state satisfies `accept`, up to `timeout`.
-    pub async fn wait_for_state(
-        &self,
-        timeout: Duration,
-        accept: impl Fn(&HighLevelState) -> bool,
-    ) -> Option<HighLevelState> {
-        self.core().wait_for(timeout, accept).await
-    }
-
-    /// The command being streamed now (after the action clear and the error-word override).
-    pub async fn latched_command(&self) -> HighLevelCommand {
-        self.core().latched().await
-    }
-
     /// The robot raised "SDK mismatch" and the stream stopped for good.
     pub async fn halted(&self) -> bool {
         self.core().halted().await
-    }
-
-    /// Counters: link, state anomalies, disconnects, stream lateness.
-    pub fn stats(&self) -> ClientStats {
-        self.core().stats()
-    }
-
-    /// The bound local address.
-    pub fn local_addr(&self) -> std::net::SocketAddr {
-        self.core().local_addr()
     }
 }

@@ -1,13 +1,12 @@
 //! The LowLevel client: twelve motors, position/velocity/PD/torque commands.
 
-use std::time::Duration;
-
-use tokio::sync::watch;
 use zsl_proto::rules::check_motor_command;
 use zsl_proto::udp::{LowLevelCommand, LowLevelState, MotorCommand, MotorState};
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::core::{CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile};
+use super::core::{
+    CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile, client_accessors,
+};
 use super::snapshot::Imu;
 
 pub(super) struct LowLevelProfile;
@@ -81,11 +80,6 @@ impl LowLevel {
         self.core().read(LowLevelState::has_motor_data).unwrap_or(false)
     }
 
-    /// The whole state as received.
-    pub fn state(&self) -> Option<LowLevelState> {
-        self.core().read(|s| *s)
-    }
-
     /// `getQuaternion()`: w, x, y, z.
     pub fn quaternion(&self) -> Option<[f32; 4]> {
         self.core().read(|s| floats(&s.quaternion))
@@ -111,47 +105,5 @@ impl LowLevel {
         self.core().read(|s| s.into())
     }
 
-    /// State arrived within the watchdog timeout.
-    pub fn check_connection(&self) -> bool {
-        self.connection() == Connection::Connected
-    }
-
-    /// The connection now.
-    pub fn connection(&self) -> Connection {
-        self.core().connection()
-    }
-
-    /// Connection events.
-    pub fn connection_events(&self) -> watch::Receiver<Connection> {
-        self.core().connection_events()
-    }
-
-    /// Every accepted state, as it arrives (`None` after a timeout).
-    pub fn state_updates(&self) -> watch::Receiver<Option<LowLevelState>> {
-        self.core().state.subscribe()
-    }
-
-    /// Waits until a state satisfies `accept`, up to `timeout`.
-    pub async fn wait_for_state(
-        &self,
-        timeout: Duration,
-        accept: impl Fn(&LowLevelState) -> bool,
-    ) -> Option<LowLevelState> {
-        self.core().wait_for(timeout, accept).await
-    }
-
-    /// The command being streamed now.
-    pub async fn latched_command(&self) -> LowLevelCommand {
-        self.core().latched().await
-    }
-
-    /// Counters.
-    pub fn stats(&self) -> ClientStats {
-        self.core().stats()
-    }
-
-    /// The bound local address.
-    pub fn local_addr(&self) -> std::net::SocketAddr {
-        self.core().local_addr()
-    }
+    client_accessors!(LowLevelState, LowLevelCommand);
 }
