@@ -517,6 +517,8 @@ pub struct DogSimConfig {
     pub model: Model,
     /// State period. Default 2 ms (500 Hz).
     pub state_period: Duration,
+    /// Pin the simulator's thread to this CPU (Linux), to keep it off a control loop's core.
+    pub cpu: Option<usize>,
 }
 
 impl Default for DogSimConfig {
@@ -528,6 +530,7 @@ impl Default for DogSimConfig {
             client: None,
             model: Model::Zsl1,
             state_period: Duration::from_millis(2),
+            cpu: None,
         }
     }
 }
@@ -613,11 +616,21 @@ impl DogSim {
             cycles: 0,
         }));
         let stop = Arc::new(AtomicBool::new(false));
+        let (pinned_tx, pinned) = std::sync::mpsc::sync_channel(1);
         let thread = std::thread::Builder::new().name("dog-sim".into()).spawn({
             let (shared, stop) = (shared.clone(), stop.clone());
-            move || run(&high, &low, &config, &shared, &stop)
+            move || {
+                let pinned = config.cpu.map_or(Ok(()), pin_current_thread);
+                let ok = pinned.is_ok();
+                let _ = pinned_tx.send(pinned);
+                if ok {
+                    run(&high, &low, &config, &shared, &stop);
+                }
+            }
         })?;
-        Ok(Self { shared, stop, thread: Some(thread), high_level_addr, low_level_addr })
+        let sim = Self { shared, stop, thread: Some(thread), high_level_addr, low_level_addr };
+        pinned.recv().map_err(|_| io::Error::other("the dog simulator thread died"))??;
+        Ok(sim)
     }
 
     /// Where HighLevel commands go.
@@ -661,6 +674,18 @@ impl Drop for DogSim {
     }
 }
 
+/// Pins the calling thread to `cpu`.
+fn pin_current_thread(cpu: usize) -> io::Result<()> {
+    use rustix::thread::{CpuSet, sched_setaffinity};
+    if cpu >= CpuSet::MAX_CPU {
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("CPU {cpu} is beyond CPU_SETSIZE")));
+    }
+    let mut set = CpuSet::new();
+    set.set(cpu);
+    sched_setaffinity(None, &set)
+        .map_err(|e| io::Error::new(io::Error::from(e).kind(), format!("pinning the dog simulator to CPU {cpu}: {e}")))
+}
+
 /// Junk the garbage fault sends: longer than any state, so no decoder accepts it.
 const GARBAGE: [u8; 600] = [0xEE; 600];
 
@@ -676,8 +701,10 @@ fn run(high: &UdpSocket, low: &UdpSocket, config: &DogSimConfig, shared: &Mutex<
         let timeout = Timespec::try_from(wait).unwrap_or(Timespec { tv_sec: 0, tv_nsec: 2_000_000 });
         let mut fds = [PollFd::new(high, PollFlags::IN), PollFd::new(low, PollFlags::IN)];
         let _ = poll(&mut fds, Some(&timeout));
-        let (mut reply_high, mut reply_low) = (false, false);
-        {
+        let readable = fds.map(|fd| !fd.revents().is_empty());
+        // A command that changes something is answered at once, before the socket is drained
+        // further (low latency for the client's acknowledgement).
+        if readable[0] {
             let mut s = lock(shared);
             while let Ok((len, from)) = high.recv_from(&mut buf) {
                 match high_codec.decode(&buf[..len]) {
@@ -686,11 +713,16 @@ fn run(high: &UdpSocket, low: &UdpSocket, config: &DogSimConfig, shared: &Mutex<
                         if config.client.is_none() {
                             s.high_level.client = Some(from);
                         }
-                        reply_high |= s.dog.on_high_level(&command, model);
+                        if s.dog.on_high_level(&command, model) {
+                            send_state(high, &mut s, true, &mut buf);
+                        }
                     }
                     Err(_) => s.high_level.invalid += 1,
                 }
             }
+        }
+        if readable[1] {
+            let mut s = lock(shared);
             while let Ok((len, from)) = low.recv_from(&mut buf) {
                 match low_codec.decode(&buf[..len]) {
                     Ok((command, _)) => {
@@ -698,15 +730,16 @@ fn run(high: &UdpSocket, low: &UdpSocket, config: &DogSimConfig, shared: &Mutex<
                         if config.client.is_none() {
                             s.low_level.client = Some(from);
                         }
-                        reply_low |= s.dog.on_low_level(&command);
+                        if s.dog.on_low_level(&command) {
+                            send_state(low, &mut s, false, &mut buf);
+                        }
                     }
                     Err(_) => s.low_level.invalid += 1,
                 }
             }
         }
         let now = Instant::now();
-        let tick = now >= next;
-        if tick {
+        if now >= next {
             let dt = now.duration_since(last_step).as_secs_f32().min(0.05);
             last_step = now;
             let mut s = lock(shared);
@@ -716,14 +749,7 @@ fn run(high: &UdpSocket, low: &UdpSocket, config: &DogSimConfig, shared: &Mutex<
             if now > next + period * 10 {
                 next = now + period;
             }
-        }
-        // State at every tick, and at once when a command changed something (low latency for
-        // the client's acknowledgement).
-        let mut s = lock(shared);
-        if tick || reply_high {
             send_state(high, &mut s, true, &mut buf);
-        }
-        if tick || reply_low {
             send_state(low, &mut s, false, &mut buf);
         }
     }
@@ -827,6 +853,13 @@ mod tests {
         run_silent(&mut dog, 1.0);
         assert!(dog.velocity()[0] < 0.05, "no command for 0.5 s: the dog stops");
         assert_eq!(dog.mode(), ControlMode::Move);
+    }
+
+    #[test]
+    fn pinning_to_a_cpu_that_does_not_exist_is_an_error_not_a_silent_default() {
+        let err = DogSim::spawn(DogSimConfig { cpu: Some(100_000), ..DogSimConfig::loopback() }).unwrap_err();
+        assert!(err.to_string().contains("CPU 100000"), "{err}");
+        assert!(DogSim::spawn(DogSimConfig { cpu: Some(0), ..DogSimConfig::loopback() }).is_ok());
     }
 
     #[test]

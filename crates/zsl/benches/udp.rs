@@ -4,7 +4,7 @@
 //! - Latency percentiles, measured in interleaved rounds so that a slow spell of the host hits
 //!   every variant alike:
 //!   - *raw echo*: a 40-byte datagram to an echo thread that answers with 560 bytes, plain
-//!     blocking std sockets (the baseline);
+//!     blocking std sockets (the baseline), sample by sample alternating with the round trip;
 //!   - *call to wire*: from `HighLevel::move_velocity()` being called to the datagram read by
 //!     a socket standing in for the dog (the vendor client needs about 1.8 ms: it waits for
 //!     its next 2 ms tick);
@@ -60,6 +60,19 @@ fn codec(criterion: &mut Criterion) {
     group.finish();
 }
 
+/// The CPUs the two sides run on: the client side (this thread, the runtime's workers) on one,
+/// the peer (echo thread, simulator) on the other, as between a computer and its robot. Without
+/// pinning, whether two threads share a vCPU decides a loopback round trip on this VM (~10 µs
+/// shared, ~40 µs apart) and the comparison would measure the scheduler's luck.
+const CLIENT_CPU: usize = 0;
+const PEER_CPU: usize = 1;
+
+fn pin(cpu: usize) {
+    let mut set = rustix::thread::CpuSet::new();
+    set.set(cpu);
+    rustix::thread::sched_setaffinity(None, &set).expect("pinning a bench thread (needs 2 CPUs)");
+}
+
 /// The baseline: 40 bytes out, 560 back, through an echo thread on plain blocking sockets.
 struct RawEcho {
     socket: UdpSocket,
@@ -72,6 +85,7 @@ impl RawEcho {
         let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
         socket.connect(echo.local_addr().unwrap()).unwrap();
         let handle = std::thread::spawn(move || {
+            pin(PEER_CPU);
             let mut buf = [0u8; 600];
             let reply = [0u8; 560];
             while let Ok((n, from)) = echo.recv_from(&mut buf) {
@@ -129,35 +143,41 @@ fn call_to_wire(runtime: &tokio::runtime::Runtime, samples: &mut Vec<u64>, n: us
     });
 }
 
-/// Round trip through the simulator: a call → the state that reports the new mode. Measured in
-/// a task on the runtime, where a user's control loop runs.
-fn sim_round_trip(runtime: &tokio::runtime::Runtime, samples: &mut Vec<u64>, n: usize) {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+/// Round trip through the simulator (a call → the state that reports the new mode), sample by
+/// sample alternating with a raw echo round trip, so that both see the same state of the host
+/// (on this VM a sleeping vCPU's wake-up alone swings a round trip between ~10 and ~40 µs).
+/// Measured in a task on the runtime, where a user's control loop runs.
+fn round_trips(runtime: &tokio::runtime::Runtime, raw: &mut Vec<u64>, trip: &mut Vec<u64>, n: usize) {
+    let sim = DogSim::spawn(DogSimConfig { cpu: Some(PEER_CPU), ..DogSimConfig::loopback() }).unwrap();
     let addr = sim.high_level_addr();
-    let measured = runtime.block_on(runtime.spawn(async move {
-        let mut samples = Vec::with_capacity(n);
-        let dog = HighLevel::connect(loopback_options(addr)).await.unwrap();
-        assert!(dog.wait_connected(Duration::from_secs(2)).await);
-        for i in 0..n + 200 {
-            let (target, start) = if i % 2 == 0 {
+    let (raw_samples, trip_samples) = runtime
+        .block_on(runtime.spawn(async move {
+            let echo = RawEcho::start();
+            let out = HighLevelCommand::stand_up().encode(Model::Zsl1);
+            let mut buf = [0u8; 600];
+            let (mut raw, mut trip) = (Vec::with_capacity(n), Vec::with_capacity(n));
+            let dog = HighLevel::connect(loopback_options(addr)).await.unwrap();
+            assert!(dog.wait_connected(Duration::from_secs(2)).await);
+            for i in 0..n + 200 {
+                let start = Instant::now();
+                echo.round_trip(&out, &mut buf);
+                let raw_ns = start.elapsed().as_nanos() as u64;
+                let target = if i % 2 == 0 { ControlMode::Passive } else { ControlMode::LieDown };
                 let start = Instant::now();
                 // The 11th call in a row made while the robot still reports the other mode is
                 // `NotAcknowledged` (it was sent all the same): the result does not matter here.
-                let _ = dog.passive().await;
-                (ControlMode::Passive, start)
-            } else {
-                let start = Instant::now();
-                let _ = dog.lie_down().await;
-                (ControlMode::LieDown, start)
-            };
-            assert!(dog.wait_for_mode(target, Duration::from_secs(1)).await.is_some());
-            if i >= 200 {
-                samples.push(start.elapsed().as_nanos() as u64);
+                let _ = if i % 2 == 0 { dog.passive().await } else { dog.lie_down().await };
+                assert!(dog.wait_for_mode(target, Duration::from_secs(1)).await.is_some());
+                if i >= 200 {
+                    trip.push(start.elapsed().as_nanos() as u64);
+                    raw.push(raw_ns);
+                }
             }
-        }
-        samples
-    }));
-    samples.extend(measured.unwrap());
+            (raw, trip)
+        }))
+        .unwrap();
+    raw.extend(raw_samples);
+    trip.extend(trip_samples);
     drop(sim);
 }
 
@@ -168,16 +188,17 @@ fn main() {
 
     let quick = std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some();
     let (rounds, per_round) = if quick { (3, 500) } else { (10, 1000) };
-    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+    pin(CLIENT_CPU);
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .on_thread_start(|| pin(CLIENT_CPU))
+        .enable_all()
+        .build()
+        .unwrap();
     let (mut raw, mut wire, mut trip) = (Vec::new(), Vec::new(), Vec::new());
-    let out = HighLevelCommand::stand_up().encode(Model::Zsl1);
-    let mut buf = [0u8; 600];
     for _ in 0..rounds {
-        let echo = RawEcho::start();
-        common::time_each(&mut raw, per_round, || echo.round_trip(&out, &mut buf));
-        drop(echo);
         call_to_wire(&runtime, &mut wire, per_round);
-        sim_round_trip(&runtime, &mut trip, per_round);
+        round_trips(&runtime, &mut raw, &mut trip, per_round);
     }
     let (raw, wire, trip) = (percentiles(raw), percentiles(wire), percentiles(trip));
     let json = format!(
