@@ -116,3 +116,13 @@ fn sim_and_device_commands_as_two_processes() {
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("velocity_mps must be finite"));
 }
+
+#[test]
+fn demo_lowcmd_loop_and_json_output() {
+    let out = robowire().args(["demo", "--only", "lowcmd", "--duration", "1", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");
+    assert_eq!(report["passed"], true, "{report}");
+    assert_eq!(report["checks"].as_array().unwrap().len(), 2);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("caught by the CRC"), "the report goes to stderr");
+}

@@ -96,7 +96,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
 }
 
 async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
-    println!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) ==");
+    say!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) ==");
     let sim = DogSim::spawn(DogSimConfig::loopback()).context("starting the dog simulator")?;
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
     let watchdog = Duration::from_millis(500);
@@ -106,7 +106,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     }
     .with_watchdog(watchdog);
     let dog = HighLevel::connect(options).await?;
-    println!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr());
+    say!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr());
     let started = Instant::now();
     let mut calls = Calls::default();
     let mut checks = Vec::new();
@@ -124,7 +124,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     // Stand up.
     let stood = stand(&dog, &mut calls, "stand_up").await?;
     let height = dog.position().map_or(0.0, |p| p[2]);
-    println!(
+    say!(
         "  stand    stand_up -> mode {:?}, body at {height:.2} m {}",
         dog.control_mode().unwrap_or(ControlMode::Passive),
         lap()
@@ -147,7 +147,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let closure_m = (end[0] - origin[0]).hypot(end[1] - origin[1]);
     let heading_error = wrap(dog.rpy().context("no state")?[2] - heading0).abs();
     let walked = sim.snapshot().dog.distance_m();
-    println!(
+    say!(
         "  square   {side_m:.2} m sides: corners {} · back within {:.3} m, heading error {:.3} rad, walked {walked:.2} m {}",
         corners.iter().map(|(x, y)| format!("({x:+.2}, {y:+.2})")).collect::<Vec<_>>().join(" "),
         closure_m,
@@ -171,7 +171,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let back = dog.rpy().map_or(1.0, |r| r[0]);
     let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0).await;
     calls.record("attitude_control(0, 0, 0, 0)", &zero);
-    println!("  attitude roll +0.5 rad/s for 0.4 s -> {rolled:+.2} rad, back -> {back:+.2} rad {}", lap());
+    say!("  attitude roll +0.5 rad/s for 0.4 s -> {rolled:+.2} rad, back -> {back:+.2} rad {}", lap());
     checks.push(Check::new(
         "dog: attitude rates roll the body and back",
         result.is_ok() && result_back.is_ok() && rolled > 0.15 && back.abs() < 0.05,
@@ -186,7 +186,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let landed = dog.wait_for_state(WAIT, |s| (s.position[2].get() - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
     let action_cleared = dog.latched_command().await.action.get() == 0;
     let tricks = sim.snapshot().dog.tricks_done() - tricks_before;
-    println!(
+    say!(
         "  trick    jump -> airborne {airborne}, landed standing {landed}, action cleared after 6 datagrams {action_cleared} {}",
         lap()
     );
@@ -204,7 +204,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     sim.clear_faults();
     dog.wait_for_state(WAIT, |s| s.error_word.get() == 0).await;
     let code = refused.as_ref().err().map(CallError::return_code);
-    println!("  fault    error word 0x3011 -> stand_up returns {code:?}; the stream forced passive {}", lap());
+    say!("  fault    error word 0x3011 -> stand_up returns {code:?}; the stream forced passive {}", lap());
     checks.push(Check::new(
         "dog: motor fault reported as the call's return code",
         code == Some(ReturnCode::MotorFault),
@@ -216,7 +216,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let result = dog.move_velocity(0.4, 0.0, 0.0).await;
     calls.record("move(0.4, 0, 0)", &result);
     if let Err(e) = &result {
-        println!("  move(0.4, 0, 0) refused: {e}");
+        say!("  move(0.4, 0, 0) refused: {e}");
     }
     dog.wait_for_state(WAIT, |s| s.body_velocity[0].get() > 0.35).await;
     let mut events = dog.connection_events();
@@ -229,7 +229,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     sim.clear_faults();
     let back = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Connected)).await.is_ok();
     let stopped = settle(&dog).await;
-    println!(
+    say!(
         "  fault    dog silent -> Disconnected after {:.0} ms, latched vx {latched_vx} m/s, reconnected {back}, dog stopped {stopped} {}",
         noticed.as_secs_f64() * 1e3,
         lap()
@@ -244,7 +244,7 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let result = dog.lie_down().await;
     calls.record("lie_down", &result);
     let lying = dog.wait_for_state(WAIT, |s| s.position[2].get() < 0.12).await.is_some();
-    println!("  lie      lie_down -> mode {:?} {}", dog.control_mode().unwrap_or(ControlMode::Passive), lap());
+    say!("  lie      lie_down -> mode {:?} {}", dog.control_mode().unwrap_or(ControlMode::Passive), lap());
     checks.push(Check::new(
         "dog: lies down (mode 51, body low)",
         result.is_ok() && lying,
@@ -254,16 +254,16 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let stats = dog.stats();
     let snapshot = sim.snapshot();
     let [x, y, _] = snapshot.dog.position_m();
-    println!();
-    println!("  summary ({:.1} s)", started.elapsed().as_secs_f64());
-    println!("    calls     {}", calls.0.iter().map(|(n, c)| format!("{n} 0x{c:04x}")).collect::<Vec<_>>().join(", "));
-    println!(
+    say!();
+    say!("  summary ({:.1} s)", started.elapsed().as_secs_f64());
+    say!("    calls     {}", calls.0.iter().map(|(n, c)| format!("{n} 0x{c:04x}")).collect::<Vec<_>>().join(", "));
+    say!(
         "    body      at ({x:+.2}, {y:+.2}) m, walked {:.2} m, battery {:.1} %, {} tricks",
         snapshot.dog.distance_m(),
         snapshot.dog.battery_percent(),
         snapshot.dog.tricks_done()
     );
-    println!(
+    say!(
         "    client    sent {} · states {} · decode errors {} · foreign dropped {} · disconnects {} reconnects {} · stream lateness p50 {} µs p99 {} µs",
         stats.link.sent,
         stats.states,
@@ -274,9 +274,11 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         stats.stream_lateness.p50_us,
         stats.stream_lateness.p99_us
     );
-    println!(
+    say!(
         "    simulator {} commands ({} invalid) · {} states sent",
-        snapshot.high_level.commands, snapshot.high_level.invalid, snapshot.high_level.states_sent
+        snapshot.high_level.commands,
+        snapshot.high_level.invalid,
+        snapshot.high_level.states_sent
     );
     checks.push(Check::new(
         "dog: every command decoded strictly by the dog",

@@ -30,10 +30,10 @@ const PHASES: [Phase; 3] = [
 ];
 
 pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
-    println!("== KMC chassis (UART on a pseudo-terminal) ==");
+    say!("== KMC chassis (UART on a pseudo-terminal) ==");
     let sim = ChassisSim::spawn(ChassisSimConfig::default()).context("starting the chassis simulator")?;
     let options = DriverOptions { poll_battery: true, poll_allstate: true, ..Default::default() };
-    println!(
+    say!(
         "simulator on {}; Driver at {} Hz control, {} Hz speed, battery and all-state polls",
         sim.path().display(),
         options.control_rate_hz,
@@ -73,9 +73,13 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         }
         let state = sim.state();
         let turned = state.heading_rad - heading_before;
-        println!(
+        say!(
             "  {:<8} set_command({:+.2} m/s, {:+.2} rad/s) -> reported speed {:+.3} m/s, heading change {:+.3} rad",
-            phase.name, phase.velocity_mps, phase.yaw_rate_radps, last_speed, turned
+            phase.name,
+            phase.velocity_mps,
+            phase.yaw_rate_radps,
+            last_speed,
+            turned
         );
         // Settled: within 10 % of the step (plus 2 cm/s for the report's age).
         let tolerance = 0.1 * (phase.velocity_mps - speed_before).abs() + 0.02;
@@ -102,7 +106,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         .find(|r| r.at > last_command_at && r.frame == HostFrame::PcControl(PcControl::STOP))
         .map(|r| r.at - last_command_at);
     let timeouts = driver.stats().command_timeouts;
-    println!(
+    say!(
         "  timeout  no set_command for 600 ms -> (0, 0) streamed after {} ms, chassis commanded {:+.2} m/s",
         timeout_stop.map_or("never".into(), |d| d.as_millis().to_string()),
         sim.state().commanded_velocity_mps
@@ -126,7 +130,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         received.iter().skip(before_stop).filter(|r| matches!(r.frame, HostFrame::PcControl(_))).collect();
     let burst = after_stop.iter().rev().take_while(|r| r.frame == HostFrame::PcControl(PcControl::STOP)).count();
     let stats = driver.stats();
-    println!("  stop     driver.stop() -> {} × (0, 0) at the end of the stream", burst);
+    say!("  stop     driver.stop() -> {} × (0, 0) at the end of the stream", burst);
     checks.push(Check::new(
         "stop: burst of 3 × (0, 0)",
         stats.stop_frames_sent == 3 && burst >= 3,
@@ -158,9 +162,9 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let pct =
         |p: usize| intervals_us.get((p * intervals_us.len()).div_ceil(100).saturating_sub(1)).copied().unwrap_or(0);
     let sim_stats = sim.stats();
-    println!();
-    println!("  summary ({:.1} s)", elapsed.as_secs_f64());
-    println!(
+    say!();
+    say!("  summary ({:.1} s)", elapsed.as_secs_f64());
+    say!(
         "    sent      control {} (+{} stop) · speed requests {} · battery {} · all-state {}",
         stats.control_frames_sent,
         stats.stop_frames_sent,
@@ -168,11 +172,14 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         stats.battery_requests_sent,
         stats.all_state_requests_sent
     );
-    println!(
+    say!(
         "    received  {} frames ({} bytes) · chassis answered {}, dropped {} (injected)",
-        stats.frames_received, stats.link.bytes_read, sim_stats.responses_sent, sim_stats.responses_dropped
+        stats.frames_received,
+        stats.link.bytes_read,
+        sim_stats.responses_sent,
+        sim_stats.responses_dropped
     );
-    println!(
+    say!(
         "    0xA5 at the chassis: {rate:.1} Hz, interval p50 {:.2} ms p99 {:.2} ms · send lateness p50 {} µs p99 {} µs max {} µs",
         pct(50) as f64 / 1e3,
         pct(99) as f64 / 1e3,
@@ -180,7 +187,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         stats.control_lateness.p99_us,
         stats.control_lateness.max_us
     );
-    println!(
+    say!(
         "    decoders  host: frames {} skipped {} rejected {} · chassis: frames {} skipped {} rejected {}",
         stats.link.decoder.frames,
         stats.link.decoder.skipped_bytes,

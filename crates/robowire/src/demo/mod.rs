@@ -1,8 +1,25 @@
 //! `robowire demo`: every simulated device, driven through its client API, with checks that
 //! what was commanded was observed.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// With `--json`, the human-readable report goes to stderr and stdout carries only the JSON.
+static JSON: AtomicBool = AtomicBool::new(false);
+
+/// `println!` for the demo's report: stdout, or stderr under `--json`.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        if $crate::demo::JSON.load(std::sync::atomic::Ordering::Relaxed) {
+            eprintln!($($arg)*)
+        } else {
+            println!($($arg)*)
+        }
+    };
+}
+
 mod dog;
 mod kmc;
+mod lowcmd;
 mod spline;
 
 use std::process::ExitCode;
@@ -18,6 +35,9 @@ pub(crate) struct DemoArgs {
     /// Run one device's scenario only.
     #[arg(long, value_enum)]
     only: Option<Device>,
+    /// Print the checks as JSON on stdout (the report goes to stderr).
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -28,6 +48,8 @@ enum Device {
     Dog,
     /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).
     Spline,
+    /// Unitree LowCmd/LowState encode, decode and verify at 500 Hz.
+    Lowcmd,
 }
 
 /// One thing a scenario commanded and whether it was observed.
@@ -50,30 +72,43 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
         "--duration must be between 0.3 and 600 s, got {}",
         args.duration
     );
+    JSON.store(args.json, Ordering::Relaxed);
     let mut checks = Vec::new();
     if args.only.is_none_or(|d| d == Device::Kmc) {
         checks.extend(kmc::run(args.duration)?);
     }
     if args.only.is_none_or(|d| d == Device::Dog) {
-        println!();
+        say!();
         checks.extend(dog::run(args.duration)?);
     }
     if args.only.is_none_or(|d| d == Device::Spline) {
-        println!();
+        say!();
         checks.extend(spline::run(args.duration)?);
     }
-    println!();
-    println!("checks");
+    if args.only.is_none_or(|d| d == Device::Lowcmd) {
+        say!();
+        checks.extend(lowcmd::run(args.duration)?);
+    }
+    say!();
+    say!("checks");
     for check in &checks {
-        println!("  [{}] {:<52} {}", if check.passed { " ok " } else { "FAIL" }, check.what, check.observed);
+        say!("  [{}] {:<52} {}", if check.passed { " ok " } else { "FAIL" }, check.what, check.observed);
     }
     let failed = checks.iter().filter(|c| !c.passed).count();
-    println!();
+    if args.json {
+        let checks: Vec<_> = checks
+            .iter()
+            .map(|c| serde_json::json!({"check": c.what, "passed": c.passed, "observed": c.observed}))
+            .collect();
+        let report = serde_json::json!({"passed": failed == 0, "failed": failed, "checks": checks});
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    say!();
     if failed == 0 {
-        println!("demo passed: {} checks", checks.len());
+        say!("demo passed: {} checks", checks.len());
         Ok(ExitCode::SUCCESS)
     } else {
-        println!("demo FAILED: {failed} of {} checks", checks.len());
+        say!("demo FAILED: {failed} of {} checks", checks.len());
         Ok(ExitCode::FAILURE)
     }
 }

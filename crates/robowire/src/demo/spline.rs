@@ -32,10 +32,10 @@ fn command(pose: [f32; 3]) -> SplineCommandBlock {
 }
 
 pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
-    println!("== ZSL-1 low level (spline daemon on shared memory, 1 kHz) ==");
+    say!("== ZSL-1 low level (spline daemon on shared memory, 1 kHz) ==");
     let sim = SplineSim::spawn(SplineSimConfig::private("demo")).context("starting the spline daemon simulator")?;
     let names = sim.config().clone();
-    println!("simulator on {} and {}", names.spline_name, names.imu_name);
+    say!("simulator on {} and {}", names.spline_name, names.imu_name);
     let mut client = SplineClient::open(&names.spline_name)?;
     let mut imu = ImuReader::open(&names.imu_name)?;
 
@@ -70,7 +70,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         client.write_command(&command(pose_at(fraction)))?;
         cycles += 1;
         if !phase_printed && elapsed >= move_time {
-            println!(
+            say!(
                 "  move     lying {LYING_POSE_RAD:?} -> stand {STANDING_POSE_RAD:?} rad over {:.1} s",
                 move_time.as_secs_f64()
             );
@@ -83,7 +83,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         .flat_map(|&leg| JointIndex::ALL.into_iter().take(3).enumerate().map(move |(j, joint)| (leg, joint, j)))
         .map(|(leg, joint, j)| (state.joint(leg, joint).p.get() - STANDING_POSE_RAD[j]).abs())
         .fold(0.0f32, f32::max);
-    println!("  hold     {:.1} s at the stand pose: largest joint error {worst:.4} rad", hold_time.as_secs_f64());
+    say!("  hold     {:.1} s at the stand pose: largest joint error {worst:.4} rad", hold_time.as_secs_f64());
     let daemon = sim.stats().daemon;
     let fresh = daemon.fresh - daemon_before.fresh;
     let repeated = daemon.repeated - daemon_before.repeated;
@@ -101,7 +101,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     std::thread::sleep(Duration::from_millis(30).saturating_sub(paused_at.elapsed()));
     sim.pause(false);
     let recovered = client.wait_state(Duration::from_millis(100)).is_ok();
-    println!(
+    say!(
         "  fault    daemon hung for 30 ms -> stall reported after {} ms, fresh state again: {}",
         noticed.map_or("never".into(), |d| format!("{:.1}", d.as_secs_f64() * 1e3)),
         if recovered { "yes" } else { "no" }
@@ -110,16 +110,16 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
 
     let loop_jitter = jitter.summary();
     let sim_stats = sim.stats();
-    println!();
-    println!("  summary ({:.1} s)", start.elapsed().as_secs_f64());
-    println!(
+    say!();
+    say!("  summary ({:.1} s)", start.elapsed().as_secs_f64());
+    say!(
         "    client    {cycles} cycles, {} commands, {} states, {timeouts} timeouts · loop jitter |interval − 1 ms| p50 {} µs p99 {} µs",
         client.counters().commands_written,
         client.counters().states_read,
         loop_jitter.p50_us,
         loop_jitter.p99_us
     );
-    println!(
+    say!(
         "    daemon    {} cycles, {} missed deadlines · lateness p50 {} µs p99 {} µs max {} µs · during the loop: {fresh} fresh commands, {repeated} repeated",
         sim_stats.cycles,
         sim_stats.missed_cycles,
@@ -127,7 +127,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         sim_stats.lateness.p99_us,
         sim_stats.lateness.max_us
     );
-    println!(
+    say!(
         "    IMU       {} samples, latest age {}",
         sim_stats.imu_samples,
         imu_age.map_or("-".into(), |a| format!("{:.2} ms", a.as_secs_f64() * 1e3))
