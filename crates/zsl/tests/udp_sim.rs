@@ -284,3 +284,27 @@ async fn a_zsl1w_crawls_and_its_wheels_turn() {
     let zsl1 = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
     assert!(matches!(zsl1.crawl(0.5, 0.0, 0.0).await, Err(CallError::WrongModel { .. })));
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let options = options_to(sim.low_level_addr()).with_watchdog(Duration::from_millis(300));
+    let low = LowLevel::connect(options).await.unwrap();
+    assert!(low.wait_for_state(WAIT, |_| true).await.is_some());
+    let mut moving = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
+    moving.qd_des[1] = [0.5.into(); 4];
+    moving.tau_ff[2] = [2.0.into(); 4];
+    low.send_motor_command(&moving).await.unwrap();
+
+    sim.inject(DogFault::Silence);
+    tokio::time::timeout(WAIT, low.connection_events().wait_for(|c| *c == Connection::Disconnected))
+        .await
+        .unwrap()
+        .unwrap();
+    assert_eq!(low.motor_state(), None);
+    let latched = low.latched_command().await.motor;
+    assert!(latched.qd_des.iter().flatten().all(|v| v.get() == 0.0), "velocity targets zeroed");
+    assert_eq!((latched.q_des, latched.kp, latched.tau_ff), (moving.q_des, moving.kp, moving.tau_ff), "hold kept");
+    sim.clear_faults();
+    assert!(low.wait_for_state(WAIT, |_| true).await.is_some(), "reconnects");
+}

@@ -224,9 +224,19 @@ impl HighLevel {
     /// vy 0.1–1.0 m/s, yaw rate 0.02–3.0 rad/s (ZSL-1W 0.1–3.0). Latched until replaced:
     /// `move_velocity(0.0, 0.0, 0.0)` stops.
     pub async fn move_velocity(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
-        self.call(Call::Move, |model| {
-            let [vx, vy, wz] = check_all(&move_ranges(model), [vx_mps, vy_mps, yaw_rate_radps])?;
-            Ok(HighLevelCommand::move_velocity(vx, vy, wz))
+        self.walk(Call::Move, HighLevelCommand::move_velocity, [vx_mps, vy_mps, yaw_rate_radps]).await
+    }
+
+    /// `move`, `crawl`, `climb`: the `move` ranges of the model, then the call's datagram.
+    async fn walk(
+        &self,
+        call: Call,
+        build: fn(f32, f32, f32) -> HighLevelCommand,
+        args: [f32; 3],
+    ) -> Result<(), CallError> {
+        self.call(call, |model| {
+            let [vx, vy, wz] = check_all(&move_ranges(model), args)?;
+            Ok(build(vx, vy, wz))
         })
         .await
     }
@@ -286,21 +296,13 @@ impl HighLevel {
     /// ZSL-1W `crawl(vx, vy, yaw_rate)`: mode 18, action 17 (sticky); `move` ranges.
     pub async fn crawl(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
         self.require("crawl", Model::Zsl1W)?;
-        self.call(Call::Crawl, |model| {
-            let [vx, vy, wz] = check_all(&move_ranges(model), [vx_mps, vy_mps, yaw_rate_radps])?;
-            Ok(HighLevelCommand::crawl(vx, vy, wz))
-        })
-        .await
+        self.walk(Call::Crawl, HighLevelCommand::crawl, [vx_mps, vy_mps, yaw_rate_radps]).await
     }
 
     /// ZSL-1W `climb(vx, vy, yaw_rate)`: mode 18, action 16 (sticky); `move` ranges.
     pub async fn climb(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
         self.require("climb", Model::Zsl1W)?;
-        self.call(Call::Climb, |model| {
-            let [vx, vy, wz] = check_all(&move_ranges(model), [vx_mps, vy_mps, yaw_rate_radps])?;
-            Ok(HighLevelCommand::climb(vx, vy, wz))
-        })
-        .await
+        self.walk(Call::Climb, HighLevelCommand::climb, [vx_mps, vy_mps, yaw_rate_radps]).await
     }
 
     /// ZSL-1W `cancelCrawl()`: mode 18, action 0, flag 0.
