@@ -63,6 +63,14 @@ fn demo_drives_the_simulated_chassis_and_checks_what_it_saw() {
     for phase in ["straight", "turn", "reverse", "timeout", "stop"] {
         assert!(stdout.contains(phase), "{phase} missing from {stdout}");
     }
+    // The summary table: a column for the chassis, its rates, timings, counters and faults.
+    let table = stdout.split("\nsummary\n").nth(1).expect("a summary table");
+    for row in ["result", "commanded", "observed", "rates", "p50/p99/max µs", "counters", "faults"] {
+        assert!(table.lines().any(|l| l.trim_start().starts_with(row)), "row {row} missing from {table}");
+    }
+    assert!(table.contains("noise 64 B -> skipped 64 B"), "{table}");
+    // Not a terminal: the progress line is printed once a second as a plain line.
+    assert!(stdout.lines().any(|l| l.starts_with("  > kmc ") && l.contains(" Hz")), "{stdout}");
 }
 
 #[test]
@@ -124,5 +132,17 @@ fn demo_lowcmd_loop_and_json_output() {
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");
     assert_eq!(report["passed"], true, "{report}");
     assert_eq!(report["checks"].as_array().unwrap().len(), 2);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("caught by the CRC"), "the report goes to stderr");
+    let device = &report["devices"][0];
+    assert_eq!(device["device"], "lowcmd", "{report}");
+    let rate_hz = device["rates_hz"]["loop"].as_f64().unwrap();
+    assert!((475.0..=525.0).contains(&rate_hz), "{report}");
+    assert!(device["timings_us"]["lateness"]["p99"].as_u64().is_some(), "{report}");
+    assert_eq!(
+        device["counters"]["CRC rejects"],
+        device["faults"][0]["injected"].as_str().unwrap().split(' ').next().unwrap().parse::<u64>().unwrap(),
+        "every flipped bit rejected: {report}"
+    );
+    assert_eq!(device["faults"][0]["detected"], true, "{report}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("caught by the CRC") && stderr.contains("\nsummary\n"), "the report goes to stderr");
 }

@@ -140,6 +140,12 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
     assert!(client.wait_connected(WAIT).await);
     let stats = client.stats();
     assert_eq!((stats.disconnects, stats.reconnects), (1, 1));
+    assert!(
+        u128::from(stats.state_gap.max_us) >= watchdog.as_micros(),
+        "the silence shows as the largest gap between states: {:?}",
+        stats.state_gap
+    );
+    assert!(stats.state_gap.p50_us < 10_000, "the dog streams every 2 ms: {:?}", stats.state_gap);
     assert_eq!(client.latched_command().await.vx.get(), 0.0, "a stale motion never resumes");
 }
 

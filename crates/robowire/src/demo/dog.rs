@@ -9,7 +9,7 @@ use anyhow::Context;
 use robowire_sim::dog::{DogFault, DogSim, DogSimConfig, STANDING_HEIGHT_M};
 use zsl::udp::{CallError, ClientOptions, Connection, ControlMode, HighLevel, ReturnCode};
 
-use super::Check;
+use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 
 const WAIT: Duration = Duration::from_secs(3);
 /// Control period of the demo's own loops.
@@ -90,12 +90,30 @@ async fn stand(dog: &HighLevel, calls: &mut Calls, name: &str) -> anyhow::Result
     Ok(dog.wait_for_state(WAIT, up).await.is_some())
 }
 
-pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
+pub(super) fn run(duration_s: f64) -> anyhow::Result<DeviceReport> {
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(scenario(duration_s))
 }
 
-async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
+/// The live line, until the scenario ends.
+async fn show_progress(dog: &HighLevel) -> std::convert::Infallible {
+    let mut progress = Progress::new("dog");
+    loop {
+        tokio::time::sleep(Duration::from_millis(50)).await;
+        if progress.due() {
+            let stats = dog.stats();
+            let mode = dog.control_mode().map_or_else(|| format!("{:?}", dog.connection()), |m| format!("{m:?}"));
+            progress.show(&Status {
+                mode: &mode,
+                motion: dog.state().map_or("-".into(), |s| format!("{:+.3} m/s", s.body_velocity[0].get())),
+                loop_count: stats.link.sent,
+                lateness_us: (stats.stream_lateness.p99_us, "p99"),
+            });
+        }
+    }
+}
+
+async fn scenario(duration_s: f64) -> anyhow::Result<DeviceReport> {
     say!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) ==");
     let sim = DogSim::spawn(DogSimConfig::loopback()).context("starting the dog simulator")?;
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
@@ -107,9 +125,16 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     .with_watchdog(watchdog);
     let dog = HighLevel::connect(options).await?;
     say!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr());
+    tokio::select! {
+        report = steps(&sim, &dog, watchdog, duration_s) => report,
+        never = show_progress(&dog) => match never {},
+    }
+}
+
+async fn steps(sim: &DogSim, dog: &HighLevel, watchdog: Duration, duration_s: f64) -> anyhow::Result<DeviceReport> {
     let started = Instant::now();
     let mut calls = Calls::default();
-    let mut checks = Vec::new();
+    let mut report = DeviceReport::new("dog");
 
     let mut phase = Instant::now();
     let mut lap = move || {
@@ -118,18 +143,20 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         format!("({seconds:.1} s)")
     };
     let connected = dog.wait_connected(WAIT).await;
-    checks.push(Check::new("dog: state arrives, client connects", connected, format!("{:?}", dog.connection())));
+    report.checks.push(Check::new("dog: state arrives, client connects", connected, format!("{:?}", dog.connection())));
     anyhow::ensure!(connected, "the dog simulator sends no state");
 
     // Stand up.
-    let stood = stand(&dog, &mut calls, "stand_up").await?;
+    let stood = stand(dog, &mut calls, "stand_up").await?;
     let height = dog.position().map_or(0.0, |p| p[2]);
     say!(
         "  stand    stand_up -> mode {:?}, body at {height:.2} m {}",
         dog.control_mode().unwrap_or(ControlMode::Passive),
         lap()
     );
-    checks.push(Check::new("dog: stands up (mode 1, standing height)", stood, format!("height {height:.2} m")));
+    report.checks.push(Check::new("dog: stands up (mode 1, standing height)", stood, format!("height {height:.2} m")));
+    report.commanded.push("stand_up".into());
+    report.observed.push(format!("standing, body {height:.2} m"));
     tokio::time::sleep(Duration::from_millis(200)).await;
 
     // Walk a square, closed loop on position and heading.
@@ -138,8 +165,8 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let heading0 = dog.rpy().context("no state")?[2];
     let mut corners = Vec::new();
     for corner in 1..=4 {
-        walk(&dog, side_m, &mut calls).await?;
-        turn_to(&dog, wrap(heading0 + corner as f32 * std::f32::consts::FRAC_PI_2)).await?;
+        walk(dog, side_m, &mut calls).await?;
+        turn_to(dog, wrap(heading0 + corner as f32 * std::f32::consts::FRAC_PI_2)).await?;
         let p = dog.position().context("no state")?;
         corners.push((p[0] - origin[0], p[1] - origin[1]));
     }
@@ -154,11 +181,13 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         heading_error,
         lap()
     );
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: walks a square and returns to the start",
         closure_m < 0.05 && heading_error < 0.02 && walked > 3.5 * side_m,
         format!("closure {closure_m:.3} m, heading {heading_error:.3} rad, walked {walked:.2} m"),
     ));
+    report.commanded.push(format!("square, {side_m:.2} m sides"));
+    report.observed.push(format!("back within {:.0} mm", closure_m * 1e3));
 
     // Attitude: roll one way for 0.4 s, back, zero rates.
     let result = dog.attitude_control(0.5, 0.0, 0.0, 0.0).await;
@@ -172,11 +201,13 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0).await;
     calls.record("attitude_control(0, 0, 0, 0)", &zero);
     say!("  attitude roll +0.5 rad/s for 0.4 s -> {rolled:+.2} rad, back -> {back:+.2} rad {}", lap());
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: attitude rates roll the body and back",
         result.is_ok() && result_back.is_ok() && rolled > 0.15 && back.abs() < 0.05,
         format!("roll {rolled:+.2} rad, then {back:+.2} rad"),
     ));
+    report.commanded.push("roll +0.5, -0.5 rad/s".into());
+    report.observed.push(format!("roll {rolled:+.2}, {back:+.2} rad"));
 
     // A trick: jump, back to standing.
     let tricks_before = sim.snapshot().dog.tricks_done();
@@ -190,11 +221,13 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         "  trick    jump -> airborne {airborne}, landed standing {landed}, action cleared after 6 datagrams {action_cleared} {}",
         lap()
     );
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: jumps and lands standing",
         result.is_ok() && airborne && landed && tricks == 1,
         format!("{tricks} trick done"),
     ));
+    report.commanded.push("jump".into());
+    report.observed.push(format!("{} and landed", if airborne { "airborne" } else { "not airborne" }));
 
     // Fault: a motor fault in the error word refuses calls with the robot's word.
     sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
@@ -205,14 +238,14 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     dog.wait_for_state(WAIT, |s| s.error_word.get() == 0).await;
     let code = refused.as_ref().err().map(CallError::return_code);
     say!("  fault    error word 0x3011 -> stand_up returns {code:?}; the stream forced passive {}", lap());
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: motor fault reported as the call's return code",
         code == Some(ReturnCode::MotorFault),
         format!("{code:?}"),
     ));
 
     // Fault: the dog falls silent while walking; the client stops the walk and reconnects.
-    stand(&dog, &mut calls, "stand_up").await?;
+    stand(dog, &mut calls, "stand_up").await?;
     let result = dog.move_velocity(0.4, 0.0, 0.0).await;
     calls.record("move(0.4, 0, 0)", &result);
     if let Err(e) = &result {
@@ -228,16 +261,27 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let latched_vx = dog.latched_command().await.vx.get();
     sim.clear_faults();
     let back = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Connected)).await.is_ok();
-    let stopped = settle(&dog).await;
+    let stopped = settle(dog).await;
     say!(
         "  fault    dog silent -> Disconnected after {:.0} ms, latched vx {latched_vx} m/s, reconnected {back}, dog stopped {stopped} {}",
         noticed.as_secs_f64() * 1e3,
         lap()
     );
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: silence noticed, walk stopped, reconnected",
         lost && latched_vx == 0.0 && back && stopped && noticed < watchdog + Duration::from_millis(500),
         format!("after {:.0} ms (watchdog {} ms)", noticed.as_secs_f64() * 1e3, watchdog.as_millis()),
+    ));
+
+    report.faults.push(InjectedFault::new(
+        "motor fault",
+        code == Some(ReturnCode::MotorFault),
+        code.map_or("call accepted".into(), |c| format!("{c:?} returned")),
+    ));
+    report.faults.push(InjectedFault::new(
+        "silence",
+        lost && back,
+        format!("lost at {:.0} ms, back", noticed.as_secs_f64() * 1e3),
     ));
 
     // Lie down.
@@ -245,45 +289,41 @@ async fn scenario(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     calls.record("lie_down", &result);
     let lying = dog.wait_for_state(WAIT, |s| s.position[2].get() < 0.12).await.is_some();
     say!("  lie      lie_down -> mode {:?} {}", dog.control_mode().unwrap_or(ControlMode::Passive), lap());
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "dog: lies down (mode 51, body low)",
         result.is_ok() && lying,
         format!("{:?}", dog.control_mode()),
     ));
+    report.commanded.push("lie_down".into());
+    report.observed.push(format!("{:?}", dog.control_mode().unwrap_or(ControlMode::Passive)));
 
     let stats = dog.stats();
     let snapshot = sim.snapshot();
     let [x, y, _] = snapshot.dog.position_m();
-    say!();
-    say!("  summary ({:.1} s)", started.elapsed().as_secs_f64());
-    say!("    calls     {}", calls.0.iter().map(|(n, c)| format!("{n} 0x{c:04x}")).collect::<Vec<_>>().join(", "));
+    say!("  calls    {}", calls.0.iter().map(|(n, c)| format!("{n} 0x{c:04x}")).collect::<Vec<_>>().join(", "));
     say!(
-        "    body      at ({x:+.2}, {y:+.2}) m, walked {:.2} m, battery {:.1} %, {} tricks",
+        "  body     at ({x:+.2}, {y:+.2}) m, walked {:.2} m, battery {:.1} %, {} tricks",
         snapshot.dog.distance_m(),
         snapshot.dog.battery_percent(),
         snapshot.dog.tricks_done()
     );
-    say!(
-        "    client    sent {} · states {} · decode errors {} · foreign dropped {} · disconnects {} reconnects {} · stream lateness p50 {} µs p99 {} µs",
-        stats.link.sent,
-        stats.states,
-        stats.link.decode_errors,
-        stats.link.foreign_dropped,
-        stats.disconnects,
-        stats.reconnects,
-        stats.stream_lateness.p50_us,
-        stats.stream_lateness.p99_us
-    );
-    say!(
-        "    simulator {} commands ({} invalid) · {} states sent",
-        snapshot.high_level.commands,
-        snapshot.high_level.invalid,
-        snapshot.high_level.states_sent
-    );
-    checks.push(Check::new(
+    let seconds = started.elapsed().as_secs_f64();
+    report.rates_hz =
+        vec![("commands sent", stats.link.sent as f64 / seconds), ("states in", stats.states as f64 / seconds)];
+    report.timings = vec![("stream lateness", stats.stream_lateness), ("state gap", stats.state_gap)];
+    report.counters = vec![
+        ("states", stats.states),
+        ("decode errors", stats.link.decode_errors),
+        ("short states", stats.short_states),
+        ("foreign dropped", stats.link.foreign_dropped),
+        ("disconnects", stats.disconnects),
+        ("dog commands", snapshot.high_level.commands),
+        ("dog invalid", snapshot.high_level.invalid),
+    ];
+    report.checks.push(Check::new(
         "dog: every command decoded strictly by the dog",
         snapshot.high_level.invalid == 0 && snapshot.high_level.commands > 0,
         format!("{} commands, {} invalid", snapshot.high_level.commands, snapshot.high_level.invalid),
     ));
-    Ok(checks)
+    Ok(report)
 }

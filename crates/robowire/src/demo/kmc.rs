@@ -6,9 +6,10 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use kmc::{ChassisFrame, Driver, DriverOptions};
 use kmc_proto::{HostFrame, PcControl};
+use robowire_core::timing::LatenessRing;
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 
-use super::Check;
+use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 
 /// Shortest motion phase: a 0.2 s first-order response settles within 2 % in 0.8 s.
 const MIN_PHASE: Duration = Duration::from_millis(800);
@@ -29,7 +30,7 @@ const PHASES: [Phase; 3] = [
     Phase { name: "reverse", velocity_mps: -0.3, yaw_rate_radps: 0.0 },
 ];
 
-pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
+pub(super) fn run(duration_s: f64) -> anyhow::Result<DeviceReport> {
     say!("== KMC chassis (UART on a pseudo-terminal) ==");
     let sim = ChassisSim::spawn(ChassisSimConfig::default()).context("starting the chassis simulator")?;
     let options = DriverOptions { poll_battery: true, poll_allstate: true, ..Default::default() };
@@ -39,11 +40,14 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         options.control_rate_hz,
         options.vehicle_speed_rate_hz
     );
+    let control_rate_hz = options.control_rate_hz;
     let mut driver = Driver::new(sim.path(), options)?;
     driver.start()?;
     let started = Instant::now();
     let phase_time = Duration::from_secs_f64(duration_s / PHASES.len() as f64).max(MIN_PHASE);
-    let mut checks = Vec::new();
+    let mut report = DeviceReport::new("kmc");
+    let mut progress = Progress::new("kmc");
+    let mut speed_reports = [0u64; PHASES.len()];
     let mut last_speed = 0.0f32;
     let mut battery_volts = None;
     let mut all_state_seen = [0u32; 2];
@@ -64,11 +68,23 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
             last_command_at = Instant::now();
             for frame in driver.messages_until((Instant::now() + COMMAND_REFRESH).min(end)) {
                 match frame {
-                    ChassisFrame::VehicleSpeed(v) => last_speed = v.speed_mps,
+                    ChassisFrame::VehicleSpeed(v) => {
+                        last_speed = v.speed_mps;
+                        speed_reports[i] += 1;
+                    }
                     ChassisFrame::BatteryVoltage(b) => battery_volts = Some(b.volts),
                     ChassisFrame::AllState(s) => all_state_seen[usize::from(s.motor_id.min(1))] += 1,
                     ChassisFrame::Af(_) => {}
                 }
+            }
+            if progress.due() {
+                let stats = driver.stats();
+                progress.show(&Status {
+                    mode: phase.name,
+                    motion: format!("{last_speed:+.3} m/s"),
+                    loop_count: stats.control_frames_sent,
+                    lateness_us: (stats.control_lateness.p99_us, "p99"),
+                });
             }
         }
         let state = sim.state();
@@ -83,14 +99,25 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         );
         // Settled: within 10 % of the step (plus 2 cm/s for the report's age).
         let tolerance = 0.1 * (phase.velocity_mps - speed_before).abs() + 0.02;
-        checks.push(Check::new(
+        report.commanded.push(format!(
+            "{} {:+.2} m/s{}",
+            phase.name,
+            phase.velocity_mps,
+            if phase.yaw_rate_radps == 0.0 { String::new() } else { format!(" {:+.2} rad/s", phase.yaw_rate_radps) }
+        ));
+        report.observed.push(format!(
+            "{} {last_speed:+.3} m/s{}",
+            phase.name,
+            if phase.yaw_rate_radps == 0.0 { String::new() } else { format!(" {turned:+.2} rad") }
+        ));
+        report.checks.push(Check::new(
             format!("{}: speed reaches {:+.2} m/s", phase.name, phase.velocity_mps),
             (last_speed - phase.velocity_mps).abs() <= tolerance,
             format!("{last_speed:+.3} m/s"),
         ));
         if phase.yaw_rate_radps != 0.0 {
             let expected = phase.yaw_rate_radps * phase_time.as_secs_f32();
-            checks.push(Check::new(
+            report.checks.push(Check::new(
                 format!("{}: heading turns by ~{expected:+.2} rad", phase.name),
                 turned > 0.5 * expected && turned < 1.2 * expected,
                 format!("{turned:+.3} rad"),
@@ -111,7 +138,7 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         timeout_stop.map_or("never".into(), |d| d.as_millis().to_string()),
         sim.state().commanded_velocity_mps
     );
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "timeout: (0, 0) streamed ~300 ms after the last command",
         timeouts == 1
             && timeout_stop.is_some_and(|d| d >= Duration::from_millis(300) && d <= Duration::from_millis(340)),
@@ -131,12 +158,12 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let burst = after_stop.iter().rev().take_while(|r| r.frame == HostFrame::PcControl(PcControl::STOP)).count();
     let stats = driver.stats();
     say!("  stop     driver.stop() -> {} × (0, 0) at the end of the stream", burst);
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "stop: burst of 3 × (0, 0)",
         stats.stop_frames_sent == 3 && burst >= 3,
         format!("{burst} stop frames"),
     ));
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         "battery and all-state polls answered",
         battery_volts.is_some() && all_state_seen.iter().all(|&n| n > 0),
         format!(
@@ -146,56 +173,70 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
             all_state_seen[1]
         ),
     ));
-    checks.push(Check::new(
+    report.checks.push(Check::new(
         format!("line noise: {GARBAGE_BYTES} garbage bytes skipped by the decoder"),
         stats.link.decoder.skipped_bytes == GARBAGE_BYTES as u64,
         format!("skipped {} rejected {}", stats.link.decoder.skipped_bytes, stats.link.decoder.rejected_candidates),
     ));
 
-    // Rates and jitter as the chassis saw them.
-    let arrivals: Vec<Instant> =
-        received.iter().filter(|r| matches!(r.frame, HostFrame::PcControl(_))).map(|r| r.at).collect();
+    // Rates and jitter as the chassis saw them: |interval between 0xA5 frames − period|.
+    // The stop burst is sent back to back by design: the stream is measured up to it.
+    let arrivals: Vec<Instant> = received
+        .iter()
+        .take(before_stop)
+        .filter(|r| matches!(r.frame, HostFrame::PcControl(_)))
+        .map(|r| r.at)
+        .collect();
     let rate = arrivals.len().saturating_sub(1) as f64
         / arrivals.last().zip(arrivals.first()).map_or(1.0, |(l, f)| (*l - *f).as_secs_f64().max(1e-9));
-    let mut intervals_us: Vec<u64> = arrivals.windows(2).map(|w| (w[1] - w[0]).as_micros() as u64).collect();
-    intervals_us.sort_unstable();
-    let pct =
-        |p: usize| intervals_us.get((p * intervals_us.len()).div_ceil(100).saturating_sub(1)).copied().unwrap_or(0);
+    let period_us = 1e6 / control_rate_hz;
+    let mut jitter: LatenessRing<4096> = LatenessRing::new();
+    for w in arrivals.windows(2) {
+        jitter.record(((w[1] - w[0]).as_micros() as f64 - period_us).abs() as u32);
+    }
     let sim_stats = sim.stats();
-    say!();
-    say!("  summary ({:.1} s)", elapsed.as_secs_f64());
-    say!(
-        "    sent      control {} (+{} stop) · speed requests {} · battery {} · all-state {}",
-        stats.control_frames_sent,
-        stats.stop_frames_sent,
-        stats.speed_requests_sent,
-        stats.battery_requests_sent,
-        stats.all_state_requests_sent
-    );
-    say!(
-        "    received  {} frames ({} bytes) · chassis answered {}, dropped {} (injected)",
-        stats.frames_received,
-        stats.link.bytes_read,
-        sim_stats.responses_sent,
-        sim_stats.responses_dropped
-    );
-    say!(
-        "    0xA5 at the chassis: {rate:.1} Hz, interval p50 {:.2} ms p99 {:.2} ms · send lateness p50 {} µs p99 {} µs max {} µs",
-        pct(50) as f64 / 1e3,
-        pct(99) as f64 / 1e3,
-        stats.control_lateness.p50_us,
-        stats.control_lateness.p99_us,
-        stats.control_lateness.max_us
-    );
-    say!(
-        "    decoders  host: frames {} skipped {} rejected {} · chassis: frames {} skipped {} rejected {}",
-        stats.link.decoder.frames,
-        stats.link.decoder.skipped_bytes,
-        stats.link.decoder.rejected_candidates,
-        sim_stats.decoder.frames,
-        sim_stats.decoder.skipped_bytes,
-        sim_stats.decoder.rejected_candidates
-    );
-    checks.push(Check::new("control stream at ~100 Hz", (90.0..=110.0).contains(&rate), format!("{rate:.1} Hz")));
-    Ok(checks)
+    report.checks.push(Check::new(
+        "control stream at ~100 Hz",
+        (90.0..=110.0).contains(&rate),
+        format!("{rate:.1} Hz"),
+    ));
+
+    report.commanded.push("silence 600 ms, then stop()".into());
+    report.observed.push(format!(
+        "(0, 0) after {} ms, {burst} × stop",
+        timeout_stop.map_or("never".into(), |d| d.as_millis().to_string())
+    ));
+    let seconds = elapsed.as_secs_f64();
+    report.rates_hz = vec![
+        ("0xA5 at chassis", rate),
+        ("speed reports", speed_reports.iter().sum::<u64>() as f64 / (phase_time.as_secs_f64() * PHASES.len() as f64)),
+        ("frames in", stats.frames_received as f64 / seconds),
+    ];
+    report.timings = vec![("send lateness", stats.control_lateness), ("0xA5 jitter", jitter.summary())];
+    report.counters = vec![
+        ("host frames", stats.link.decoder.frames),
+        ("host skipped B", stats.link.decoder.skipped_bytes),
+        ("host rejected", stats.link.decoder.rejected_candidates),
+        ("chassis frames", sim_stats.decoder.frames),
+        ("chassis skipped B", sim_stats.decoder.skipped_bytes),
+        ("queue dropped", stats.queue_dropped),
+    ];
+    report.faults = vec![
+        InjectedFault::new(
+            format!("noise {GARBAGE_BYTES} B"),
+            stats.link.decoder.skipped_bytes == GARBAGE_BYTES as u64,
+            format!("skipped {} B", stats.link.decoder.skipped_bytes),
+        ),
+        InjectedFault::new(
+            format!("{} reply lost", sim_stats.responses_dropped),
+            speed_reports[1] > 0,
+            format!("next used ({})", speed_reports[1]),
+        ),
+        InjectedFault::new(
+            "stale command",
+            timeouts == 1 && timeout_stop.is_some(),
+            format!("(0, 0) at {} ms", timeout_stop.unwrap_or_default().as_millis()),
+        ),
+    ];
+    Ok(report)
 }

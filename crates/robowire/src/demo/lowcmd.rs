@@ -9,18 +9,20 @@ use std::time::{Duration, Instant};
 use lowcmd_proto::{CdrEncoding, DecodeError, LowCmd, LowState, Message, MotorCmd};
 use robowire_core::timing::LatenessRing;
 
-use super::Check;
+use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 
 const PERIOD: Duration = Duration::from_millis(2);
 const STAND_RAD: [f32; 3] = [0.0, 0.67, -1.3];
 
-pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
+pub(super) fn run(duration_s: f64) -> anyhow::Result<DeviceReport> {
     say!("== Unitree LowCmd / LowState (encode, CDR, decode, verify at 500 Hz) ==");
     let run_for = Duration::from_secs_f64(duration_s.max(1.0));
     let mut lateness: LatenessRing<4096> = LatenessRing::new();
     let mut work: LatenessRing<4096> = LatenessRing::new();
     let (mut cycles, mut mismatches, mut corrupted, mut caught) = (0u64, 0u64, 0u64, 0u64);
     let mut cdr = [0u8; 1200];
+    let mut progress = Progress::new("lowcmd");
+    let mut window_late_us = 0u32;
     let start = Instant::now();
     let mut next = start + PERIOD;
     while start.elapsed() < run_for {
@@ -29,7 +31,9 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
             std::thread::sleep(next - now);
         }
         let woke = Instant::now();
-        lateness.record(u32::try_from(woke.saturating_duration_since(next).as_micros()).unwrap_or(u32::MAX));
+        let late_us = u32::try_from(woke.saturating_duration_since(next).as_micros()).unwrap_or(u32::MAX);
+        lateness.record(late_us);
+        window_late_us = window_late_us.max(late_us);
         next += PERIOD;
 
         // The controller: a slow sway of the calves around the stand pose.
@@ -71,6 +75,14 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
         }
         work.record(u32::try_from(woke.elapsed().as_micros()).unwrap_or(u32::MAX));
         cycles += 1;
+        if progress.due() {
+            progress.show(&Status {
+                mode: "servo sway",
+                motion: format!("calf {:+.3} rad", cmd.motor_cmd[2].q),
+                loop_count: cycles,
+                lateness_us: (std::mem::take(&mut window_late_us), "max"),
+            });
+        }
     }
     let elapsed = start.elapsed().as_secs_f64();
     let rate_hz = cycles as f64 / elapsed;
@@ -84,7 +96,23 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     );
     say!("  verify   {} round trips (image + XCDR1 + LowState), {mismatches} mismatches", cycles);
     say!("  fault    {corrupted} images with a flipped bit, {caught} caught by the CRC");
-    Ok(vec![
+    let mut report = DeviceReport::new("lowcmd");
+    report.commanded = vec!["12 motors, sway ±0.1 rad".into(), "image, XCDR1, LowState".into()];
+    report.observed = vec![format!("{cycles} round trips"), format!("{mismatches} mismatches")];
+    report.rates_hz = vec![("loop", rate_hz)];
+    report.timings = vec![("lateness", late), ("work per cycle", busy)];
+    report.counters = vec![
+        ("images decoded", 2 * cycles + corrupted),
+        ("CDR decoded", cycles),
+        ("mismatches", mismatches),
+        ("CRC rejects", caught),
+    ];
+    report.faults = vec![InjectedFault::new(
+        format!("{corrupted} bit flips"),
+        corrupted > 0 && caught == corrupted,
+        format!("{caught} caught"),
+    )];
+    report.checks = vec![
         Check::new(
             "lowcmd: 500 Hz encode/decode/verify loop",
             (rate_hz - 500.0).abs() < 25.0 && mismatches == 0,
@@ -95,5 +123,6 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
             corrupted > 0 && caught == corrupted,
             format!("{caught} of {corrupted}"),
         ),
-    ])
+    ];
+    Ok(report)
 }

@@ -6,23 +6,35 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// With `--json`, the human-readable report goes to stderr and stdout carries only the JSON.
 static JSON: AtomicBool = AtomicBool::new(false);
 
-/// `println!` for the demo's report: stdout, or stderr under `--json`.
+fn json() -> bool {
+    JSON.load(Ordering::Relaxed)
+}
+
+/// `println!` for the demo's report: stdout, or stderr under `--json`; clears the live
+/// progress line first.
 macro_rules! say {
-    ($($arg:tt)*) => {
-        if $crate::demo::JSON.load(std::sync::atomic::Ordering::Relaxed) {
+    ($($arg:tt)*) => {{
+        $crate::demo::progress::clear();
+        if $crate::demo::json() {
             eprintln!($($arg)*)
         } else {
             println!($($arg)*)
         }
-    };
+    }};
 }
 
 mod dog;
 mod kmc;
 mod lowcmd;
+mod progress;
+mod report;
 mod spline;
 
+pub(crate) use progress::{Progress, Status};
+pub(crate) use report::{Check, DeviceReport, InjectedFault};
+
 use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 
@@ -52,19 +64,8 @@ enum Device {
     Lowcmd,
 }
 
-/// One thing a scenario commanded and whether it was observed.
-#[derive(Debug)]
-pub(crate) struct Check {
-    pub(crate) what: String,
-    pub(crate) passed: bool,
-    pub(crate) observed: String,
-}
-
-impl Check {
-    pub(crate) fn new(what: impl Into<String>, passed: bool, observed: impl Into<String>) -> Self {
-        Self { what: what.into(), passed, observed: observed.into() }
-    }
-}
+/// A device's scenario: runs for about the given seconds of motion, reports what it saw.
+type Scenario = fn(f64) -> anyhow::Result<DeviceReport>;
 
 pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
@@ -73,42 +74,43 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
         args.duration
     );
     JSON.store(args.json, Ordering::Relaxed);
-    let mut checks = Vec::new();
-    if args.only.is_none_or(|d| d == Device::Kmc) {
-        checks.extend(kmc::run(args.duration)?);
-    }
-    if args.only.is_none_or(|d| d == Device::Dog) {
-        say!();
-        checks.extend(dog::run(args.duration)?);
-    }
-    if args.only.is_none_or(|d| d == Device::Spline) {
-        say!();
-        checks.extend(spline::run(args.duration)?);
-    }
-    if args.only.is_none_or(|d| d == Device::Lowcmd) {
-        say!();
-        checks.extend(lowcmd::run(args.duration)?);
+    let scenarios: [(Device, Scenario); 4] = [
+        (Device::Kmc, kmc::run),
+        (Device::Dog, dog::run),
+        (Device::Spline, spline::run),
+        (Device::Lowcmd, lowcmd::run),
+    ];
+    let mut reports = Vec::new();
+    for (device, scenario) in scenarios {
+        if args.only.is_none_or(|d| d == device) {
+            if !reports.is_empty() {
+                say!();
+            }
+            let started = Instant::now();
+            let mut report = scenario(args.duration)?;
+            report.elapsed = started.elapsed();
+            reports.push(report);
+        }
     }
     say!();
     say!("checks");
-    for check in &checks {
+    for check in reports.iter().flat_map(|r| &r.checks) {
         say!("  [{}] {:<52} {}", if check.passed { " ok " } else { "FAIL" }, check.what, check.observed);
     }
-    let failed = checks.iter().filter(|c| !c.passed).count();
+    say!();
+    say!("summary");
+    say!("{}", report::table(&reports).trim_end());
     if args.json {
-        let checks: Vec<_> = checks
-            .iter()
-            .map(|c| serde_json::json!({"check": c.what, "passed": c.passed, "observed": c.observed}))
-            .collect();
-        let report = serde_json::json!({"passed": failed == 0, "failed": failed, "checks": checks});
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", serde_json::to_string_pretty(&report::json(&reports))?);
     }
+    let total = reports.iter().map(|r| r.checks.len()).sum::<usize>();
+    let failed = reports.iter().flat_map(|r| &r.checks).filter(|c| !c.passed).count();
     say!();
     if failed == 0 {
-        say!("demo passed: {} checks", checks.len());
+        say!("demo passed: {total} checks");
         Ok(ExitCode::SUCCESS)
     } else {
-        say!("demo FAILED: {failed} of {} checks", checks.len());
+        say!("demo FAILED: {failed} of {total} checks");
         Ok(ExitCode::FAILURE)
     }
 }

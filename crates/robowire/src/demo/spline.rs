@@ -9,7 +9,7 @@ use robowire_sim::spline::{LYING_POSE_RAD, STANDING_POSE_RAD, SplineSim, SplineS
 use zsl::spline::{ImuReader, SplineError};
 use zsl::{JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock};
 
-use super::Check;
+use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 
 const KP: f32 = 60.0;
 const KD: f32 = 2.0;
@@ -31,7 +31,7 @@ fn command(pose: [f32; 3]) -> SplineCommandBlock {
     cmd
 }
 
-pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
+pub(super) fn run(duration_s: f64) -> anyhow::Result<DeviceReport> {
     say!("== ZSL-1 low level (spline daemon on shared memory, 1 kHz) ==");
     let sim = SplineSim::spawn(SplineSimConfig::private("demo")).context("starting the spline daemon simulator")?;
     let names = sim.config().clone();
@@ -50,25 +50,37 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
     let daemon_before = sim.stats().daemon;
     // The loop runs on the daemon's clock: each fresh state triggers the next command.
     let mut phase_printed = false;
+    let mut progress = Progress::new("spline");
+    let mut window_jitter_us = 0u32;
     while start.elapsed() < move_time + hold_time {
-        match client.wait_state(Duration::from_millis(5)) {
-            Ok(_) => {}
+        let knee_rad = match client.wait_state(Duration::from_millis(5)) {
+            Ok(state) => state.joint(Leg::FrontRight, JointIndex::Knee).p.get(),
             Err(SplineError::Timeout { .. }) => {
                 timeouts += 1;
                 continue;
             }
             Err(e) => return Err(e).context("the daemon stopped answering during the PD loop"),
-        }
+        };
         let now = Instant::now();
         if let Some(last) = last_write {
             let interval_us = (now - last).as_micros() as i64;
-            jitter.record(u32::try_from((interval_us - 1000).unsigned_abs()).unwrap_or(u32::MAX));
+            let jitter_us = u32::try_from((interval_us - 1000).unsigned_abs()).unwrap_or(u32::MAX);
+            jitter.record(jitter_us);
+            window_jitter_us = window_jitter_us.max(jitter_us);
         }
         last_write = Some(now);
         let elapsed = start.elapsed();
         let fraction = elapsed.as_secs_f32() / move_time.as_secs_f32();
         client.write_command(&command(pose_at(fraction)))?;
         cycles += 1;
+        if progress.due() {
+            progress.show(&Status {
+                mode: if elapsed < move_time { "stand-up" } else { "hold" },
+                motion: format!("knee {knee_rad:+.3} rad"),
+                loop_count: cycles,
+                lateness_us: (std::mem::take(&mut window_jitter_us), "max"),
+            });
+        }
         if !phase_printed && elapsed >= move_time {
             say!(
                 "  move     lying {LYING_POSE_RAD:?} -> stand {STANDING_POSE_RAD:?} rad over {:.1} s",
@@ -110,31 +122,38 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
 
     let loop_jitter = jitter.summary();
     let sim_stats = sim.stats();
-    say!();
-    say!("  summary ({:.1} s)", start.elapsed().as_secs_f64());
+    let elapsed = start.elapsed().as_secs_f64();
     say!(
-        "    client    {cycles} cycles, {} commands, {} states, {timeouts} timeouts · loop jitter |interval − 1 ms| p50 {} µs p99 {} µs",
-        client.counters().commands_written,
-        client.counters().states_read,
-        loop_jitter.p50_us,
-        loop_jitter.p99_us
-    );
-    say!(
-        "    daemon    {} cycles, {} missed deadlines · lateness p50 {} µs p99 {} µs max {} µs · during the loop: {fresh} fresh commands, {repeated} repeated",
-        sim_stats.cycles,
-        sim_stats.missed_cycles,
-        sim_stats.lateness.p50_us,
-        sim_stats.lateness.p99_us,
-        sim_stats.lateness.max_us
-    );
-    say!(
-        "    IMU       {} samples, latest age {}",
+        "  IMU      {} samples, latest age {}",
         sim_stats.imu_samples,
         imu_age.map_or("-".into(), |a| format!("{:.2} ms", a.as_secs_f64() * 1e3))
     );
 
     let total = (move_time + hold_time).as_millis() as u64;
-    Ok(vec![
+    let mut report = DeviceReport::new("spline");
+    report.commanded = vec![
+        format!("12 joints up, {:.1} s", move_time.as_secs_f64()),
+        format!("hold {:.1} s, kp {KP} kd {KD}", hold_time.as_secs_f64()),
+    ];
+    report.observed = vec![format!("max error {worst:.4} rad"), format!("{fresh} fresh, {repeated} repeated")];
+    report.rates_hz = vec![
+        ("PD loop", cycles as f64 / (move_time + hold_time).as_secs_f64()),
+        ("daemon", sim_stats.cycles as f64 / elapsed),
+        ("IMU", sim_stats.imu_samples as f64 / elapsed),
+    ];
+    report.timings = vec![("loop jitter", loop_jitter), ("daemon lateness", sim_stats.lateness)];
+    report.counters = vec![
+        ("commands", client.counters().commands_written),
+        ("states", client.counters().states_read),
+        ("wait timeouts", timeouts),
+        ("daemon missed", sim_stats.missed_cycles),
+    ];
+    report.faults = vec![InjectedFault::new(
+        "hang 30 ms",
+        noticed.is_some() && recovered,
+        format!("stall at {:.1} ms", noticed.unwrap_or_default().as_secs_f64() * 1e3),
+    )];
+    report.checks = vec![
         Check::new("low level: legs reach the stand pose", worst < 0.02, format!("largest error {worst:.4} rad")),
         Check::new(
             "low level: a fresh command nearly every daemon cycle",
@@ -146,5 +165,6 @@ pub(super) fn run(duration_s: f64) -> anyhow::Result<Vec<Check>> {
             noticed.is_some_and(|d| d <= Duration::from_millis(25)) && recovered,
             format!("after {:.1} ms", noticed.unwrap_or_default().as_secs_f64() * 1e3),
         ),
-    ])
+    ];
+    Ok(report)
 }

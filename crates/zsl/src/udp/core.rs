@@ -192,6 +192,9 @@ pub struct ClientStats {
     pub reconnects: u64,
     /// Lateness of the 2 ms stream against its absolute deadlines.
     pub stream_lateness: LatenessSummary,
+    /// Time between consecutive accepted state datagrams, µs (the robot sends every 2 ms; the
+    /// maximum shows how close the link came to the watchdog).
+    pub state_gap: LatenessSummary,
 }
 
 #[derive(Debug, Default)]
@@ -241,6 +244,8 @@ pub(super) struct Core<P: Profile> {
     connection: watch::Sender<Connection>,
     counters: StateCounters,
     lateness: Mutex<LatenessRing<1024>>,
+    /// When the last state was accepted, and the gaps between states.
+    state_gaps: Mutex<(Option<Instant>, LatenessRing<1024>)>,
     link: StatsHandle,
     local: SocketAddr,
     pub(super) options: ClientOptions,
@@ -279,6 +284,7 @@ impl<P: Profile> Client<P> {
             connection: watch::Sender::new(Connection::Waiting),
             counters: StateCounters::default(),
             lateness: Mutex::new(LatenessRing::new()),
+            state_gaps: Mutex::new((None, LatenessRing::new())),
             link: stats,
             local,
             options,
@@ -348,6 +354,7 @@ impl<P: Profile> Core<P> {
             disconnects: c.disconnects.load(Ordering::Relaxed),
             reconnects: c.reconnects.load(Ordering::Relaxed),
             stream_lateness: self.lateness.lock().map(|r| r.summary()).unwrap_or_default(),
+            state_gap: self.state_gaps.lock().map(|g| g.1.summary()).unwrap_or_default(),
         }
     }
 
@@ -423,6 +430,12 @@ async fn receive<P: Profile>(core: Arc<Core<P>>, mut receiver: UdpReceiver<Codec
 fn on_state<P: Profile>(core: &Core<P>, received: &StateReceived<P::State>) {
     let c = &core.counters;
     bump(&c.states);
+    if let Ok(mut gaps) = core.state_gaps.lock() {
+        let now = Instant::now();
+        if let Some(last) = gaps.0.replace(now) {
+            gaps.1.record(u32::try_from((now - last).as_micros()).unwrap_or(u32::MAX));
+        }
+    }
     if received.update.short {
         bump(&c.short_states);
     }
