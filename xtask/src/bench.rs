@@ -12,8 +12,9 @@ use serde_json::Value;
 use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
+/// The latency and loop-jitter programs among them write their figures to `bench-meta-*.json`.
 const BENCHES: &[(&str, &str)] =
-    &[("kmc-proto", "codec"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline"), ("zsl", "udp")];
+    &[("kmc-proto", "codec"), ("kmc", "serial"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline"), ("zsl", "udp")];
 
 /// One row of the table.
 #[derive(Debug, Serialize)]
@@ -52,6 +53,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let meta_path = target.join("bench-meta.json");
     let spline_meta_path = target.join("bench-meta-spline.json");
     let udp_meta_path = target.join("bench-meta-zsl-udp.json");
+    let kmc_meta_path = target.join("bench-meta-kmc.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -64,6 +66,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META", &meta_path)
             .env("ROBOWIRE_BENCH_META_SPLINE", &spline_meta_path)
             .env("ROBOWIRE_BENCH_META_ZSL_UDP", &udp_meta_path)
+            .env("ROBOWIRE_BENCH_META_KMC", &kmc_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -105,6 +108,9 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
         });
     }
 
+    let kmc: Value = serde_json::from_str(&std::fs::read_to_string(&kmc_meta_path).context("KMC bench metadata")?)?;
+    rows.extend(kmc_serial_rows(&kmc)?);
+
     rows.extend(lowcmd_rows(&criterion)?);
     let spline: Value =
         serde_json::from_str(&std::fs::read_to_string(&spline_meta_path).context("spline bench metadata")?)?;
@@ -118,6 +124,50 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     std::fs::write(target.join("bench-report.md"), &markdown)?;
     std::fs::write(target.join("bench-report.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
     println!("written: {} and bench-report.json", target.join("bench-report.md").display());
+    Ok(rows)
+}
+
+/// Rows of the KMC serial bench: request → response on a pty, the Driver's 100 Hz stream.
+fn kmc_serial_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let us = |key: &str| meta[key].as_f64().map(|ns| ns / 1e3).with_context(|| format!("kmc meta {key}"));
+    let mut rows = Vec::new();
+    for pct in ["p50", "p99"] {
+        let (trip, raw) = (us(&format!("round_trip_{pct}_ns"))?, us(&format!("raw_echo_{pct}_ns"))?);
+        rows.push(Row {
+            path: format!("KMC 0xB3 request → speed frame via UartClient and the simulator (pty), {pct}"),
+            figure: format!("{trip:.1} µs"),
+            baseline: format!("raw pty echo (1 B out, 5 B back): {raw:.1} µs"),
+            ratio: format!("{:.2}×", trip / raw),
+            target: "–".into(),
+            met: None,
+        });
+    }
+    let summary = |key: &str| -> anyhow::Result<(u64, u64, u64)> {
+        let s = &meta[key];
+        let field = |f: &str| s[f].as_u64().with_context(|| format!("kmc meta {key}.{f}"));
+        Ok((field("p50_us")?, field("p99_us")?, field("max_us")?))
+    };
+    let seconds = meta["stream_seconds"].as_f64().context("kmc meta stream_seconds")?;
+    let (l50, l99, lmax) = summary("stream_lateness")?;
+    let (b50, b99, bmax) = summary("sleep_loop_lateness")?;
+    rows.push(Row {
+        path: format!("KMC Driver 0xA5 stream send lateness over {seconds:.0} s"),
+        figure: format!("p50 {l50} µs, p99 {l99} µs, max {lmax} µs"),
+        baseline: format!("bare thread sleeping to the same deadlines: p50 {b50} µs, p99 {b99} µs, max {bmax} µs"),
+        ratio: format!("{:.2}× (p99)", l99 as f64 / b99.max(1) as f64),
+        target: "–".into(),
+        met: None,
+    });
+    let rate_hz = meta["stream_rate_hz"].as_f64().context("kmc meta stream_rate_hz")?;
+    let (j50, j99, jmax) = summary("stream_jitter_at_chassis")?;
+    rows.push(Row {
+        path: "KMC 0xA5 stream at the chassis: rate, |interval − 10 ms|".into(),
+        figure: format!("{rate_hz:.1} Hz; p50 {j50} µs, p99 {j99} µs, max {jmax} µs"),
+        baseline: "period 10 ms".into(),
+        ratio: format!("{:.1} % of the period (p99)", j99 as f64 / 100.0),
+        target: "~100 Hz".into(),
+        met: Some((99.0..=101.0).contains(&rate_hz)),
+    });
     Ok(rows)
 }
 

@@ -21,10 +21,11 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 
-mod common;
-use common::{percentiles, time_each};
+#[path = "../../../benches/timing.rs"]
+mod timing;
 use robowire_shm::{CreateOptions, MappedRegion, SharedRegion};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use timing::{percentiles, time_each};
 use zsl::{
     CommandUpdate, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineDaemon, SplineStateBlock,
 };

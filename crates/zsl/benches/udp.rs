@@ -25,8 +25,9 @@ use robowire_sim::dog::{DogSim, DogSimConfig};
 use zsl::udp::{ClientOptions, ControlMode, HighLevel, HighLevelState, LowLevelCommand, LowLevelState, MotorCommand};
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, MAGIC_ZSL1, Model};
 
-mod common;
-use common::percentiles;
+#[path = "../../../benches/timing.rs"]
+mod timing;
+use timing::{percentiles, pin};
 
 fn codec(criterion: &mut Criterion) {
     let mut group = criterion.benchmark_group("zsl_udp_codec");
@@ -66,12 +67,6 @@ fn codec(criterion: &mut Criterion) {
 /// shared, ~40 µs apart) and the comparison would measure the scheduler's luck.
 const CLIENT_CPU: usize = 0;
 const PEER_CPU: usize = 1;
-
-fn pin(cpu: usize) {
-    let mut set = rustix::thread::CpuSet::new();
-    set.set(cpu);
-    rustix::thread::sched_setaffinity(None, &set).expect("pinning a bench thread (needs 2 CPUs)");
-}
 
 /// The baseline: 40 bytes out, 560 back, through an echo thread on plain blocking sockets.
 struct RawEcho {
