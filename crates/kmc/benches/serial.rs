@@ -125,11 +125,15 @@ fn driver_stream(seconds: f64) -> (LatenessSummary, LatenessSummary, f64) {
         for _frame in driver.messages_until(Instant::now() + Duration::from_millis(50)) {}
     }
     let stats = driver.stats();
+    // The stop burst at the end is back to back by design: the stream is measured up to it.
+    let stopping_at = Instant::now();
     driver.stop().unwrap();
-    let arrivals: Vec<Instant> =
-        sim.received().iter().filter(|r| matches!(r.frame, HostFrame::PcControl(_))).map(|r| r.at).collect();
-    // The stop burst at the end is back to back by design.
-    let stream = &arrivals[..arrivals.len().saturating_sub(stats.stop_frames_sent as usize)];
+    let stream: Vec<Instant> = sim
+        .received()
+        .iter()
+        .filter(|r| matches!(r.frame, HostFrame::PcControl(_)) && r.at < stopping_at)
+        .map(|r| r.at)
+        .collect();
     let mut jitter: LatenessRing<16384> = LatenessRing::new();
     for w in stream.windows(2) {
         jitter.record(((w[1] - w[0]).as_micros() as f64 - period_us).abs() as u32);
