@@ -1,5 +1,4 @@
-//! `robowire`: run the demo on the built-in simulators, run a simulator alone, talk to a real
-//! device, or decode frames.
+#![doc = include_str!("../README.md")]
 
 mod decode;
 mod demo;

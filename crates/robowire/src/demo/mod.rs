@@ -47,7 +47,8 @@ pub(crate) struct DemoArgs {
     /// Run one device's scenario only.
     #[arg(long, value_enum)]
     only: Option<Device>,
-    /// Print the checks as JSON on stdout (the report goes to stderr).
+    /// Print the checks and every device's figures as JSON on stdout (the report goes to
+    /// stderr).
     #[arg(long)]
     json: bool,
 }
