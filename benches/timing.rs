@@ -31,9 +31,7 @@ pub(crate) fn percentiles(mut samples: Vec<u64>) -> (u64, u64) {
 /// share a vCPU decides a loopback round trip on a VM and a comparison would measure the
 /// scheduler's luck.
 pub(crate) fn pin(cpu: usize) {
-    let mut set = rustix::thread::CpuSet::new();
-    set.set(cpu);
-    rustix::thread::sched_setaffinity(None, &set).expect("pinning a bench thread (needs 2 CPUs)");
+    robowire_rt::pin_current_thread(cpu).expect("pinning a bench thread (needs 2 CPUs)");
 }
 
 /// Runs `f` on a new thread pinned to `cpu` and returns its result; threads `f` spawns (a

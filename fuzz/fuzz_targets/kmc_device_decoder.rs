@@ -4,4 +4,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| kmc_proto::harness::host_frame_stream(data));
+fuzz_target!(|data: &[u8]| kmc_proto::stream_consistency::host_frame_stream(data));

@@ -4,4 +4,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| zsl_proto::harness::datagram_decode(data));
+fuzz_target!(|data: &[u8]| zsl_proto::decode_roundtrip::datagram_decode(data));

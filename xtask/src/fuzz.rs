@@ -27,20 +27,24 @@ pub const TARGETS: &[Target] = &[
     Target {
         name: "kmc_host_decoder",
         seeds: || kmc_seeds("chassis->host"),
-        check: kmc_proto::harness::chassis_frame_stream,
+        check: kmc_proto::stream_consistency::chassis_frame_stream,
     },
     Target {
         name: "kmc_device_decoder",
         seeds: || kmc_seeds("host->chassis"),
-        check: kmc_proto::harness::host_frame_stream,
+        check: kmc_proto::stream_consistency::host_frame_stream,
     },
     Target {
         name: "lowcmd_image_decode",
         seeds: || unitree_seeds("packed_hex"),
-        check: lowcmd_proto::harness::image_decode,
+        check: lowcmd_proto::decode_roundtrip::image_decode,
     },
-    Target { name: "lowcmd_cdr_decode", seeds: || unitree_seeds("cdr_hex"), check: lowcmd_proto::harness::cdr_decode },
-    Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::harness::datagram_decode },
+    Target {
+        name: "lowcmd_cdr_decode",
+        seeds: || unitree_seeds("cdr_hex"),
+        check: lowcmd_proto::decode_roundtrip::cdr_decode,
+    },
+    Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::decode_roundtrip::datagram_decode },
 ];
 
 /// ZSL-1 seeds: every captured datagram.
@@ -124,7 +128,7 @@ fn has_nightly() -> bool {
 /// Writes the seeds and runs each selected target for `seconds`.
 ///
 /// With a nightly toolchain the targets run under AddressSanitizer; with stable only, with
-/// `-s none` (no sanitizer; the checks in the harness still run).
+/// `-s none` (no sanitizer; the property checks still run).
 pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
     let root = workspace_root();
     let fuzz_dir = root.join("fuzz");

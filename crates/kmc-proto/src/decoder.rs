@@ -37,6 +37,14 @@ fn decode_with<F>(
     DecodeStep::need_more(i)
 }
 
+/// A speed plausibility bound that is not finite and positive.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("a speed bound must be finite and positive, got {bound_mps} m/s")]
+pub struct InvalidSpeedBound {
+    /// The bound given.
+    pub bound_mps: f32,
+}
+
 /// Host-side decoder (spec §6.2): finds [`ChassisFrame`]s in the bytes the chassis sends.
 ///
 /// ```
@@ -71,13 +79,19 @@ impl ChassisFrameDecoder {
     }
 
     /// Sets the plausibility bound: a `0xB3` response with |speed| at or above it is rejected.
-    /// A non-finite or non-positive bound is ignored and the default kept.
-    #[must_use]
-    pub fn with_max_speed_mps(mut self, bound_mps: f32) -> Self {
-        if bound_mps.is_finite() && bound_mps > 0.0 {
-            self.max_speed_mps = bound_mps;
+    /// The bound must be finite and positive.
+    ///
+    /// ```
+    /// # use kmc_proto::ChassisFrameDecoder;
+    /// assert_eq!(ChassisFrameDecoder::new().with_max_speed_mps(5.0).unwrap().max_speed_mps(), 5.0);
+    /// assert!(ChassisFrameDecoder::new().with_max_speed_mps(f32::NAN).is_err());
+    /// ```
+    pub fn with_max_speed_mps(mut self, bound_mps: f32) -> Result<Self, InvalidSpeedBound> {
+        if !(bound_mps.is_finite() && bound_mps > 0.0) {
+            return Err(InvalidSpeedBound { bound_mps });
         }
-        self
+        self.max_speed_mps = bound_mps;
+        Ok(self)
     }
 
     /// The speed bound in force, m/s.

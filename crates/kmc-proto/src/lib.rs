@@ -7,14 +7,15 @@ mod control;
 mod decoder;
 mod error;
 mod frame;
-#[doc(hidden)]
-pub mod harness;
 #[cfg(feature = "serde")]
 mod serde_impl;
+#[cfg(feature = "fuzzing")]
+#[doc(hidden)]
+pub mod stream_consistency;
 
 pub use af::{AfFrame, AfRequest, AfResponse, AllState, BatteryVoltage, ParamId, Rw};
 pub use control::{CURVATURE_VELOCITY_THRESHOLD_MPS, PcControl, VehicleSpeed, VehicleSpeedRequest};
-pub use decoder::{ChassisFrameDecoder, HostFrameDecoder};
+pub use decoder::{ChassisFrameDecoder, HostFrameDecoder, InvalidSpeedBound};
 pub use error::{DecodeError, EncodeError};
 pub use frame::{ChassisFrame, HostFrame};
 pub use robowire_core::{BufferTooSmall, DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};

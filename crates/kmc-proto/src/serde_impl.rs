@@ -1,26 +1,11 @@
 //! JSON shapes of frames (feature `serde`): the golden fixtures' `fields` objects and
-//! `robowire decode kmc --json`. Field names are the spec's; non-finite floats are the strings
-//! `"NaN"`, `"-NaN"`, `"Infinity"`, `"-Infinity"`.
+//! `robowire decode kmc --json`. Field names are the spec's; floats in robowire-core's one JSON
+//! form (non-finite ones as the strings `"NaN"`, `"-NaN"`, `"Infinity"`, `"-Infinity"`).
 
+use robowire_core::serde_f32::F32;
 use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
 
 use crate::{AfFrame, AllState, ChassisFrame, HostFrame, Rw};
-
-/// An f32 as a JSON number (shortest round-trip form), or a string when non-finite.
-struct F32(f32);
-
-impl Serialize for F32 {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let v = self.0;
-        if v.is_finite() {
-            s.serialize_f32(v)
-        } else if v.is_nan() {
-            s.serialize_str(if v.is_sign_negative() { "-NaN" } else { "NaN" })
-        } else {
-            s.serialize_str(if v > 0.0 { "Infinity" } else { "-Infinity" })
-        }
-    }
-}
 
 /// A 4-byte slot as 8 lowercase hex digits, in wire order.
 struct Slot([u8; 4]);

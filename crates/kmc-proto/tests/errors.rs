@@ -43,15 +43,18 @@ fn speed_bound_is_exclusive_and_configurable() {
         Err(DecodeError::SpeedOutOfBounds { speed_mps: -20.0, bound_mps: 20.0 })
     );
     let mut strict: FrameBuffer<ChassisFrameDecoder, 128> =
-        FrameBuffer::new(ChassisFrameDecoder::new().with_max_speed_mps(2.0));
+        FrameBuffer::new(ChassisFrameDecoder::new().with_max_speed_mps(2.0).unwrap());
     let mut got = Vec::new();
     strict.push_all(&frame(3.0), |f| got.push(f));
     strict.push_all(&frame(1.0), |f| got.push(f));
     assert_eq!(got, [ChassisFrame::VehicleSpeed(VehicleSpeed { speed_mps: 1.0 })]);
     assert_eq!(strict.counters().rejected_candidates, 1);
     assert!(matches!(strict.decoder().last_rejection(), Some(DecodeError::SpeedOutOfBounds { .. })));
-    // A nonsensical bound keeps the default.
-    assert_eq!(ChassisFrameDecoder::new().with_max_speed_mps(f32::NAN).max_speed_mps(), 20.0);
+    // A nonsensical bound is refused, not silently ignored.
+    for bad in [f32::NAN, f32::INFINITY, 0.0, -1.0] {
+        let refused = ChassisFrameDecoder::new().with_max_speed_mps(bad).unwrap_err();
+        assert_eq!(refused.bound_mps.to_bits(), bad.to_bits());
+    }
 }
 
 #[test]

@@ -21,8 +21,8 @@ use std::time::{Duration, Instant};
 use kmc::{ChassisFrame, Driver, DriverOptions, SerialPortOptions, UartClient};
 use kmc_proto::HostFrame;
 use robowire_core::timing::{LatenessRing, LatenessSummary};
+use robowire_serial::Pty;
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
-use robowire_sim::pty::Pty;
 
 #[path = "../../../benches/timing.rs"]
 mod timing;

@@ -14,7 +14,7 @@ use robowire_serial::{Backoff, LinkCounters, SerialError, SerialLink, SerialPort
 use tokio::sync::{mpsc, oneshot};
 use tokio::time::Instant;
 
-use crate::{KmcError, realtime};
+use crate::KmcError;
 use robowire_core::finite;
 
 /// Battery poll rate when [`DriverOptions::poll_battery`] is on, Hz.
@@ -41,7 +41,7 @@ pub struct DriverOptions {
     /// Read all-state (ID 0x06) of motors 0 and 1 at [`ALL_STATE_POLL_HZ`]. Default off.
     pub poll_allstate: bool,
     /// Without a `set_command` for this long the stream sends (0, 0). Default 300 ms.
-    pub command_timeout_ms: u64,
+    pub command_timeout: Duration,
     /// (0, 0) frames sent on [`Driver::stop`]. Default 3; at least 1.
     pub stop_burst_count: u32,
     /// `SCHED_FIFO` priority 1..=99 for the driver thread; `None` (the vendor's -1) keeps normal
@@ -67,7 +67,7 @@ impl Default for DriverOptions {
             vehicle_speed_rate_hz: 50.0,
             poll_battery: false,
             poll_allstate: false,
-            command_timeout_ms: 300,
+            command_timeout: Duration::from_millis(300),
             stop_burst_count: 3,
             realtime_priority: None,
             cpu_affinity: None,
@@ -99,8 +99,8 @@ impl DriverOptions {
         {
             return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
         }
-        if !(self.max_speed_mps.is_finite() && self.max_speed_mps > 0.0) {
-            return bad("max_speed_mps", format!("{} must be finite and positive", self.max_speed_mps));
+        if let Err(e) = ChassisFrameDecoder::new().with_max_speed_mps(self.max_speed_mps) {
+            return bad("max_speed_mps", e.to_string());
         }
         Ok(())
     }
@@ -186,7 +186,7 @@ struct Running {
 ///
 /// [`start`](Self::start) opens the port and starts an I/O thread that sends, on absolute
 /// deadlines, the current command at `control_rate_hz` (or (0, 0) when no
-/// [`set_command`](Self::set_command) came within `command_timeout_ms`), `0xB3` requests at
+/// [`set_command`](Self::set_command) came within `command_timeout`), `0xB3` requests at
 /// `vehicle_speed_rate_hz`, and the enabled polls. Responses queue up for
 /// [`try_pop_message`](Self::try_pop_message). [`stop`](Self::stop) (or dropping the driver)
 /// sends the stop burst.
@@ -408,13 +408,15 @@ fn io_thread(
 ) {
     let setup = || -> Result<(tokio::runtime::Runtime, SerialLink<ChassisFrameDecoder>), KmcError> {
         if let Some(cpu) = options.cpu_affinity {
-            realtime::pin_current_thread(cpu)?;
+            robowire_rt::pin_current_thread(cpu)?;
         }
         if let Some(priority) = options.realtime_priority {
-            realtime::set_realtime_priority(priority)?;
+            robowire_rt::set_realtime_priority(priority)?;
         }
         let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(KmcError::Thread)?;
-        let decoder = ChassisFrameDecoder::new().with_max_speed_mps(options.max_speed_mps);
+        let decoder = ChassisFrameDecoder::new()
+            .with_max_speed_mps(options.max_speed_mps)
+            .map_err(|e| KmcError::Option { name: "max_speed_mps", reason: e.to_string() })?;
         let link = {
             let _entered = runtime.enter();
             SerialLink::open(&port, &options.serial, decoder)?
@@ -585,7 +587,7 @@ impl IoLoop {
             let lateness_us = u32::try_from(now.duration_since(self.control.next).as_micros()).unwrap_or(u32::MAX);
             let (command, fresh) = {
                 let state = self.shared.lock();
-                let timeout = Duration::from_millis(self.options.command_timeout_ms);
+                let timeout = self.options.command_timeout;
                 let fresh = state.command_set_at.is_some_and(|at| now.saturating_duration_since(at) <= timeout);
                 (if fresh { state.command } else { PcControl::STOP }, fresh)
             };

@@ -5,6 +5,7 @@ use std::io;
 
 use kmc_proto::EncodeError;
 use robowire_core::NonFinite;
+use robowire_rt::RtError;
 use robowire_serial::SerialError;
 
 /// Everything the KMC facade can fail with.
@@ -34,27 +35,10 @@ pub enum KmcError {
     /// [`Driver::start`](crate::Driver::start) on a running driver.
     #[error("the driver is already running")]
     AlreadyRunning,
-    /// `realtime_priority` could not be applied.
-    #[error(
-        "cannot run the driver thread at SCHED_FIFO priority {priority}: {reason} \
-         (needs CAP_SYS_NICE or an rtprio limit; set realtime_priority to None for normal scheduling)"
-    )]
-    RealtimePriority {
-        /// The requested priority.
-        priority: u8,
-        /// What the system said.
-        reason: String,
-    },
-    /// `cpu_affinity` could not be applied.
-    #[error("cannot pin the driver thread to CPU {cpu}: {source}")]
-    CpuAffinity {
-        /// The requested CPU index.
-        cpu: usize,
-        /// What the system said.
-        #[source]
-        source: io::Error,
-    },
+    /// `realtime_priority` or `cpu_affinity` could not be applied to the driver thread.
+    #[error("the driver thread could not be placed as asked")]
+    Placement(#[from] RtError),
     /// The driver thread or its runtime could not be created.
-    #[error("cannot start the driver thread: {0}")]
+    #[error("cannot start the driver thread")]
     Thread(#[source] io::Error),
 }

@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use kmc::{ChassisFrame, Driver, DriverOptions, KmcError, LinkState, NonFinite};
+use kmc::{ChassisFrame, Driver, DriverOptions, KmcError, LinkState, NonFinite, RtError};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault, Received};
 
@@ -250,14 +250,14 @@ fn invalid_options_and_start_failures_are_typed() {
     pinned.stop().unwrap();
     let mut nowhere =
         Driver::new(sim.path(), DriverOptions { cpu_affinity: Some(1 << 20), ..Default::default() }).unwrap();
-    assert!(matches!(nowhere.start(), Err(KmcError::CpuAffinity { cpu, .. }) if cpu == 1 << 20));
+    assert!(matches!(nowhere.start(), Err(KmcError::Placement(RtError::CpuAffinity { cpu, .. })) if cpu == 1 << 20));
     // SCHED_FIFO needs privileges this machine may or may not grant: either it works, or the
     // error says which priority failed.
     let mut realtime =
         Driver::new(sim.path(), DriverOptions { realtime_priority: Some(10), ..Default::default() }).unwrap();
     match realtime.start() {
         Ok(()) => realtime.stop().unwrap(),
-        Err(KmcError::RealtimePriority { priority: 10, .. }) => {}
+        Err(KmcError::Placement(RtError::RealtimePriority { priority: 10, .. })) => {}
         Err(other) => panic!("unexpected error {other}"),
     }
 }

@@ -61,6 +61,8 @@ pub(crate) fn walk<V: Visitor>(
                 visitor.scalar(*pos, base + field.offset, len)?;
                 *pos += len;
             }
+            // C padding has no place in CDR.
+            Shape::Pad => {}
             Shape::Struct(sub) => {
                 let header_at = (xcdr2 && field.count.is_some()).then(|| {
                     *pos = align(*pos, 4);

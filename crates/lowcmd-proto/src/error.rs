@@ -7,10 +7,28 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum DecodeError<M> {
-    /// The input is not the message's exact length.
-    #[error("wrong length: {expected} bytes expected, {found} given")]
+    /// A struct image that is not the message's exact length.
+    #[error("wrong length: the struct image is {expected} bytes, {found} given")]
     Length {
-        /// The message's length in this encoding.
+        /// The image's length.
+        expected: usize,
+        /// Bytes given.
+        found: usize,
+    },
+    /// Too short for a CDR payload's 4-byte encapsulation header.
+    #[error(
+        "a CDR payload starts with its 4-byte encapsulation header (00 01 00 00 XCDR1, 00 07 00 00 XCDR2); {found} bytes given"
+    )]
+    NoEncapsulation {
+        /// Bytes given.
+        found: usize,
+    },
+    /// A CDR payload that is not the message's exact length in its encoding.
+    #[error("wrong length: the {encoding:?} payload is {expected} bytes with its header, {found} given")]
+    CdrLength {
+        /// The payload's encoding, from its header.
+        encoding: crate::CdrEncoding,
+        /// The payload's length in that encoding, header included.
         expected: usize,
         /// Bytes given.
         found: usize,
@@ -56,6 +74,8 @@ impl<M> DecodeError<M> {
     pub fn without_message(self) -> DecodeError<()> {
         match self {
             Self::Length { expected, found } => DecodeError::Length { expected, found },
+            Self::NoEncapsulation { found } => DecodeError::NoEncapsulation { found },
+            Self::CdrLength { encoding, expected, found } => DecodeError::CdrLength { encoding, expected, found },
             Self::Encapsulation { found } => DecodeError::Encapsulation { found },
             Self::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
             Self::NonZeroPadding { offset, value } => DecodeError::NonZeroPadding { offset, value },

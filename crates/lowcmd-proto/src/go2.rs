@@ -6,10 +6,10 @@
 //! [`zerocopy::FromZeros::new_zeroed`] (the IDL default) or by decoding, never with non-zero
 //! padding that would poison the CRC.
 
+use zerocopy::FromZeros;
 use zerocopy::little_endian::{F32, I16, I32, U16, U32};
-use zerocopy::{FromBytes, FromZeros, Immutable, IntoBytes, KnownLayout, Unaligned};
 
-use crate::layout::{Scalar, Shape, StructLayout, field};
+use crate::layout::idl_struct;
 
 /// `head` of every `LowCmd_` the vendor examples send.
 pub const HEAD: [u8; 2] = [0xFE, 0xEF];
@@ -28,32 +28,25 @@ pub const VEL_STOP_F: f32 = 16000.0;
 /// Motor slots in both messages; the Go2 drives the first 12.
 pub const MOTOR_COUNT: usize = 20;
 
-const U8: Shape = Shape::Scalar(Scalar::U8);
-const U16S: Shape = Shape::Scalar(Scalar::U16);
-const I16S: Shape = Shape::Scalar(Scalar::I16);
-const U32S: Shape = Shape::Scalar(Scalar::U32);
-const I32S: Shape = Shape::Scalar(Scalar::I32);
-const F32S: Shape = Shape::Scalar(Scalar::F32);
-
-/// One motor's command, 36 bytes (spec §3.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct MotorCmd {
-    /// 0x01 servo; 0 is the IDL default; other values undocumented.
-    pub mode: u8,
-    _pad0: [u8; 3],
-    /// Position target, rad ([`POS_STOP_F`]: none).
-    pub q: F32,
-    /// Velocity target, rad/s ([`VEL_STOP_F`]: none).
-    pub dq: F32,
-    /// Feed-forward torque, N·m.
-    pub tau: F32,
-    /// Position gain.
-    pub kp: F32,
-    /// Velocity gain.
-    pub kd: F32,
-    /// Reserved.
-    pub reserve: [U32; 3],
+idl_struct! {
+    /// One motor's command, 36 bytes (spec §3.2).
+    pub struct MotorCmd as "MotorCmd_" in MOTOR_CMD_LAYOUT {
+        /// 0x01 servo; 0 is the IDL default; other values undocumented.
+        pub mode: u8 => scalar(U8),
+        _pad0: [u8; 3] => pad,
+        /// Position target, rad ([`POS_STOP_F`]: none).
+        pub q: F32 => scalar(F32),
+        /// Velocity target, rad/s ([`VEL_STOP_F`]: none).
+        pub dq: F32 => scalar(F32),
+        /// Feed-forward torque, N·m.
+        pub tau: F32 => scalar(F32),
+        /// Position gain.
+        pub kp: F32 => scalar(F32),
+        /// Velocity gain.
+        pub kd: F32 => scalar(F32),
+        /// Reserved.
+        pub reserve: [U32; 3] => array(U32),
+    }
 }
 
 impl MotorCmd {
@@ -74,56 +67,52 @@ impl MotorCmd {
         cmd.tau = tau.into();
         cmd
     }
+}
 
-    pub(crate) fn zero_padding(&mut self) {
-        self._pad0 = [0; 3];
+idl_struct! {
+    /// Battery command, 4 bytes.
+    pub struct BmsCmd as "BmsCmd_" in BMS_CMD_LAYOUT {
+        /// Battery off.
+        pub off: u8 => scalar(U8),
+        /// Reserved.
+        pub reserve: [u8; 3] => array(U8),
     }
 }
 
-/// Battery command, 4 bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct BmsCmd {
-    /// Battery off.
-    pub off: u8,
-    /// Reserved.
-    pub reserve: [u8; 3],
-}
-
-/// Go2 low-level command, `unitree_go::msg::dds_::LowCmd_`, 812 bytes (spec §3.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct LowCmd {
-    /// [`HEAD`] (0xFE 0xEF).
-    pub head: [u8; 2],
-    /// [`LEVEL_LOW`] for low-level control.
-    pub level_flag: u8,
-    /// Reserved.
-    pub frame_reserve: u8,
-    /// Serial number.
-    pub sn: [U32; 2],
-    /// Version.
-    pub version: [U32; 2],
-    /// Bandwidth.
-    pub bandwidth: U16,
-    _pad0: [u8; 2],
-    /// Motors, joint order FR, FL, RR, RL × hip, thigh, calf; slots 12..19 unused on the Go2.
-    pub motor_cmd: [MotorCmd; MOTOR_COUNT],
-    /// Battery command.
-    pub bms_cmd: BmsCmd,
-    /// Wireless remote bytes.
-    pub wireless_remote: [u8; 40],
-    /// LEDs.
-    pub led: [u8; 12],
-    /// Fans.
-    pub fan: [u8; 2],
-    /// GPIO.
-    pub gpio: u8,
-    _pad1: [u8; 1],
-    /// Reserved; the last word the CRC covers.
-    pub reserve: U32,
-    /// CRC of bytes 0..808, written by the encoder.
-    pub crc: U32,
+idl_struct! {
+    /// Go2 low-level command, `unitree_go::msg::dds_::LowCmd_`, 812 bytes (spec §3.1).
+    pub struct LowCmd as "LowCmd_" in LOW_CMD_LAYOUT {
+        /// [`HEAD`] (0xFE 0xEF).
+        pub head: [u8; 2] => array(U8),
+        /// [`LEVEL_LOW`] for low-level control.
+        pub level_flag: u8 => scalar(U8),
+        /// Reserved.
+        pub frame_reserve: u8 => scalar(U8),
+        /// Serial number.
+        pub sn: [U32; 2] => array(U32),
+        /// Version.
+        pub version: [U32; 2] => array(U32),
+        /// Bandwidth.
+        pub bandwidth: U16 => scalar(U16),
+        _pad0: [u8; 2] => pad,
+        /// Motors, joint order FR, FL, RR, RL × hip, thigh, calf; slots 12..19 unused on the Go2.
+        pub motor_cmd: [MotorCmd; MOTOR_COUNT] => nested_array(MOTOR_CMD_LAYOUT),
+        /// Battery command.
+        pub bms_cmd: BmsCmd => nested(BMS_CMD_LAYOUT),
+        /// Wireless remote bytes.
+        pub wireless_remote: [u8; 40] => array(U8),
+        /// LEDs.
+        pub led: [u8; 12] => array(U8),
+        /// Fans.
+        pub fan: [u8; 2] => array(U8),
+        /// GPIO.
+        pub gpio: u8 => scalar(U8),
+        _pad1: [u8; 1] => pad,
+        /// Reserved; the last word the CRC covers.
+        pub reserve: U32 => scalar(U32),
+        /// CRC of bytes 0..808, written by the encoder.
+        pub crc: U32 => scalar(U32),
+    }
 }
 
 impl Default for LowCmd {
@@ -138,136 +127,128 @@ impl Default for LowCmd {
     }
 }
 
-impl LowCmd {
-    pub(crate) fn zero_padding_impl(&mut self) {
-        self._pad0 = [0; 2];
-        self._pad1 = [0; 1];
-        self.motor_cmd.iter_mut().for_each(MotorCmd::zero_padding);
+idl_struct! {
+    /// IMU sample, 56 bytes (spec §3.4).
+    pub struct ImuState as "IMUState_" in IMU_STATE_LAYOUT {
+        /// Orientation quaternion (w, x, y, z).
+        pub quaternion: [F32; 4] => array(F32),
+        /// Angular rate, rad/s.
+        pub gyroscope: [F32; 3] => array(F32),
+        /// Acceleration, m/s².
+        pub accelerometer: [F32; 3] => array(F32),
+        /// Roll, pitch, yaw, rad.
+        pub rpy: [F32; 3] => array(F32),
+        /// Temperature, raw `uint8` (°C).
+        pub temperature: u8 => scalar(U8),
+        _pad0: [u8; 3] => pad,
     }
 }
 
-/// IMU sample, 56 bytes (spec §3.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct ImuState {
-    /// Orientation quaternion (w, x, y, z).
-    pub quaternion: [F32; 4],
-    /// Angular rate, rad/s.
-    pub gyroscope: [F32; 3],
-    /// Acceleration, m/s².
-    pub accelerometer: [F32; 3],
-    /// Roll, pitch, yaw, rad.
-    pub rpy: [F32; 3],
-    /// Temperature, raw `uint8` (°C).
-    pub temperature: u8,
-    _pad0: [u8; 3],
+idl_struct! {
+    /// One motor's state, 48 bytes (spec §3.4).
+    pub struct MotorState as "MotorState_" in MOTOR_STATE_LAYOUT {
+        /// Mode.
+        pub mode: u8 => scalar(U8),
+        _pad0: [u8; 3] => pad,
+        /// Position, rad.
+        pub q: F32 => scalar(F32),
+        /// Velocity, rad/s.
+        pub dq: F32 => scalar(F32),
+        /// Acceleration, rad/s².
+        pub ddq: F32 => scalar(F32),
+        /// Estimated torque, N·m.
+        pub tau_est: F32 => scalar(F32),
+        /// Raw position.
+        pub q_raw: F32 => scalar(F32),
+        /// Raw velocity.
+        pub dq_raw: F32 => scalar(F32),
+        /// Raw acceleration.
+        pub ddq_raw: F32 => scalar(F32),
+        /// Temperature, raw `uint8` (°C).
+        pub temperature: u8 => scalar(U8),
+        _pad1: [u8; 3] => pad,
+        /// Lost-frame counter.
+        pub lost: U32 => scalar(U32),
+        /// Reserved.
+        pub reserve: [U32; 2] => array(U32),
+    }
 }
 
-/// One motor's state, 48 bytes (spec §3.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct MotorState {
-    /// Mode.
-    pub mode: u8,
-    _pad0: [u8; 3],
-    /// Position, rad.
-    pub q: F32,
-    /// Velocity, rad/s.
-    pub dq: F32,
-    /// Acceleration, rad/s².
-    pub ddq: F32,
-    /// Estimated torque, N·m.
-    pub tau_est: F32,
-    /// Raw position.
-    pub q_raw: F32,
-    /// Raw velocity.
-    pub dq_raw: F32,
-    /// Raw acceleration.
-    pub ddq_raw: F32,
-    /// Temperature, raw `uint8` (°C).
-    pub temperature: u8,
-    _pad1: [u8; 3],
-    /// Lost-frame counter.
-    pub lost: U32,
-    /// Reserved.
-    pub reserve: [U32; 2],
+idl_struct! {
+    /// Battery state, 44 bytes, no padding (spec §3.5).
+    pub struct BmsState as "BmsState_" in BMS_STATE_LAYOUT {
+        /// Version, high byte.
+        pub version_high: u8 => scalar(U8),
+        /// Version, low byte.
+        pub version_low: u8 => scalar(U8),
+        /// Status.
+        pub status: u8 => scalar(U8),
+        /// State of charge, %.
+        pub soc: u8 => scalar(U8),
+        /// Current, mA.
+        pub current: I32 => scalar(I32),
+        /// Charge cycles.
+        pub cycle: U16 => scalar(U16),
+        /// BQ temperatures, raw `uint8`.
+        pub bq_ntc: [u8; 2] => array(U8),
+        /// MCU temperatures, raw `uint8`.
+        pub mcu_ntc: [u8; 2] => array(U8),
+        /// Cell voltages, mV.
+        pub cell_vol: [U16; 15] => array(U16),
+    }
 }
 
-/// Battery state, 44 bytes, no padding (spec §3.5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct BmsState {
-    /// Version, high byte.
-    pub version_high: u8,
-    /// Version, low byte.
-    pub version_low: u8,
-    /// Status.
-    pub status: u8,
-    /// State of charge, %.
-    pub soc: u8,
-    /// Current, mA.
-    pub current: I32,
-    /// Charge cycles.
-    pub cycle: U16,
-    /// BQ temperatures, raw `uint8`.
-    pub bq_ntc: [u8; 2],
-    /// MCU temperatures, raw `uint8`.
-    pub mcu_ntc: [u8; 2],
-    /// Cell voltages, mV.
-    pub cell_vol: [U16; 15],
-}
-
-/// Go2 low-level state, `unitree_go::msg::dds_::LowState_`, 1180 bytes (spec §3.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct LowState {
-    /// Header bytes.
-    pub head: [u8; 2],
-    /// Level flag.
-    pub level_flag: u8,
-    /// Reserved.
-    pub frame_reserve: u8,
-    /// Serial number.
-    pub sn: [U32; 2],
-    /// Version.
-    pub version: [U32; 2],
-    /// Bandwidth.
-    pub bandwidth: U16,
-    _pad0: [u8; 2],
-    /// IMU.
-    pub imu_state: ImuState,
-    /// Motors, joint order as in [`LowCmd::motor_cmd`].
-    pub motor_state: [MotorState; MOTOR_COUNT],
-    /// Battery.
-    pub bms_state: BmsState,
-    /// Foot force, raw.
-    pub foot_force: [I16; 4],
-    /// Estimated foot force.
-    pub foot_force_est: [I16; 4],
-    /// Tick counter.
-    pub tick: U32,
-    /// Wireless remote (spec §5.4).
-    pub wireless_remote: [u8; 40],
-    /// Bit flags.
-    pub bit_flag: u8,
-    _pad1: [u8; 3],
-    /// ADC reel.
-    pub adc_reel: F32,
-    /// NTC temperature 1, raw `uint8`.
-    pub temperature_ntc1: u8,
-    /// NTC temperature 2, raw `uint8`.
-    pub temperature_ntc2: u8,
-    _pad2: [u8; 2],
-    /// Supply voltage, V.
-    pub power_v: F32,
-    /// Supply current, A.
-    pub power_a: F32,
-    /// Fan frequencies (`uint16`).
-    pub fan_frequency: [U16; 4],
-    /// Reserved; the last word the CRC covers.
-    pub reserve: U32,
-    /// CRC of bytes 0..1176.
-    pub crc: U32,
+idl_struct! {
+    /// Go2 low-level state, `unitree_go::msg::dds_::LowState_`, 1180 bytes (spec §3.3).
+    pub struct LowState as "LowState_" in LOW_STATE_LAYOUT {
+        /// Header bytes.
+        pub head: [u8; 2] => array(U8),
+        /// Level flag.
+        pub level_flag: u8 => scalar(U8),
+        /// Reserved.
+        pub frame_reserve: u8 => scalar(U8),
+        /// Serial number.
+        pub sn: [U32; 2] => array(U32),
+        /// Version.
+        pub version: [U32; 2] => array(U32),
+        /// Bandwidth.
+        pub bandwidth: U16 => scalar(U16),
+        _pad0: [u8; 2] => pad,
+        /// IMU.
+        pub imu_state: ImuState => nested(IMU_STATE_LAYOUT),
+        /// Motors, joint order as in [`LowCmd::motor_cmd`].
+        pub motor_state: [MotorState; MOTOR_COUNT] => nested_array(MOTOR_STATE_LAYOUT),
+        /// Battery.
+        pub bms_state: BmsState => nested(BMS_STATE_LAYOUT),
+        /// Foot force, raw.
+        pub foot_force: [I16; 4] => array(I16),
+        /// Estimated foot force.
+        pub foot_force_est: [I16; 4] => array(I16),
+        /// Tick counter.
+        pub tick: U32 => scalar(U32),
+        /// Wireless remote (spec §5.4).
+        pub wireless_remote: [u8; 40] => array(U8),
+        /// Bit flags.
+        pub bit_flag: u8 => scalar(U8),
+        _pad1: [u8; 3] => pad,
+        /// ADC reel.
+        pub adc_reel: F32 => scalar(F32),
+        /// NTC temperature 1, raw `uint8`.
+        pub temperature_ntc1: u8 => scalar(U8),
+        /// NTC temperature 2, raw `uint8`.
+        pub temperature_ntc2: u8 => scalar(U8),
+        _pad2: [u8; 2] => pad,
+        /// Supply voltage, V.
+        pub power_v: F32 => scalar(F32),
+        /// Supply current, A.
+        pub power_a: F32 => scalar(F32),
+        /// Fan frequencies (`uint16`).
+        pub fan_frequency: [U16; 4] => array(U16),
+        /// Reserved; the last word the CRC covers.
+        pub reserve: U32 => scalar(U32),
+        /// CRC of bytes 0..1176.
+        pub crc: U32 => scalar(U32),
+    }
 }
 
 impl Default for LowState {
@@ -276,142 +257,6 @@ impl Default for LowState {
         Self::new_zeroed()
     }
 }
-
-impl LowState {
-    pub(crate) fn zero_padding_impl(&mut self) {
-        self._pad0 = [0; 2];
-        self._pad1 = [0; 3];
-        self._pad2 = [0; 2];
-        self.imu_state._pad0 = [0; 3];
-        for m in &mut self.motor_state {
-            m._pad0 = [0; 3];
-            m._pad1 = [0; 3];
-        }
-    }
-}
-
-/// Layout of [`MotorCmd`].
-pub static MOTOR_CMD_LAYOUT: StructLayout = StructLayout {
-    name: "MotorCmd_",
-    size: size_of::<MotorCmd>(),
-    fields: &[
-        field!(MotorCmd, mode, U8),
-        field!(MotorCmd, q, F32S),
-        field!(MotorCmd, dq, F32S),
-        field!(MotorCmd, tau, F32S),
-        field!(MotorCmd, kp, F32S),
-        field!(MotorCmd, kd, F32S),
-        field!(MotorCmd, reserve, U32S, [3]),
-    ],
-};
-
-/// Layout of [`BmsCmd`].
-pub static BMS_CMD_LAYOUT: StructLayout = StructLayout {
-    name: "BmsCmd_",
-    size: size_of::<BmsCmd>(),
-    fields: &[field!(BmsCmd, off, U8), field!(BmsCmd, reserve, U8, [3])],
-};
-
-/// Layout of [`LowCmd`].
-pub static LOW_CMD_LAYOUT: StructLayout = StructLayout {
-    name: "LowCmd_",
-    size: size_of::<LowCmd>(),
-    fields: &[
-        field!(LowCmd, head, U8, [2]),
-        field!(LowCmd, level_flag, U8),
-        field!(LowCmd, frame_reserve, U8),
-        field!(LowCmd, sn, U32S, [2]),
-        field!(LowCmd, version, U32S, [2]),
-        field!(LowCmd, bandwidth, U16S),
-        field!(LowCmd, motor_cmd, Shape::Struct(&MOTOR_CMD_LAYOUT), [MOTOR_COUNT]),
-        field!(LowCmd, bms_cmd, Shape::Struct(&BMS_CMD_LAYOUT)),
-        field!(LowCmd, wireless_remote, U8, [40]),
-        field!(LowCmd, led, U8, [12]),
-        field!(LowCmd, fan, U8, [2]),
-        field!(LowCmd, gpio, U8),
-        field!(LowCmd, reserve, U32S),
-        field!(LowCmd, crc, U32S),
-    ],
-};
-
-/// Layout of [`ImuState`].
-pub static IMU_STATE_LAYOUT: StructLayout = StructLayout {
-    name: "IMUState_",
-    size: size_of::<ImuState>(),
-    fields: &[
-        field!(ImuState, quaternion, F32S, [4]),
-        field!(ImuState, gyroscope, F32S, [3]),
-        field!(ImuState, accelerometer, F32S, [3]),
-        field!(ImuState, rpy, F32S, [3]),
-        field!(ImuState, temperature, U8),
-    ],
-};
-
-/// Layout of [`MotorState`].
-pub static MOTOR_STATE_LAYOUT: StructLayout = StructLayout {
-    name: "MotorState_",
-    size: size_of::<MotorState>(),
-    fields: &[
-        field!(MotorState, mode, U8),
-        field!(MotorState, q, F32S),
-        field!(MotorState, dq, F32S),
-        field!(MotorState, ddq, F32S),
-        field!(MotorState, tau_est, F32S),
-        field!(MotorState, q_raw, F32S),
-        field!(MotorState, dq_raw, F32S),
-        field!(MotorState, ddq_raw, F32S),
-        field!(MotorState, temperature, U8),
-        field!(MotorState, lost, U32S),
-        field!(MotorState, reserve, U32S, [2]),
-    ],
-};
-
-/// Layout of [`BmsState`].
-pub static BMS_STATE_LAYOUT: StructLayout = StructLayout {
-    name: "BmsState_",
-    size: size_of::<BmsState>(),
-    fields: &[
-        field!(BmsState, version_high, U8),
-        field!(BmsState, version_low, U8),
-        field!(BmsState, status, U8),
-        field!(BmsState, soc, U8),
-        field!(BmsState, current, I32S),
-        field!(BmsState, cycle, U16S),
-        field!(BmsState, bq_ntc, U8, [2]),
-        field!(BmsState, mcu_ntc, U8, [2]),
-        field!(BmsState, cell_vol, U16S, [15]),
-    ],
-};
-
-/// Layout of [`LowState`].
-pub static LOW_STATE_LAYOUT: StructLayout = StructLayout {
-    name: "LowState_",
-    size: size_of::<LowState>(),
-    fields: &[
-        field!(LowState, head, U8, [2]),
-        field!(LowState, level_flag, U8),
-        field!(LowState, frame_reserve, U8),
-        field!(LowState, sn, U32S, [2]),
-        field!(LowState, version, U32S, [2]),
-        field!(LowState, bandwidth, U16S),
-        field!(LowState, imu_state, Shape::Struct(&IMU_STATE_LAYOUT)),
-        field!(LowState, motor_state, Shape::Struct(&MOTOR_STATE_LAYOUT), [MOTOR_COUNT]),
-        field!(LowState, bms_state, Shape::Struct(&BMS_STATE_LAYOUT)),
-        field!(LowState, foot_force, I16S, [4]),
-        field!(LowState, foot_force_est, I16S, [4]),
-        field!(LowState, tick, U32S),
-        field!(LowState, wireless_remote, U8, [40]),
-        field!(LowState, bit_flag, U8),
-        field!(LowState, adc_reel, F32S),
-        field!(LowState, temperature_ntc1, U8),
-        field!(LowState, temperature_ntc2, U8),
-        field!(LowState, power_v, F32S),
-        field!(LowState, power_a, F32S),
-        field!(LowState, fan_frequency, U16S, [4]),
-        field!(LowState, reserve, U32S),
-        field!(LowState, crc, U32S),
-    ],
-};
 
 // Sizes and offsets of spec §3, checked at compile time.
 const _: () = {

@@ -4,15 +4,16 @@
 
 mod cdr;
 pub mod crc;
+#[cfg(feature = "fuzzing")]
+#[doc(hidden)]
+pub mod decode_roundtrip;
 mod error;
 pub mod go2;
-#[doc(hidden)]
-pub mod harness;
 pub mod hg;
-#[cfg(feature = "json")]
-pub mod json;
 pub mod layout;
 mod message;
+#[cfg(feature = "serde")]
+mod serde_impl;
 
 pub use cdr::CdrEncoding;
 pub use error::DecodeError;

@@ -5,7 +5,7 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use crate::cdr::{self, BodyError, CdrEncoding, Transcoder};
 use crate::crc::crc32_words_in_place;
-use crate::layout::StructLayout;
+use crate::layout::{PadRange, StructLayout, padding_count, padding_ranges};
 use crate::{DecodeError, go2, hg};
 
 /// Largest struct image (HG `LowState_`).
@@ -56,9 +56,19 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
     const TOPIC: &'static str;
     /// Struct image length in bytes.
     const IMAGE_LEN: usize = size_of::<Self>();
+    /// The image's padding, `(offset, len)`, flattened from [`FIELDS`](Self::FIELDS) at compile
+    /// time.
+    const PADDING: &'static [PadRange];
 
     /// Sets every padding byte to zero.
-    fn zero_padding(&mut self);
+    fn zero_padding(&mut self) {
+        let bytes = self.as_mut_bytes();
+        for &(offset, len) in Self::PADDING {
+            if let Some(pad) = bytes.get_mut(offset..offset + len) {
+                pad.fill(0);
+            }
+        }
+    }
 
     /// The `crc` field (the last 4 bytes).
     fn crc(&self) -> u32 {
@@ -145,11 +155,12 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         let header: [u8; 4] = bytes
             .get(..4)
             .and_then(|h| h.try_into().ok())
-            .ok_or(DecodeError::Length { expected: Self::cdr_len(CdrEncoding::Xcdr1), found: bytes.len() })?;
+            .ok_or(DecodeError::NoEncapsulation { found: bytes.len() })?;
         let encoding = CdrEncoding::from_header(header).ok_or(DecodeError::Encapsulation { found: header })?;
         let expected = Self::cdr_len(encoding);
+        let length = DecodeError::CdrLength { encoding, expected, found: bytes.len() };
         if bytes.len() != expected {
-            return Err(DecodeError::Length { expected, found: bytes.len() });
+            return Err(length);
         }
         let mut image = [0u8; MAX_IMAGE_LEN];
         let image = &mut image[..Self::IMAGE_LEN];
@@ -161,9 +172,9 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
                 BodyError::ArrayHeader { field, expected, found } => {
                     DecodeError::ArrayHeader { field, expected, found }
                 }
-                BodyError::OutOfBounds => DecodeError::Length { expected, found: bytes.len() },
+                BodyError::OutOfBounds => DecodeError::CdrLength { encoding, expected, found: bytes.len() },
             })?;
-        let message = Self::read_from_bytes(image).map_err(|_| DecodeError::Length { expected, found: bytes.len() })?;
+        let message = Self::read_from_bytes(image).map_err(|_| length)?;
         let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
         // CDR carries no struct padding: the rebuilt image is zero-padded by construction.
         Ok((Unverified { message, crc, padding: None }, encoding))
@@ -205,9 +216,7 @@ macro_rules! message {
             const FIELDS: &'static StructLayout = &$layout;
             const DDS_TYPE_NAME: &'static str = $dds;
             const TOPIC: &'static str = $topic;
-            fn zero_padding(&mut self) {
-                self.zero_padding_impl();
-            }
+            const PADDING: &'static [PadRange] = &padding_ranges::<{ padding_count(&$layout) }>(&$layout);
         }
         impl $ty {
             #[doc = concat!("The sealed ", stringify!($len), "-byte struct image (zero padding, CRC).")]

@@ -18,6 +18,7 @@ fn field_mask(layout: &StructLayout, mask: &mut [bool], base: usize) {
             match field.shape {
                 Shape::Scalar(s) => mask[at..at + s.size()].iter_mut().for_each(|b| *b = true),
                 Shape::Struct(sub) => field_mask(sub, mask, at),
+                Shape::Pad => {}
             }
         }
     }
@@ -142,8 +143,11 @@ fn typed_errors() {
         LowCmd::decode_cdr(&wrong_dheader[..n]),
         Err(DecodeError::ArrayHeader { field: "motor_cmd", expected: 720, found: 0x211 })
     );
-    assert_eq!(LowCmd::decode_cdr(&cdr[..n - 1]), Err(DecodeError::Length { expected: 820, found: 819 }));
-    assert!(matches!(LowCmd::decode_cdr(&cdr[..2]), Err(DecodeError::Length { .. })));
+    assert_eq!(
+        LowCmd::decode_cdr(&cdr[..n - 1]),
+        Err(DecodeError::CdrLength { encoding: CdrEncoding::Xcdr2, expected: 820, found: 819 })
+    );
+    assert_eq!(LowCmd::decode_cdr(&cdr[..2]), Err(DecodeError::NoEncapsulation { found: 2 }));
     let mut short = [0u8; 100];
     assert!(LowCmd::default().encode_image(&mut short).is_err());
     assert!(LowCmd::default().encode_cdr(CdrEncoding::Xcdr1, &mut short).is_err());
@@ -217,4 +221,35 @@ proptest! {
         prop_assert_eq!(crc32_words(&bytes), Some(oracle));
         prop_assert_eq!(crc32_words_table(&bytes), Some(oracle));
     }
+}
+
+/// JSON with the IDL names: a round trip, the crc ignored and rewritten, and typed refusals.
+#[test]
+fn json_round_trip_and_refusals() {
+    let mut cmd = LowCmd::default();
+    cmd.motor_cmd[2] = go2::MotorCmd::servo(-1.3, 0.0, 60.0, 5.0, f32::NAN);
+    let text = serde_json::to_string(&cmd).unwrap();
+    assert!(text.contains(r#""q":-1.3,"#) && text.contains(r#""tau":"NaN""#), "shortest floats, NaN as a string");
+    assert!(!text.contains("_pad"), "padding is not an IDL field");
+    let back: LowCmd = serde_json::from_str(&text).unwrap();
+    assert_eq!(back.to_image(), cmd.to_image());
+
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value["crc"] = 0.into();
+    let sealed: LowCmd = serde_json::from_value(value.clone()).unwrap();
+    assert_eq!(sealed.crc(), cmd.computed_crc(), "the crc is the encoder's to write");
+
+    let refused = |edit: fn(&mut serde_json::Value)| {
+        let mut v = value.clone();
+        edit(&mut v);
+        serde_json::from_value::<LowCmd>(v).unwrap_err().to_string()
+    };
+    assert!(refused(|v| v["gpio"] = 256.into()).contains("gpio: 256 does not fit uint8"));
+    let kp = refused(|v| v["motor_cmd"][0]["kp"] = "fast".into());
+    assert!(kp.contains(r#"motor_cmd[0].kp: expected a number (float), found "fast""#), "{kp}");
+    assert!(refused(|v| v["led"] = serde_json::json!([1, 2])).contains("led: expected 12 elements, found 2"));
+    assert!(refused(|v| v["bogus"] = 1.into()).contains("bogus: no such field in LowCmd_"));
+    assert!(refused(|v| drop(v.as_object_mut().unwrap().remove("level_flag"))).contains("level_flag: missing"));
+    let dq = refused(|v| drop(v["motor_cmd"][3].as_object_mut().unwrap().remove("dq")));
+    assert!(dq.contains("motor_cmd[3].dq: missing"), "{dq}");
 }

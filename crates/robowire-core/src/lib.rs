@@ -4,6 +4,9 @@
 
 mod datagram;
 pub mod le;
+#[cfg(feature = "serde")]
+pub mod serde_f32;
+pub mod shm;
 mod stream;
 pub mod timing;
 

@@ -1,6 +1,8 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+pub mod pty;
+
 use std::io;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -47,12 +49,14 @@ impl Default for Backoff {
     }
 }
 
+pub use pty::{Pty, PtyDevice};
+
 /// Transport errors. "The bytes were bad" is not one: decoders skip and count those.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SerialError {
     /// The port could not be opened or configured.
-    #[error("cannot open serial port {path}: {source}")]
+    #[error("cannot open serial port {path}")]
     Open {
         /// Device path.
         path: PathBuf,
@@ -62,7 +66,7 @@ pub enum SerialError {
     },
     /// The device went away: a read returned end-of-file or failed, or a write failed.
     /// The link stays unusable until [`SerialLink::reopen`] succeeds.
-    #[error("serial port {path} disconnected{}", source.as_ref().map(|e| format!(": {e}")).unwrap_or_default())]
+    #[error("serial port {path} disconnected")]
     Disconnected {
         /// Device path.
         path: PathBuf,
@@ -71,7 +75,7 @@ pub enum SerialError {
         source: Option<io::Error>,
     },
     /// Reopening gave up after the backoff's `max_attempts`.
-    #[error("gave up reopening serial port {path} after {attempts} attempts: {last}")]
+    #[error("gave up reopening serial port {path} after {attempts} attempts")]
     ReopenFailed {
         /// Device path.
         path: PathBuf,

@@ -1,37 +1,70 @@
 //! The one place with `unsafe`: word-wise access to memory that another thread or process may
-//! change at any time. Everything goes through raw pointers; no Rust reference to the memory is
-//! ever created except the momentary `&Atomic*` of an atomic operation.
+//! change at any time, and the two ways such memory comes to exist (a heap allocation, a
+//! mapping). Everything goes through raw pointers; no Rust reference to the memory is ever
+//! created except the momentary `&Atomic*` of an atomic operation.
+//!
+//! Soundness rests on one type: a [`Words`] or [`DWord`] can only be made by
+//! [`RawRegion::words`] / [`RawRegion::dword`] after the range was checked against the region
+//! (in bounds, aligned), and it borrows the region, so it cannot outlive the memory.
 
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::marker::PhantomData;
+use std::ptr::NonNull;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, AtomicU64};
+
+use memmap2::MmapRaw;
 
 use crate::RegionError;
 
-/// A base pointer and a length: memory shared with other threads or processes.
+/// What keeps the memory alive.
+#[derive(Debug)]
+enum Backing {
+    /// Atomics on the heap. An `Arc`, not a `Box`: moving a `Box` asserts unique access and
+    /// would invalidate the base pointer (Miri's Stacked Borrows says so); the `Arc`'s
+    /// allocation stays put when the `RawRegion` moves.
+    Heap(#[allow(dead_code)] Arc<[AtomicU64]>),
+    /// A shared mapping.
+    Mapped(#[allow(dead_code)] MmapRaw),
+}
+
+/// A base pointer, a length and what owns the memory: memory shared with other threads or
+/// processes.
 ///
-/// Invariants (upheld by the constructors' callers, [`crate::MappedRegion`] and
-/// [`crate::HeapRegion`]): `base` is 8-byte aligned, `len` bytes from `base` stay valid and
-/// writable for the lifetime of the `RawRegion`, and every access to them, by anyone, is an
-/// atomic access of one fixed size per location (u32 words for data and flags, u64 for
-/// designated u64 fields).
+/// Invariants, established by the two constructors and relied on by every access: `base` is
+/// 8-byte aligned; `len` bytes from `base` are valid for reads and writes for as long as the
+/// `RawRegion` lives (the backing is owned here and never replaced); every access to them from
+/// robowire is an atomic access of one fixed size per location (u32 words for data and flags,
+/// u64 for designated u64 fields). Other processes sharing a mapping are expected to follow the
+/// same rule (the protocols robowire speaks use aligned 4- and 8-byte fields).
 #[derive(Debug)]
 pub(crate) struct RawRegion {
-    base: *mut u8,
+    base: NonNull<u8>,
     len: usize,
+    _backing: Backing,
 }
 
 // SAFETY: the region is only accessed through atomic operations (see the invariants above), which
-// are safe to perform from any thread.
+// are safe to perform from any thread; the backing (an `Arc` of atomics, a mapping) may be moved
+// to and dropped on any thread.
 unsafe impl Send for RawRegion {}
 // SAFETY: as for Send: shared access is all atomic.
 unsafe impl Sync for RawRegion {}
 
 impl RawRegion {
-    /// # Safety
-    ///
-    /// `base` must be 8-byte aligned and valid for reads and writes of `len` bytes for as long
-    /// as the returned value lives, and the memory must only ever be accessed atomically.
-    pub(crate) unsafe fn new(base: *mut u8, len: usize) -> Self {
-        Self { base, len }
+    /// A zeroed region of `len` bytes on the heap (rounded up to whole u64s internally).
+    pub(crate) fn heap(len: usize) -> Self {
+        let storage: Arc<[AtomicU64]> = (0..len.div_ceil(8)).map(|_| AtomicU64::new(0)).collect();
+        // The slice is 8-byte aligned and at least `len` bytes long. It is made of atomics, so
+        // writing through a pointer derived from a shared reference to it is allowed.
+        let base = NonNull::new(storage.as_ptr().cast::<u8>().cast_mut()).unwrap_or(NonNull::dangling());
+        Self { base, len, _backing: Backing::Heap(storage) }
+    }
+
+    /// The whole of a shared mapping.
+    pub(crate) fn mapped(map: MmapRaw) -> Self {
+        // A mapping is page-aligned, `map.len()` bytes long, readable and writable.
+        let base = NonNull::new(map.as_mut_ptr()).unwrap_or(NonNull::dangling());
+        Self { base, len: map.len(), _backing: Backing::Mapped(map) }
     }
 
     pub(crate) fn len(&self) -> usize {
@@ -50,59 +83,58 @@ impl RawRegion {
         Ok(())
     }
 
-    fn word(&self, offset: usize) -> &AtomicU32 {
-        // SAFETY: callers checked `offset + 4 <= len` and 4-byte alignment (base is 8-aligned), so
-        // the pointer is in bounds, aligned, and valid for the region's lifetime, which bounds the
-        // returned reference. All accesses to this word are 4-byte atomics (type invariant), as
-        // `AtomicU32::from_ptr` requires.
-        unsafe { AtomicU32::from_ptr(self.base.add(offset).cast::<u32>()) }
+    /// The u32 words of `[offset, offset + len)`, checked once.
+    pub(crate) fn words(&self, offset: usize, len: usize) -> Result<Words<'_>, RegionError> {
+        self.check(offset, len, 4)?;
+        // In bounds (checked), so the offset pointer stays inside the allocation; base is
+        // 8-aligned and offset a multiple of 4, so it is 4-aligned.
+        let first = self.base.as_ptr().wrapping_add(offset).cast::<AtomicU32>();
+        Ok(Words { first: NonNull::new(first).unwrap_or(NonNull::dangling()), count: len / 4, _region: PhantomData })
     }
 
-    fn dword(&self, offset: usize) -> &AtomicU64 {
-        // SAFETY: callers checked `offset + 8 <= len` and 8-byte alignment (base is 8-aligned);
-        // all accesses to this location are 8-byte atomics (type invariant).
-        unsafe { AtomicU64::from_ptr(self.base.add(offset).cast::<u64>()) }
-    }
-
-    /// Copies `dst.len()` bytes from `offset`, word by word with relaxed loads.
-    pub(crate) fn read(&self, offset: usize, dst: &mut [u8]) -> Result<(), RegionError> {
-        self.check(offset, dst.len(), 4)?;
-        let (words, _) = dst.as_chunks_mut::<4>();
-        for (i, chunk) in words.iter_mut().enumerate() {
-            *chunk = self.word(offset + 4 * i).load(Ordering::Relaxed).to_le_bytes();
-        }
-        Ok(())
-    }
-
-    /// Copies `src` to `offset`, word by word with relaxed stores.
-    pub(crate) fn write(&self, offset: usize, src: &[u8]) -> Result<(), RegionError> {
-        self.check(offset, src.len(), 4)?;
-        let (words, _) = src.as_chunks::<4>();
-        for (i, chunk) in words.iter().enumerate() {
-            self.word(offset + 4 * i).store(u32::from_le_bytes(*chunk), Ordering::Relaxed);
-        }
-        Ok(())
-    }
-
-    pub(crate) fn load_u32(&self, offset: usize, order: Ordering) -> Result<u32, RegionError> {
-        self.check(offset, 4, 4)?;
-        Ok(self.word(offset).load(order))
-    }
-
-    pub(crate) fn store_u32(&self, offset: usize, value: u32, order: Ordering) -> Result<(), RegionError> {
-        self.check(offset, 4, 4)?;
-        self.word(offset).store(value, order);
-        Ok(())
-    }
-
-    pub(crate) fn load_u64(&self, offset: usize, order: Ordering) -> Result<u64, RegionError> {
+    /// The u64 at `offset`, checked.
+    pub(crate) fn dword(&self, offset: usize) -> Result<DWord<'_>, RegionError> {
         self.check(offset, 8, 8)?;
-        Ok(self.dword(offset).load(order))
+        let at = self.base.as_ptr().wrapping_add(offset).cast::<AtomicU64>();
+        Ok(DWord { at: NonNull::new(at).unwrap_or(NonNull::dangling()), _region: PhantomData })
     }
+}
 
-    pub(crate) fn store_u64(&self, offset: usize, value: u64, order: Ordering) -> Result<(), RegionError> {
-        self.check(offset, 8, 8)?;
-        self.dword(offset).store(value, order);
-        Ok(())
+/// `count` u32 words starting at `first`, proven in bounds and 4-aligned in a region that lives
+/// for `'r`. Only [`RawRegion::words`] makes one.
+pub(crate) struct Words<'r> {
+    first: NonNull<AtomicU32>,
+    count: usize,
+    _region: PhantomData<&'r RawRegion>,
+}
+
+impl<'r> Words<'r> {
+    /// Word `i`, or `None` past the end.
+    pub(crate) fn get(&self, i: usize) -> Option<&'r AtomicU32> {
+        if i >= self.count {
+            return None;
+        }
+        // SAFETY: `i < count` and the whole range of `count` words was checked to lie inside the
+        // region, 4-aligned (the type's invariant), so the pointer is in bounds and aligned; the
+        // region outlives `'r`, which bounds the reference. Every access to this word is a
+        // 4-byte atomic (RawRegion's invariant), as `AtomicU32::from_ptr` requires.
+        Some(unsafe { AtomicU32::from_ptr(self.first.as_ptr().add(i).cast::<u32>()) })
+    }
+}
+
+/// A u64 proven in bounds and 8-aligned in a region that lives for `'r`. Only
+/// [`RawRegion::dword`] makes one.
+pub(crate) struct DWord<'r> {
+    at: NonNull<AtomicU64>,
+    _region: PhantomData<&'r RawRegion>,
+}
+
+impl<'r> DWord<'r> {
+    /// The atomic.
+    pub(crate) fn get(&self) -> &'r AtomicU64 {
+        // SAFETY: checked in bounds and 8-aligned when made (the type's invariant); the region
+        // outlives `'r`; every access to this location is an 8-byte atomic (RawRegion's
+        // invariant), as `AtomicU64::from_ptr` requires.
+        unsafe { AtomicU64::from_ptr(self.at.as_ptr().cast::<u64>()) }
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 
-use robowire_shm::{HeapRegion, RegionError, SharedRegion};
+use robowire_shm::{FlaggedBlock, HeapRegion, RegionError, SharedRegion, VersionedReadError, VersionedRecord};
 
 /// Bounds, alignment, copies and atomics.
 fn basic_access<R: SharedRegion>(region: &R) {
@@ -32,52 +32,105 @@ fn basic_access<R: SharedRegion>(region: &R) {
     assert_eq!(region.load_u64(200, Ordering::Acquire), Ok(u64::MAX - 1));
     let mut word = [0u8; 4];
     region.read(100, &mut word).unwrap();
-    assert_eq!(u32::from_le_bytes(word), 0xDEAD_BEEF, "little-endian words");
+    assert_eq!(u32::from_ne_bytes(word), 0xDEAD_BEEF, "bytes copied as they are in memory");
 }
 
-/// A producer publishes blocks with release; a consumer that acquires the flag sees the whole
-/// block of that round.
+/// The two protocols, single-threaded: lengths, flags, versions.
+fn protocols<R: SharedRegion>(region: &R) {
+    let block = FlaggedBlock::new(0, 32, 32);
+    let other = block.for_consumer(36);
+    let mut got = [0u8; 32];
+    assert_eq!(region.take(&block, &mut got), Ok(false));
+    assert_eq!(region.take(&block, &mut [0; 8]), Err(RegionError::Length { expected: 32, found: 8 }));
+    assert_eq!(region.publish(&[block, other], &[3; 8]), Err(RegionError::Length { expected: 32, found: 8 }));
+    region.publish(&[block, other], &[3; 32]).unwrap();
+    assert_eq!((region.is_raised(&block), region.is_raised(&other)), (Ok(true), Ok(true)));
+    assert_eq!(region.take(&block, &mut got), Ok(true));
+    assert_eq!(got, [3; 32]);
+    assert_eq!((region.is_raised(&block), region.is_raised(&other)), (Ok(false), Ok(true)), "one consumer's flag");
+    assert_eq!(region.take(&other, &mut got), Ok(true));
+
+    let record = VersionedRecord::new(64, 48);
+    let mut data = [0u8; 40];
+    assert_eq!(region.read_versioned(&record, &mut data, 4), Err(VersionedReadError::Empty));
+    assert_eq!(region.write_versioned(&record, 0, &[0; 40]), Err(RegionError::ZeroVersion));
+    region.write_versioned(&record, 42, &[9; 40]).unwrap();
+    assert_eq!(region.read_versioned(&record, &mut data, 4).map(|r| r.version), Ok(42));
+    assert_eq!(data, [9; 40]);
+    // A writer stuck mid-update (version 0) reads as no record, never as data.
+    region.store_u64(64, 0, Ordering::Relaxed).unwrap();
+    assert_eq!(region.read_versioned(&record, &mut data, 4), Err(VersionedReadError::Empty));
+    assert!(region.check_fits(1024).is_ok() && region.check_fits(1025).is_err());
+}
+
+/// A producer publishes blocks through the handshake; a consumer that takes one sees the whole
+/// block of that round, every round, in order.
 fn flag_handshake<R: SharedRegion + Send + Sync + 'static>(region: Arc<R>, rounds: u32) {
-    const FLAG: usize = 512;
+    const BLOCK: FlaggedBlock = FlaggedBlock::new(0, 256, 512);
     let producer = {
         let region = region.clone();
         std::thread::spawn(move || {
             for round in 1..=rounds {
-                while region.load_u32(FLAG, Ordering::Acquire).unwrap() != 0 {
+                while region.is_raised(&BLOCK).unwrap() {
                     std::hint::spin_loop();
                     std::thread::yield_now();
                 }
-                let block: Vec<u8> = (0..64u32).flat_map(|i| (round * 1000 + i).to_le_bytes()).collect();
-                region.write(0, &block).unwrap();
-                region.store_u32(FLAG, round, Ordering::Release).unwrap();
+                let block: Vec<u8> = (0..64u32).flat_map(|i| (round * 1000 + i).to_ne_bytes()).collect();
+                region.publish(&[BLOCK], &block).unwrap();
             }
         })
     };
-    let mut expected = 1;
-    while expected <= rounds {
-        let round = region.load_u32(FLAG, Ordering::Acquire).unwrap();
-        if round == 0 {
+    let mut round = 1;
+    let mut block = [0u8; 256];
+    while round <= rounds {
+        if !region.take(&BLOCK, &mut block).unwrap() {
             std::hint::spin_loop();
             std::thread::yield_now();
             continue;
         }
-        assert_eq!(round, expected);
-        let mut block = [0u8; 256];
-        region.read(0, &mut block).unwrap();
         for (i, word) in block.chunks_exact(4).enumerate() {
-            assert_eq!(u32::from_le_bytes(word.try_into().unwrap()), round * 1000 + i as u32, "round {round} word {i}");
+            assert_eq!(u32::from_ne_bytes(word.try_into().unwrap()), round * 1000 + i as u32, "round {round} word {i}");
         }
-        region.store_u32(FLAG, 0, Ordering::Release).unwrap();
-        expected += 1;
+        round += 1;
     }
     producer.join().unwrap();
+}
+
+/// A writer updates a record as fast as it can; every record a reader accepts is whole.
+fn versioned_record<R: SharedRegion + Send + Sync + 'static>(region: Arc<R>, versions: u64) {
+    const RECORD: VersionedRecord = VersionedRecord::new(600, 40);
+    let writer = {
+        let region = region.clone();
+        std::thread::spawn(move || {
+            for version in 1..=versions {
+                let data: Vec<u8> = (0..8u32).flat_map(|_| (version as u32).to_ne_bytes()).collect();
+                region.write_versioned(&RECORD, version, &data).unwrap();
+            }
+        })
+    };
+    let mut data = [0u8; 32];
+    let mut accepted = 0;
+    while !writer.is_finished() || accepted == 0 {
+        match region.read_versioned(&RECORD, &mut data, 8) {
+            Ok(read) => {
+                let version = read.version;
+                accepted += 1;
+                assert!(data.chunks_exact(4).all(|w| u32::from_ne_bytes(w.try_into().unwrap()) == version as u32));
+            }
+            Err(VersionedReadError::Empty | VersionedReadError::Torn { .. }) => std::thread::yield_now(),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    writer.join().unwrap();
 }
 
 #[test]
 fn heap_region_conforms() {
     basic_access(&HeapRegion::new(1024));
+    protocols(&HeapRegion::new(1024));
     let rounds = if cfg!(miri) { 20 } else { 2000 };
     flag_handshake(Arc::new(HeapRegion::new(1024)), rounds);
+    versioned_record(Arc::new(HeapRegion::new(1024)), u64::from(rounds));
 }
 
 #[test]
@@ -103,8 +156,10 @@ mod mapped {
         let creator = MappedRegion::create(&name, 1024, &CreateOptions::default()).unwrap();
         basic_access(&creator);
         drop(creator);
+        protocols(&MappedRegion::create(&name, 1024, &CreateOptions::default()).unwrap());
         let creator = Arc::new(MappedRegion::create(&name, 1024, &CreateOptions::default()).unwrap());
-        flag_handshake(creator, 2000);
+        flag_handshake(creator.clone(), 2000);
+        versioned_record(creator, 2000);
     }
 
     #[test]
@@ -159,5 +214,48 @@ mod mapped {
         assert!(MappedRegion::open(&name, 8).is_ok());
         MappedRegion::unlink(&name).unwrap();
         MappedRegion::unlink(&name).unwrap(); // idempotent
+    }
+
+    /// The name of the object the permission test's child process opens.
+    const DENIED_ENV: &str = "ROBOWIRE_SHM_DENIED_OBJECT";
+
+    /// A process that may not open an object gets the object's mode and owner and what to do,
+    /// not a bare I/O error. Root may open anything, so as root the open runs in a child
+    /// process as `nobody`; otherwise the object is made unreadable to its own owner.
+    #[test]
+    fn permission_denied_names_mode_and_owner() {
+        if let Ok(object) = std::env::var(DENIED_ENV) {
+            // The child: report what opening gives.
+            match MappedRegion::open(&object, 8) {
+                Err(e @ ShmError::PermissionDenied { .. }) => println!("DENIED {e}"),
+                other => println!("UNEXPECTED {other:?}"),
+            }
+            return;
+        }
+        let name = name("denied");
+        let root = rustix::process::geteuid().is_root();
+        let mode = if root { 0o600 } else { 0o000 };
+        let _creator = MappedRegion::create(&name, 64, &CreateOptions { mode, unlink_on_drop: true }).unwrap();
+        let text = if root {
+            use std::os::unix::process::CommandExt;
+            let output = std::process::Command::new(std::env::current_exe().unwrap())
+                .args(["--exact", "mapped::permission_denied_names_mode_and_owner", "--nocapture", "--test-threads=1"])
+                .env(DENIED_ENV, &name)
+                .uid(65534)
+                .gid(65534)
+                .output()
+                .unwrap();
+            String::from_utf8_lossy(&output.stdout).into_owned()
+        } else {
+            match MappedRegion::open(&name, 8) {
+                Err(e @ ShmError::PermissionDenied { .. }) => format!("DENIED {e}"),
+                other => format!("UNEXPECTED {other:?}"),
+            }
+        };
+        assert!(text.contains("DENIED"), "{text}");
+        assert!(text.contains(&format!("mode {mode:04o}")), "{text}");
+        let owner = rustix::process::geteuid().as_raw();
+        assert!(text.contains(&format!("owner uid {owner}")), "{text}");
+        assert!(text.contains("0660"), "says what to do: {text}");
     }
 }

@@ -1,6 +1,7 @@
 //! A KMC wheeled chassis on a pseudo-terminal (spec `kmc-uart.md`).
 //!
-//! The simulator decodes host frames with the device-side decoder of `kmc-proto`, models the
+//! The simulator is the device end of `robowire-serial` (a pseudo-terminal) with the device-side
+//! decoder of `kmc-proto`; it models the
 //! vehicle speed as a first-order response to the commanded velocity, answers `0xB3` speed
 //! requests, battery reads (ID 0x07) and all-state reads (ID 0x06, nine slots), applies
 //! writes (speed, servo, reset), and injects faults on request: garbage bytes, dropped
@@ -12,18 +13,17 @@
 use std::collections::VecDeque;
 use std::f32::consts::PI;
 use std::io;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use kmc_proto::{
-    AfFrame, AllState, BatteryVoltage, ChassisFrame, DecoderCounters, FrameBuffer, HostFrame, HostFrameDecoder,
-    MAX_FRAME_LEN, ParamId, PcControl, Rw, VehicleSpeed,
+    AfFrame, AllState, BatteryVoltage, ChassisFrame, DecoderCounters, HostFrame, HostFrameDecoder, MAX_FRAME_LEN,
+    ParamId, PcControl, Rw, VehicleSpeed,
 };
-
-use crate::pty::Pty;
+use robowire_serial::{Pty, PtyDevice};
 
 /// Simulator settings.
 #[derive(Debug, Clone)]
@@ -158,6 +158,9 @@ pub struct ChassisSim {
     link: Option<PathBuf>,
 }
 
+/// The device end of the line, with the chassis's decoder.
+type Line = PtyDevice<HostFrameDecoder>;
+
 fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
     shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }
@@ -165,10 +168,7 @@ fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
 impl ChassisSim {
     /// Opens a pty and starts the simulator on its own thread.
     pub fn spawn(config: ChassisSimConfig) -> io::Result<Self> {
-        let pty = Pty::open()?;
-        if let Some(link) = &config.link {
-            point_link(link, pty.slave_path())?;
-        }
+        let line = Line::open(HostFrameDecoder::new, config.link.clone())?;
         let shared = Arc::new(Mutex::new(Shared {
             state: ChassisState { battery_volts: config.battery_initial_volts, ..ChassisState::default() },
             stats: ChassisSimStats::default(),
@@ -176,7 +176,7 @@ impl ChassisSim {
             garbage_pending: 0,
             drop_pending: 0,
             hang_up: false,
-            slave_path: pty.slave_path().to_path_buf(),
+            slave_path: line.pty_path().to_path_buf(),
             new_pty: None,
         }));
         let stop = Arc::new(AtomicBool::new(false));
@@ -184,7 +184,7 @@ impl ChassisSim {
         let thread = std::thread::Builder::new().name("kmc-chassis-sim".into()).spawn({
             let shared = shared.clone();
             let stop = stop.clone();
-            move || Model::new(config).run(pty, &shared, &stop)
+            move || Model::new(config).run(line, &shared, &stop)
         })?;
         Ok(Self { shared, stop, thread: Some(thread), link })
     }
@@ -212,9 +212,6 @@ impl ChassisSim {
     /// After a [`Fault::HangUp`]: plugs a new pty in and points the symlink at it.
     pub fn replug(&self) -> io::Result<PathBuf> {
         let pty = Pty::open()?;
-        if let Some(link) = &self.link {
-            point_link(link, pty.slave_path())?;
-        }
         let path = pty.slave_path().to_path_buf();
         let mut s = lock(&self.shared);
         s.slave_path = path.clone();
@@ -242,21 +239,10 @@ impl Drop for ChassisSim {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(thread) = self.thread.take() {
+            // The line (and its symlink) goes with the thread.
             let _ = thread.join();
         }
-        if let Some(link) = &self.link {
-            let _ = std::fs::remove_file(link);
-        }
     }
-}
-
-fn point_link(link: &Path, target: &Path) -> io::Result<()> {
-    match std::fs::remove_file(link) {
-        Ok(()) => {}
-        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-        Err(e) => return Err(e),
-    }
-    std::os::unix::fs::symlink(target, link)
 }
 
 /// Wheel geometry of the model: two drive motors, 0 = left, 1 = right.
@@ -282,41 +268,28 @@ impl Model {
         Self { config, last_update: Instant::now(), last_control: None, wheel_position_deg: [0.0; 2], rng }
     }
 
-    fn run(mut self, pty: Pty, shared: &Mutex<Shared>, stop: &AtomicBool) {
-        let mut rx: FrameBuffer<HostFrameDecoder, 256> = FrameBuffer::new(HostFrameDecoder::new());
-        // `None` while hung up: dropping the master is what hangs the line up.
-        let mut line = Some(pty);
-        let mut buf = [0u8; 512];
+    fn run(mut self, mut line: Line, shared: &Mutex<Shared>, stop: &AtomicBool) {
         while !stop.load(Ordering::Relaxed) {
             {
                 let mut s = lock(shared);
                 if std::mem::take(&mut s.hang_up) {
                     s.stats.hang_ups += 1;
-                    line = None;
+                    line.hang_up();
                 }
-                if let Some(new) = s.new_pty.take() {
-                    line = Some(new);
-                    rx = FrameBuffer::new(HostFrameDecoder::new());
+                if let Some(new) = s.new_pty.take()
+                    && line.plug_in(new).is_err()
+                {
+                    // The symlink could not be pointed at the new line: stay unplugged.
+                    line.hang_up();
                 }
             }
-            let Some(pty) = line.as_ref() else {
-                std::thread::sleep(POLL_INTERVAL);
-                continue;
-            };
-            let n = match pty.read_timeout(&mut buf, POLL_INTERVAL) {
-                Ok(n) => n,
-                // EIO: no client has the slave open at the moment; wait for one.
-                Err(_) => {
-                    std::thread::sleep(POLL_INTERVAL);
-                    0
-                }
-            };
+            let mut frames = Vec::new();
+            // A read error other than "no client yet" leaves the line as it is; try again.
+            let _ = line.receive(POLL_INTERVAL, |frame| frames.push(frame));
             let now = Instant::now();
             let mut responses: Vec<ChassisFrame> = Vec::new();
             let mut s = lock(shared);
             self.advance(&mut s, now);
-            let mut frames = Vec::new();
-            rx.push_all(&buf[..n], |frame| frames.push(frame));
             for frame in frames {
                 if s.received.len() == RECEIVED_LOG_LEN {
                     s.received.pop_front();
@@ -326,7 +299,7 @@ impl Model {
                     responses.push(response);
                 }
             }
-            s.stats.decoder = rx.counters();
+            s.stats.decoder = line.counters().decoder;
             let mut out = Vec::new();
             if !responses.is_empty() && s.garbage_pending > 0 {
                 let count = std::mem::take(&mut s.garbage_pending);
@@ -347,7 +320,8 @@ impl Model {
             }
             drop(s);
             if !out.is_empty() {
-                let _ = pty.write_all(&out, WRITE_TIMEOUT);
+                // A client that does not read: the answer is lost, as on a real line.
+                let _ = line.send(&out, WRITE_TIMEOUT);
             }
         }
     }

@@ -4,5 +4,4 @@
 pub mod dog;
 mod joints;
 pub mod kmc;
-pub mod pty;
 pub mod spline;

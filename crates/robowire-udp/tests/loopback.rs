@@ -5,7 +5,7 @@ use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
 use robowire_core::DatagramCodec;
-use robowire_udp::{LinkStats, UdpError, UdpLink};
+use robowire_udp::{LinkStats, Peer, UdpError, UdpLink};
 
 /// Messages are a little-endian u32; anything else is a decode error.
 #[derive(Clone, Default)]
@@ -37,7 +37,7 @@ fn peer() -> UdpSocket {
 }
 
 async fn link_to(peer: &UdpSocket) -> UdpLink<Word> {
-    UdpLink::bind("127.0.0.1:0".parse().unwrap(), peer.local_addr().unwrap(), Word).await.unwrap()
+    UdpLink::bind("127.0.0.1:0".parse().unwrap(), Peer::AnyPortOf(peer.local_addr().unwrap()), Word).await.unwrap()
 }
 
 async fn recv(link: &mut UdpLink<Word>) -> Result<u32, UdpError<BadLength>> {
@@ -78,6 +78,40 @@ async fn foreign_sources_are_dropped_and_counted_decode_errors_reported() {
 }
 
 #[tokio::test]
+async fn an_exact_peer_drops_other_ports_of_its_ip() {
+    let robot = peer();
+    let mut link =
+        UdpLink::bind("127.0.0.1:0".parse().unwrap(), Peer::Exact(robot.local_addr().unwrap()), Word).await.unwrap();
+    let to = link.local_addr().unwrap();
+    peer().send_to(&1u32.to_le_bytes(), to).unwrap(); // the robot's IP, another port
+    robot.send_to(&2u32.to_le_bytes(), to).unwrap();
+    assert_eq!(recv(&mut link).await.unwrap(), 2);
+    assert_eq!((link.stats().received, link.stats().foreign_dropped), (1, 1));
+}
+
+#[tokio::test]
+async fn the_device_side_answers_whoever_spoke_last() {
+    let mut device = UdpLink::bind("127.0.0.1:0".parse().unwrap(), Peer::Any { reply_to: None }, Word).await.unwrap();
+    assert!(matches!(device.send(&1).await, Err(UdpError::NoPeer)), "nobody to answer yet");
+    assert_eq!(device.stats().send_errors, 1);
+    let (first, second) = (peer(), peer());
+    let to = device.local_addr().unwrap();
+    first.send_to(&[1, 2, 3], to).unwrap(); // does not decode: not learned
+    first.send_to(&10u32.to_le_bytes(), to).unwrap();
+    assert!(matches!(recv(&mut device).await, Err(UdpError::Decode(BadLength(3)))));
+    assert_eq!(recv(&mut device).await.unwrap(), 10);
+    assert_eq!(device.destination(), first.local_addr().ok());
+    second.send_to(&11u32.to_le_bytes(), to).unwrap();
+    assert_eq!(recv(&mut device).await.unwrap(), 11);
+    let (mut tx, _rx) = device.into_split();
+    // From a plain thread, without the runtime.
+    std::thread::spawn(move || tx.send_now(&12).unwrap()).join().unwrap();
+    let mut buf = [0u8; 8];
+    let (n, _) = second.recv_from(&mut buf).unwrap();
+    assert_eq!(&buf[..n], &12u32.to_le_bytes(), "the reply goes to whoever spoke last");
+}
+
+#[tokio::test]
 async fn an_over_long_datagram_is_a_decode_error_not_a_truncation() {
     let robot = peer();
     let mut link = link_to(&robot).await;
@@ -106,7 +140,7 @@ async fn split_halves_work_from_two_tasks() {
 async fn a_bind_failure_names_the_address_and_lists_the_hosts_ipv4_addresses() {
     let taken = UdpSocket::bind("127.0.0.1:0").unwrap();
     let addr = taken.local_addr().unwrap();
-    let err = UdpLink::bind(addr, addr, Word).await.unwrap_err();
+    let err = UdpLink::bind(addr, Peer::Exact(addr), Word).await.unwrap_err();
     let text = err.to_string();
     assert!(matches!(err, UdpError::Bind { addr: a, .. } if a == addr), "{text}");
     assert!(text.contains(&addr.to_string()), "{text}");
@@ -114,6 +148,6 @@ async fn a_bind_failure_names_the_address_and_lists_the_hosts_ipv4_addresses() {
 
     // An address this host does not have: the classic wrong `local_ip`.
     let foreign: SocketAddr = "192.0.2.1:43988".parse().unwrap();
-    let err = UdpLink::bind(foreign, addr, Word).await.unwrap_err();
+    let err = UdpLink::bind(foreign, Peer::Exact(addr), Word).await.unwrap_err();
     assert!(err.to_string().starts_with("cannot bind UDP 192.0.2.1:43988"), "{err}");
 }

@@ -1,14 +1,8 @@
 #![doc = include_str!("../README.md")]
 
-mod decode;
-mod demo;
-mod dog_cmd;
+mod cmd;
 mod hex;
-mod kmc_cmd;
-mod lowlevel;
-mod shm_cmd;
-mod sim;
-mod zsl_decode;
+mod output;
 
 use std::process::ExitCode;
 
@@ -25,23 +19,23 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Drive every simulated device through its client API and report what was seen.
-    Demo(demo::DemoArgs),
+    Demo(cmd::demo::DemoArgs),
     /// Run a device simulator alone, for your own client to talk to.
     #[command(subcommand)]
-    Sim(sim::SimCommand),
+    Sim(cmd::sim::SimCommand),
     /// Talk to a KMC wheeled chassis over a serial port.
-    Kmc(kmc_cmd::KmcArgs),
+    Kmc(cmd::kmc::KmcArgs),
     /// Drive a ZsiBot ZSL-1 / ZSL-1W over UDP (HighLevel: stand, walk, tricks, status).
-    Dog(dog_cmd::DogArgs),
+    Dog(cmd::dog::DogArgs),
     /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
     #[command(subcommand)]
-    Shm(shm_cmd::ShmCommand),
+    Shm(cmd::shm::ShmCommand),
     /// Decode frames or messages from hex and print them.
     #[command(subcommand)]
-    Decode(decode::DecodeCommand),
+    Decode(cmd::decode::DecodeCommand),
     /// Encode a message from JSON and print its bytes in hex.
     #[command(subcommand)]
-    Encode(decode::EncodeCommand),
+    Encode(cmd::encode::EncodeCommand),
 }
 
 fn main() -> ExitCode {
@@ -50,17 +44,18 @@ fn main() -> ExitCode {
     sigpipe::reset();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Demo(args) => demo::run(&args),
-        Command::Sim(command) => sim::run(command),
-        Command::Kmc(args) => kmc_cmd::run(args),
-        Command::Dog(args) => dog_cmd::run(args),
-        Command::Shm(command) => shm_cmd::run(&command),
-        Command::Decode(command) => decode::run(&command),
-        Command::Encode(command) => decode::run_encode(&command),
+        Command::Demo(args) => cmd::demo::run(&args),
+        Command::Sim(command) => cmd::sim::run(command),
+        Command::Kmc(args) => cmd::kmc::run(args),
+        Command::Dog(args) => cmd::dog::run(args),
+        Command::Shm(command) => cmd::shm::run(&command),
+        Command::Decode(command) => cmd::decode::run(&command),
+        Command::Encode(command) => cmd::encode::run(&command),
     };
     match result {
         Ok(code) => code,
         Err(error) => {
+            // The error and its causes, each once: "cannot open serial port X: No such file …".
             eprintln!("error: {error:#}");
             ExitCode::FAILURE
         }

@@ -146,3 +146,18 @@ fn demo_lowcmd_loop_and_json_output() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("caught by the CRC") && stderr.contains("\nsummary\n"), "the report goes to stderr");
 }
+
+#[test]
+fn error_messages_say_each_cause_once_and_what_was_expected() {
+    let missing = robowire().args(["kmc", "--port", "/dev/robowire-nonexistent", "speed"]).output().unwrap();
+    let err = String::from_utf8_lossy(&missing.stderr);
+    assert!(!missing.status.success());
+    assert_eq!(err.matches("No such file or directory").count(), 1, "the cause once: {err}");
+    assert!(err.contains("/dev/robowire-nonexistent"), "{err}");
+
+    let short = robowire().args(["decode", "lowstate", "--cdr", "0001"]).output().unwrap();
+    let err = String::from_utf8_lossy(&short.stderr);
+    assert!(!short.status.success());
+    assert!(err.contains("4-byte encapsulation header") && err.contains("2 bytes given"), "{err}");
+    assert!(!err.contains("1180"), "not the struct image's length: {err}");
+}

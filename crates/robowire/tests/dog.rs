@@ -69,6 +69,8 @@ fn stand_move_refuse_status_and_lie_down() {
     let json: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
     assert_eq!(json["mode"], 18);
     assert!(json["position_m"][0].as_f64().unwrap() > 0.1, "{json}");
+    // A state without error says so (not "Queued", a call's return code).
+    assert_eq!((json["error_word"].as_u64(), json["error_name"].as_str()), (Some(0), Some("none")), "{json}");
 
     let lie = dog(&port, &["lie"]);
     assert!(text(&lie).contains("robot reports mode 51"), "{}", text(&lie));

@@ -3,9 +3,12 @@
 #![forbid(unsafe_code)]
 
 pub mod codec;
+#[cfg(feature = "fuzzing")]
 #[doc(hidden)]
-pub mod harness;
+pub mod decode_roundtrip;
 pub mod rules;
+#[cfg(feature = "serde")]
+mod serde_impl;
 pub mod shm;
 pub mod udp;
 
@@ -13,5 +16,5 @@ pub use zerocopy;
 
 pub use shm::{
     ConsumerIndex, JointControl, JointFaults, JointFlags, JointIndex, JointState, Leg, LegControl, LegState, NavImu,
-    SplineCommandBlock, SplineData, SplineStateBlock,
+    NavImuSample, SplineCommandBlock, SplineData, SplineStateBlock,
 };

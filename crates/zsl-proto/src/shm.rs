@@ -5,7 +5,14 @@
 //! The vendor structs are `packed`, but every field is 4 or 8 bytes wide at a multiple of its
 //! size, so these little-endian zerocopy types (alignment 1, no padding) have the same bytes.
 //! Leg order is FR, FL, RR, RL; joint order abad, hip, knee, foot.
+//!
+//! The handshake (spec §6) is declared here as layouts for the shared-memory transport:
+//! [`SPLINE_COMMAND`] (the controller writes the legs and raises `cmd.consumer_flags[CONTROL]`;
+//! the daemon takes them), [`SPLINE_STATE`] (the daemon writes the leg states and raises both
+//! `state.consumer_flags`; each consumer takes them with its own flag) and [`IMU_RECORD`] (the
+//! timestamp is the record's version).
 
+use robowire_core::shm::{FlaggedBlock, VersionedRecord};
 use zerocopy::little_endian::{F32, I32, U32, U64};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 
@@ -32,6 +39,26 @@ pub const STATE_FLAG_OTHER_OFFSET: usize = 604;
 pub const CMD_LEGS_LEN: usize = 336;
 /// Bytes of leg states at the start of the state block (4 × 64).
 pub const STATE_LEGS_LEN: usize = 256;
+/// Bytes of `spline_data` a `/spline_shm` region must hold.
+pub const SPLINE_DATA_LEN: usize = 608;
+/// Bytes of `nav_imu` an `/imu_shm` region must hold.
+pub const NAV_IMU_LEN: usize = 48;
+
+/// The command handshake: the four [`LegControl`]s (336 bytes at 0), taken by the daemon with
+/// `cmd.consumer_flags[CONTROL]` (offset 336). `consumer_flags[OTHER]` (340) is never written by a
+/// client.
+pub const SPLINE_COMMAND: FlaggedBlock = FlaggedBlock::new(0, CMD_LEGS_LEN, CMD_FLAG_CONTROL_OFFSET);
+
+/// The state handshake as each consumer sees it: the four [`LegState`]s (256 bytes at 344), with
+/// `state.consumer_flags[CONTROL]` (600) and `[OTHER]` (604). The daemon raises both.
+pub const SPLINE_STATE: [FlaggedBlock; 2] = [
+    FlaggedBlock::new(STATE_OFFSET, STATE_LEGS_LEN, STATE_FLAG_CONTROL_OFFSET),
+    FlaggedBlock::new(STATE_OFFSET, STATE_LEGS_LEN, STATE_FLAG_OTHER_OFFSET),
+];
+
+/// The IMU record at offset 0 of `/imu_shm`: `timestamp_ns` is its version (0 while a robowire
+/// producer updates it), the 40 bytes after it the sample.
+pub const IMU_RECORD: VersionedRecord = VersionedRecord::new(0, NAV_IMU_LEN);
 
 /// Legs, in the vendor's order (`LEG_FRONT_RIGHT` … `LEG_BACK_LEFT`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -91,6 +118,22 @@ pub enum ConsumerIndex {
     Control = 0,
     /// `CONSUMER_OTHER` (1): other modules.
     Other = 1,
+}
+
+impl ConsumerIndex {
+    /// The state handshake of this consumer (one of [`SPLINE_STATE`]).
+    pub const fn state(self) -> FlaggedBlock {
+        SPLINE_STATE[self as usize]
+    }
+
+    /// The command block with this consumer's flag ([`SPLINE_COMMAND`] for the control consumer,
+    /// the one the daemon takes).
+    pub const fn command(self) -> FlaggedBlock {
+        match self {
+            Self::Control => SPLINE_COMMAND,
+            Self::Other => SPLINE_COMMAND.for_consumer(CMD_FLAG_OTHER_OFFSET),
+        }
+    }
 }
 
 /// One joint's command, 20 bytes (spec §3.1).
@@ -190,6 +233,13 @@ impl SplineCommandBlock {
         for leg in &mut self.legs {
             leg.flags = 1.into();
         }
+    }
+
+    /// A copy with `flags = 1` on every leg: what a controller writes.
+    pub fn normalized(&self) -> Self {
+        let mut copy = *self;
+        copy.normalize();
+        copy
     }
 }
 
@@ -327,12 +377,21 @@ pub struct SplineData {
     pub state: SplineStateBlock,
 }
 
-/// One IMU sample, `nav_imu`, 48 bytes at offset 0 of `/imu_shm` (spec §5).
+/// One IMU record, `nav_imu`, 48 bytes at offset 0 of `/imu_shm` (spec §5): the timestamp
+/// (the record's version, [`IMU_RECORD`]), then the sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
 #[repr(C)]
 pub struct NavImu {
     /// Sample time, ns (the header's `size_t`; clock undocumented).
     pub timestamp_ns: U64,
+    /// The sample.
+    pub sample: NavImuSample,
+}
+
+/// The 40 bytes of a `nav_imu` after its timestamp.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C)]
+pub struct NavImuSample {
     /// Acceleration x, y, z, m/s².
     pub acc: [F32; 3],
     /// Angular rate x, y, z, rad/s.
@@ -353,13 +412,16 @@ const _: () = {
     assert!(size_of::<LegState>() == 64);
     assert!(size_of::<SplineStateBlock>() == 264);
     assert!(offset_of!(SplineStateBlock, consumer_flags) == STATE_LEGS_LEN);
-    assert!(size_of::<SplineData>() == 608);
+    assert!(size_of::<SplineData>() == SPLINE_DATA_LEN);
+    assert!(size_of::<[LegControl; 4]>() == CMD_LEGS_LEN);
+    assert!(size_of::<[LegState; 4]>() == STATE_LEGS_LEN);
+    assert!(SPLINE_STATE[1].end() == SPLINE_DATA_LEN);
     assert!(offset_of!(SplineData, state) == STATE_OFFSET);
     assert!(STATE_OFFSET + STATE_LEGS_LEN == STATE_FLAG_CONTROL_OFFSET);
-    assert!(size_of::<NavImu>() == 48);
-    assert!(offset_of!(NavImu, acc) == 8);
-    assert!(offset_of!(NavImu, gyro) == 20);
-    assert!(offset_of!(NavImu, q) == 32);
+    assert!(size_of::<NavImu>() == NAV_IMU_LEN);
+    assert!(offset_of!(NavImu, sample) == 8);
+    assert!(8 + offset_of!(NavImuSample, gyro) == 20);
+    assert!(8 + offset_of!(NavImuSample, q) == 32);
 };
 
 #[cfg(test)]

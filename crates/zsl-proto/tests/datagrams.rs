@@ -73,3 +73,26 @@ fn typed_errors() {
     let empty = low.update_lenient(&[]).unwrap();
     assert!(empty.header_ok && low.has_motor_data(), "a 0-byte datagram changes nothing");
 }
+
+/// The JSON of `robowire decode zsl --json`: units in the keys, floats in their shortest form,
+/// a state without error says so (not the name of a call's return code).
+#[test]
+fn datagrams_as_json() {
+    use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model};
+    let command =
+        HighLevelCommand::decode(&HighLevelCommand::move_velocity(0.4, 0.0, -1.5).encode(Model::Zsl1W)).unwrap().0;
+    let json = serde_json::to_value(command).unwrap();
+    assert_eq!(json["model"], "zsl-1w");
+    assert_eq!(json["mode_name"], "Move");
+    assert!(serde_json::to_string(&command).unwrap().contains(r#""vx_mps":0.4,"#), "shortest f32 text");
+    assert_eq!(json["yaw_rate_radps"], -1.5);
+
+    let mut state = HighLevelState { header: HIGH_LEVEL_STATE_HEADER, ..HighLevelState::default() };
+    assert_eq!(serde_json::to_value(state).unwrap()["error_name"], "none");
+    state.error_word = 0x3011.into();
+    state.position[0] = f32::NAN.into();
+    let json = serde_json::to_value(state).unwrap();
+    assert_eq!((json["error_word"].as_u64(), json["error_name"].as_str()), (Some(0x3011), Some("MotorFault")));
+    assert_eq!(json["position_m"][0], "NaN");
+    assert_eq!(json["joint_angle_rad"]["knee"].as_array().map(Vec::len), Some(4));
+}

@@ -24,11 +24,9 @@ use criterion::Criterion;
 #[path = "../../../benches/timing.rs"]
 mod timing;
 use robowire_shm::{CreateOptions, MappedRegion, SharedRegion};
-use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use robowire_sim::spline::{CommandUpdate, SplineDaemon, SplineSim, SplineSimConfig};
 use timing::{percentiles, time_each};
-use zsl::{
-    CommandUpdate, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineDaemon, SplineStateBlock,
-};
+use zsl::{JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineStateBlock};
 use zsl_proto::zerocopy::IntoBytes;
 
 const ECHO_ENV: &str = "ROBOWIRE_SPLINE_ECHO";

@@ -22,8 +22,11 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use robowire_sim::dog::{DogSim, DogSimConfig};
-use zsl::udp::{ClientOptions, ControlMode, HighLevel, HighLevelState, LowLevelCommand, LowLevelState, MotorCommand};
-use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, MAGIC_ZSL1, Model};
+use zsl::udp::{ClientOptions, ControlMode, HighLevel};
+use zsl_proto::udp::{
+    HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState, MAGIC_ZSL1, Model,
+    MotorCommand,
+};
 
 #[path = "../../../benches/timing.rs"]
 mod timing;

@@ -4,10 +4,7 @@
 pub mod spline;
 pub mod udp;
 
-pub use spline::{
-    CommandUpdate, ImuError, ImuReader, ImuSample, ImuWriter, SplineClient, SplineClientCounters, SplineDaemon,
-    SplineDaemonCounters, SplineError,
-};
+pub use spline::{ImuError, ImuReader, ImuSample, SplineClient, SplineClientCounters, SplineError, SplineFlags};
 pub use zsl_proto::shm::{
     ConsumerIndex, JointControl, JointFlags, JointIndex, Leg, SplineCommandBlock, SplineStateBlock,
 };

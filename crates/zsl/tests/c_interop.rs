@@ -10,9 +10,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use robowire_shm::CreateOptions;
+use robowire_sim::spline::{CommandUpdate, SplineDaemon};
 use zsl::spline::SplineError;
-use zsl::{CommandUpdate, JointControl, JointFlags, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineDaemon};
-use zsl_proto::shm::{JointState, LegControl, LegState, NavImu, SplineData, SplineStateBlock};
+use zsl::{JointControl, JointFlags, JointIndex, Leg, SplineClient, SplineCommandBlock};
+use zsl_proto::shm::{JointState, LegControl, LegState, NavImu, NavImuSample, SplineData, SplineStateBlock};
 
 /// Builds tests/c/spline_peer.c with the system C compiler (`$CC`, else `cc`), once for all
 /// tests of this file (they run in parallel and must not rebuild it under each other's feet).
@@ -82,9 +83,9 @@ fn c_layout_matches_rust_layout() {
         ("spline_data.state", offset_of!(SplineData, state) as isize, size_of::<SplineStateBlock>()),
         ("nav_imu", -1, size_of::<NavImu>()),
         ("nav_imu.timestamp", offset_of!(NavImu, timestamp_ns) as isize, 8),
-        ("nav_imu.acc", offset_of!(NavImu, acc) as isize, 12),
-        ("nav_imu.gyro", offset_of!(NavImu, gyro) as isize, 12),
-        ("nav_imu.q", offset_of!(NavImu, q) as isize, 16),
+        ("nav_imu.acc", (offset_of!(NavImu, sample) + offset_of!(NavImuSample, acc)) as isize, 12),
+        ("nav_imu.gyro", (offset_of!(NavImu, sample) + offset_of!(NavImuSample, gyro)) as isize, 12),
+        ("nav_imu.q", (offset_of!(NavImu, sample) + offset_of!(NavImuSample, q)) as isize, 16),
     ];
     let got: Vec<(String, isize, usize)> = text
         .lines()

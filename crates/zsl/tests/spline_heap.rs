@@ -1,16 +1,20 @@
-//! Client, daemon and IMU on a heap region: the protocol without the operating system (these
-//! tests also run under Miri).
+//! The controller's side (this crate) against the daemon's side (`robowire-sim`) and the IMU on a
+//! heap region: the protocol without the operating system (these tests also run under Miri).
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use robowire_shm::{HeapRegion, SharedRegion};
-use zsl::spline::{ImuSample, ImuWriter, SPLINE_DATA_LEN};
+use robowire_sim::spline::{CommandUpdate, ImuWriter, SplineDaemon};
 use zsl::{
-    CommandUpdate, ConsumerIndex, ImuError, ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock,
-    SplineDaemon, SplineError, SplineStateBlock,
+    ConsumerIndex, ImuError, ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineError,
+    SplineStateBlock,
 };
+use zsl_proto::shm::{NavImu, NavImuSample, SPLINE_COMMAND, SPLINE_DATA_LEN};
+
+/// The daemon's command flag.
+const COMMAND_FLAG: usize = SPLINE_COMMAND.flag;
 
 fn region() -> Arc<HeapRegion> {
     Arc::new(HeapRegion::new(10240))
@@ -36,7 +40,7 @@ fn command_and_state_round_trip() {
     assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Fresh);
     assert_eq!(daemon.command().joint(Leg::RearLeft, JointIndex::Knee).p_des.get(), 0.5);
     assert_eq!(daemon.command().legs[2].flags.get(), 1, "leg flags are always 1");
-    assert_eq!(shared.load_u32(336, Ordering::Acquire), Ok(0), "the daemon cleared the control flag");
+    assert_eq!(shared.load_u32(COMMAND_FLAG, Ordering::Acquire), Ok(0), "the daemon cleared the control flag");
 
     assert_eq!(client.try_read_state().unwrap(), None, "no state published yet");
     let mut state = SplineStateBlock::default();
@@ -81,11 +85,11 @@ fn non_finite_commands_are_refused_on_both_sides() {
         Err(SplineError::NonFinite { leg: Leg::RearRight, joint: JointIndex::Knee, field: "kd" }) => {}
         other => panic!("{other:?}"),
     }
-    assert_eq!(shared.load_u32(336, Ordering::Acquire), Ok(0), "nothing published");
+    assert_eq!(shared.load_u32(COMMAND_FLAG, Ordering::Acquire), Ok(0), "nothing published");
     // A foreign client that writes NaN anyway: the daemon ignores the command.
     use zsl_proto::zerocopy::IntoBytes;
-    shared.write(0, &bad.as_bytes()[..336]).unwrap();
-    shared.store_u32(336, 1, Ordering::Release).unwrap();
+    shared.write(SPLINE_COMMAND.offset, bad.legs.as_bytes()).unwrap();
+    shared.store_u32(COMMAND_FLAG, 1, Ordering::Release).unwrap();
     let mut daemon = SplineDaemon::new(shared).unwrap();
     assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Rejected);
     assert_eq!(*daemon.command(), SplineCommandBlock::default());
@@ -117,7 +121,7 @@ fn regions_too_small_are_refused() {
 #[test]
 fn imu_writer_racing_the_reader_never_yields_a_torn_sample() {
     let shared = region();
-    let mut reader = ImuReader::new(shared.clone()).unwrap().with_max_attempts(1000);
+    let mut reader = ImuReader::new(shared.clone()).unwrap().with_max_attempts(100);
     assert!(matches!(reader.read(), Err(ImuError::NoSample)));
     let stop = Arc::new(AtomicBool::new(false));
     let writer = {
@@ -127,20 +131,14 @@ fn imu_writer_racing_the_reader_never_yields_a_torn_sample() {
             let mut k = 1u64;
             while !stop.load(Ordering::Relaxed) {
                 let v = k as f32;
-                writer
-                    .publish(&ImuSample {
-                        timestamp_ns: k,
-                        acc_mps2: [v; 3],
-                        gyro_radps: [v; 3],
-                        quaternion_wxyz: [v; 4],
-                    })
-                    .unwrap();
+                let sample = NavImuSample { acc: [v.into(); 3], gyro: [v.into(); 3], q: [v.into(); 4] };
+                writer.publish(&NavImu { timestamp_ns: k.into(), sample }).unwrap();
                 k += 1;
             }
             k
         })
     };
-    let reads = if cfg!(miri) { 50 } else { 200_000 };
+    let reads = if cfg!(miri) { 50 } else { 20_000 };
     let mut consistent = 0;
     for _ in 0..reads {
         match reader.read() {

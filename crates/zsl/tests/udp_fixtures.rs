@@ -6,18 +6,19 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
+use robowire_fixtures::zsl1::{frames, motor_command, vendor_call};
 use serde_json::Value;
-use zsl::udp::{CallError, ClientOptions, HighLevel, HighLevelState, LowLevel, Model, ReturnCode, StateDecoding};
-use zsl_proto::harness::{fixture_motor_command, vendor_call};
-use zsl_proto::udp::HIGH_LEVEL_STATE_HEADER;
+use zsl::udp::{
+    CallError, ClientOptions, ControlMode, HighLevel, LowLevel, Model, MotorCommand, ReturnCode, StateDecoding,
+};
+use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
 fn fixtures() -> Vec<Value> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/zsl1/frames.json");
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    frames().unwrap()
 }
 
 fn hex(s: &str) -> Vec<u8> {
-    (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap()).collect()
+    robowire_fixtures::hex_bytes(s).unwrap()
 }
 
 /// A scripted dog: receives commands, sends the state it is told to.
@@ -86,7 +87,9 @@ async fn high_level(dog: &ScriptedDog, model: Model) -> HighLevel {
 async fn report(dog: &ScriptedDog, client: &HighLevel, mode: u32, error_word: u32) {
     dog.send(&high_state(mode, error_word).encode(), client.local_addr());
     let seen = client
-        .wait_for_state(Duration::from_secs(2), |s| s.control_mode.get() == mode && s.error_word.get() == error_word)
+        .wait_for_state(Duration::from_secs(2), |s| {
+            s.body.mode == ControlMode::from_raw(mode) && s.body.error.map_or(0, ReturnCode::raw) == error_word
+        })
         .await;
     assert!(seen.is_some(), "the client sees mode {mode}");
 }
@@ -225,7 +228,7 @@ async fn every_low_level_call_in_the_fixtures_puts_its_captured_datagram_on_the_
             assert_eq!(idle, expected, "{api}");
         } else {
             assert!(vendor_call(api).is_some_and(|(name, ..)| name == "sendMotorCmd"));
-            let motor = fixture_motor_command(api).unwrap();
+            let motor = MotorCommand::from(&motor_command(api).unwrap());
             client.send_motor_command(&motor).await.unwrap();
             assert_eq!(dog.next_different(&idle), expected, "{api}");
         }

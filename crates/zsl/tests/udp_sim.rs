@@ -6,11 +6,9 @@ use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
 use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
-use zsl::udp::{
-    CallError, ClientOptions, Connection, ControlMode, HighLevel, HighLevelState, LowLevel, MotorCommand, ReturnCode,
-};
+use zsl::udp::{CallError, ClientOptions, Connection, ControlMode, HighLevel, LowLevel, MotorCommand, ReturnCode};
 use zsl_proto::rules::ArgumentError;
-use zsl_proto::udp::HIGH_LEVEL_STATE_HEADER;
+use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
 const WAIT: Duration = Duration::from_secs(3);
 
@@ -48,11 +46,11 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 
     client.move_velocity(0.5, 0.0, 0.0).await.unwrap();
     assert!(client.wait_for_mode(ControlMode::Move, WAIT).await.is_some());
-    let moving = client.wait_for_state(WAIT, |s| s.body_velocity[0].get() > 0.45).await;
+    let moving = client.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0] > 0.45).await;
     assert!(moving.is_some(), "the body reaches the commanded speed");
     let walking = client.position().unwrap()[0];
     assert!(
-        client.wait_for_state(WAIT, |s| s.position[0].get() > walking + 0.1).await.is_some(),
+        client.wait_for_state(WAIT, |s| s.body.position_m[0] > walking + 0.1).await.is_some(),
         "the position integrates the walk"
     );
     assert_eq!(
@@ -61,7 +59,7 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
         "lying down while walking is refused (robot is running)"
     );
     client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
-    assert!(client.wait_for_state(WAIT, |s| s.body_velocity[0].get().abs() < 0.05).await.is_some());
+    assert!(client.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0].abs() < 0.05).await.is_some());
     let walked = client.position().unwrap()[0] - start[0];
     assert!(walked > 0.1, "the dog moved forward: {walked} m");
     let sideways = client.position().unwrap()[1] - start[1];
@@ -71,7 +69,7 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
     assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());
     wait_until(|| sim.snapshot().dog.activity() == Activity::Lying).await;
     let body = client.body().unwrap();
-    assert!(body.battery_percent <= 100 && body.error == ReturnCode::Queued);
+    assert!(body.battery_percent <= 100 && body.error.is_none());
     let stats = client.stats();
     assert_eq!((stats.link.decode_errors, stats.link.foreign_dropped, stats.disconnects), (0, 0, 0));
     assert!(stats.link.sent > 100, "the 2 ms stream runs: {stats:?}");
@@ -82,7 +80,7 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 async fn arguments_are_checked_before_anything_is_sent() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
-    let latched = client.latched_command().await;
+    let latched = client.wire_command().await;
     let refused = |r: Result<(), CallError>| matches!(r, Err(CallError::Argument(_)));
     for (vx, vy, wz) in [
         (0.04, 0.0, 0.0),
@@ -103,7 +101,7 @@ async fn arguments_are_checked_before_anything_is_sent() {
     ));
     assert!(refused(client.attitude_control(0.0, 0.61, 0.0, 0.0).await));
     assert!(refused(client.two_leg_stand(0.1, 0.0).await));
-    assert_eq!(client.latched_command().await, latched, "nothing was latched");
+    assert_eq!(client.wire_command().await, latched, "nothing was latched");
     assert_eq!(client.move_velocity(f32::NAN, 0.0, 0.0).await.unwrap_err().return_code(), ReturnCode::SpeedTooLarge);
 
     // The band edges are inside; |v| ≤ 1e-6 is zero.
@@ -127,7 +125,7 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
     assert_eq!(*events.borrow_and_update(), Connection::Disconnected);
     assert!(!client.check_connection());
     assert_eq!(client.state(), None, "no state instead of stale or zero values");
-    let latched = client.latched_command().await;
+    let latched = client.wire_command().await;
     assert_eq!(latched.control_mode(), ControlMode::Move, "same mode");
     assert_eq!((latched.vx.get(), latched.yaw_rate.get()), (0.0, 0.0), "the latched motion became a stop");
     let sent = client.stats().link.sent;
@@ -146,7 +144,7 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
         stats.state_gap
     );
     assert!(stats.state_gap.p50_us < 10_000, "the dog streams every 2 ms: {:?}", stats.state_gap);
-    assert_eq!(client.latched_command().await.vx.get(), 0.0, "a stale motion never resumes");
+    assert_eq!(client.wire_command().await.vx.get(), 0.0, "a stale motion never resumes");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -200,8 +198,8 @@ async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
     let mut short = vec![0xde, 0xad, 0xbe, 0xef];
     short.extend_from_slice(&1.0f32.to_le_bytes());
     dog.send_to(&short, to).unwrap();
-    let merged = client.wait_for_state(WAIT, |s| s.quaternion[0].get() == 1.0).await.unwrap();
-    assert_eq!(merged.mode(), ControlMode::Move, "the rest of the state is kept");
+    let merged = client.wait_for_state(WAIT, |s| s.body.imu.quaternion_wxyz[0] == 1.0).await.unwrap();
+    assert_eq!(merged.body.mode, ControlMode::Move, "the rest of the state is kept");
     dog.send_to(&[0u8; 561], to).unwrap();
     tokio::time::sleep(Duration::from_millis(50)).await;
     let stats = client.stats();
@@ -215,10 +213,10 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(Duration::from_millis(300))).await;
 
     sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
-    assert!(client.wait_for_state(WAIT, |s| s.error() == ReturnCode::MotorFault).await.is_some());
+    assert!(client.wait_for_state(WAIT, |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
     assert!(matches!(client.jump().await, Err(CallError::SelfCheck(ReturnCode::MotorFault))));
     tokio::time::sleep(Duration::from_millis(20)).await;
-    assert_eq!(client.latched_command().await.control_mode(), ControlMode::Passive, "the stream forces passive");
+    assert_eq!(client.wire_command().await.control_mode(), ControlMode::Passive, "the stream forces passive");
     wait_until(|| sim.snapshot().dog.mode() == ControlMode::Passive).await;
     sim.clear_faults();
 
@@ -232,7 +230,7 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     assert!(client.wait_connected(WAIT).await);
 
     sim.inject(DogFault::SdkMismatch);
-    assert!(client.wait_for_state(WAIT, |s| s.sdk_mismatch.get() == 1).await.is_some());
+    assert!(client.wait_for_state(WAIT, |s| s.sdk_mismatch).await.is_some());
     tokio::time::sleep(Duration::from_millis(20)).await;
     assert!(client.halted().await, "the stream stops for good, like the vendor's");
     assert!(matches!(client.stand_up().await, Err(CallError::SdkMismatch)));
@@ -257,19 +255,17 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
 
     let stand = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
     low.send_motor_command(&stand).await.unwrap();
-    let near = |legs: &[zsl_proto::zerocopy::little_endian::F32; 4], target: f32| {
-        legs.iter().all(|q| (q.get() - target).abs() < 0.02)
-    };
-    let reached = low.wait_for_state(WAIT, |s| near(&s.motor.q[1], 0.8) && near(&s.motor.q[2], -1.5)).await;
+    let near = |legs: &[f32; 4], target: f32| legs.iter().all(|q| (q - target).abs() < 0.02);
+    let reached = low.wait_for_state(WAIT, |s| near(&s.motor.q_rad[1], 0.8) && near(&s.motor.q_rad[2], -1.5)).await;
     assert!(reached.is_some(), "the PD joints reach the targets: {:?}", low.motor_state());
     assert!(
-        high.wait_for_state(WAIT, |s| (s.joint_angle[2][0].get() + 1.5).abs() < 0.02).await.is_some(),
+        high.wait_for_state(WAIT, |s| (s.joints.position_rad.knee[0] + 1.5).abs() < 0.02).await.is_some(),
         "the HighLevel state shows the same joints"
     );
     let mut nan = stand;
-    nan.kp[0][0] = f32::NAN.into();
+    nan.kp[0][0] = f32::NAN;
     assert!(matches!(low.send_motor_command(&nan).await, Err(CallError::Argument(ArgumentError::NonFinite(_)))));
-    assert_eq!(low.latched_command().await.motor, stand);
+    assert_eq!(MotorCommand::from(&low.wire_command().await.motor), stand);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -279,13 +275,13 @@ async fn a_zsl1w_crawls_and_its_wheels_turn() {
     let options = options_to(sim.high_level_addr()).with_model(zsl::udp::Model::Zsl1W);
     let client = standing_dog(&sim, options).await;
     client.crawl(0.5, 0.0, 0.0).await.unwrap();
-    let rolling = client.wait_for_state(WAIT, |s| s.joint_angle[3][0].get() > 1.0).await;
+    let rolling = client.wait_for_state(WAIT, |s| s.joints.position_rad.foot[0] > 1.0).await;
     assert!(rolling.is_some(), "the foot (wheel) joints integrate the forward speed");
-    assert_eq!(client.latched_command().await.action_code(), zsl::udp::Action::Crawl);
+    assert_eq!(client.wire_command().await.action_code(), zsl::udp::Action::Crawl);
     client.cancel_crawl().await.unwrap();
-    assert_eq!(client.latched_command().await.action_code(), zsl::udp::Action::None);
+    assert_eq!(client.wire_command().await.action_code(), zsl::udp::Action::None);
     client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
-    assert_eq!(client.state().unwrap().sdk_mismatch.get(), 0, "the right magic raises no mismatch");
+    assert!(!client.state().unwrap().sdk_mismatch, "the right magic raises no mismatch");
 
     let zsl1 = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
     assert!(matches!(zsl1.crawl(0.5, 0.0, 0.0).await, Err(CallError::WrongModel { .. })));
@@ -298,8 +294,8 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
     let low = LowLevel::connect(options).await.unwrap();
     assert!(low.wait_for_state(WAIT, |_| true).await.is_some());
     let mut moving = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
-    moving.qd_des[1] = [0.5.into(); 4];
-    moving.tau_ff[2] = [2.0.into(); 4];
+    moving.qd_des_radps[1] = [0.5; 4];
+    moving.tau_ff_nm[2] = [2.0; 4];
     low.send_motor_command(&moving).await.unwrap();
 
     sim.inject(DogFault::Silence);
@@ -308,9 +304,13 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
         .unwrap()
         .unwrap();
     assert_eq!(low.motor_state(), None);
-    let latched = low.latched_command().await.motor;
-    assert!(latched.qd_des.iter().flatten().all(|v| v.get() == 0.0), "velocity targets zeroed");
-    assert_eq!((latched.q_des, latched.kp, latched.tau_ff), (moving.q_des, moving.kp, moving.tau_ff), "hold kept");
+    let latched = MotorCommand::from(&low.wire_command().await.motor);
+    assert!(latched.qd_des_radps.iter().flatten().all(|&v| v == 0.0), "velocity targets zeroed");
+    assert_eq!(
+        (latched.q_des_rad, latched.kp, latched.tau_ff_nm),
+        (moving.q_des_rad, moving.kp, moving.tau_ff_nm),
+        "hold kept"
+    );
     sim.clear_faults();
     assert!(low.wait_for_state(WAIT, |_| true).await.is_some(), "reconnects");
 }

@@ -5,11 +5,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use lowcmd_proto::json::{from_json, to_json};
 use lowcmd_proto::{CdrEncoding, LowCmd, LowState, Message};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use super::Outcome;
+use super::{Outcome, to_json};
 use crate::{hex_decode, hex_encode, workspace_root};
 
 /// The Unitree vector file.
@@ -27,12 +28,31 @@ fn str_of<'a>(v: &'a Value, key: &str) -> anyhow::Result<&'a str> {
     v[key].as_str().with_context(|| format!("vector field {key:?} missing"))
 }
 
+/// Whether two JSON values say the same: the same keys and lengths, numbers equal as `f32`
+/// (the vectors write each float's exact value, robowire its shortest text), strings equal.
+pub(crate) fn same_fields(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same_fields(v, w)))
+        }
+        (Value::Array(x), Value::Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(v, w)| same_fields(v, w)),
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => x as f32 == y as f32 || x == y,
+            _ => false,
+        },
+        (x, y) => x == y,
+    }
+}
+
 /// A message vector: fields → image, image → fields, CRC.
-fn check_message<M: Message + PartialEq + core::fmt::Debug>(vector: &Value) -> anyhow::Result<Vec<String>> {
+fn check_message<M>(vector: &Value) -> anyhow::Result<Vec<String>>
+where
+    M: Message + PartialEq + core::fmt::Debug + Serialize + DeserializeOwned,
+{
     let mut problems = Vec::new();
     let packed = hex_decode(str_of(vector, "packed_hex")?)?;
     let crc = vector["crc"].as_u64().context("crc")?;
-    match from_json::<M>(&vector["fields"]) {
+    match serde_json::from_value::<M>(vector["fields"].clone()) {
         Ok(message) => {
             let image = message.sealed();
             if image.as_bytes() != packed.as_slice() {
@@ -46,8 +66,7 @@ fn check_message<M: Message + PartialEq + core::fmt::Debug>(vector: &Value) -> a
     }
     match M::decode_image(&packed) {
         Ok(decoded) => {
-            let json = to_json(&decoded);
-            if json != vector["fields"] {
+            if !same_fields(&to_json(&decoded)?, &vector["fields"]) {
                 problems.push("the image decodes to other fields".into());
             }
         }
@@ -57,12 +76,15 @@ fn check_message<M: Message + PartialEq + core::fmt::Debug>(vector: &Value) -> a
 }
 
 /// A CDR vector: its source message encodes to the payload, and the payload decodes to it.
-fn check_cdr<M: Message + PartialEq + core::fmt::Debug>(vector: &Value, source: &Value) -> anyhow::Result<Vec<String>> {
+fn check_cdr<M>(vector: &Value, source: &Value) -> anyhow::Result<Vec<String>>
+where
+    M: Message + PartialEq + core::fmt::Debug + DeserializeOwned,
+{
     let mut problems = Vec::new();
     let payload = hex_decode(str_of(vector, "cdr_hex")?)?;
     let encoding = CdrEncoding::from_header(payload.get(..4).context("short payload")?.try_into()?)
         .context("unknown encapsulation in vector")?;
-    let message: M = from_json(&source["fields"]).map_err(|e| anyhow::anyhow!("source fields: {e}"))?;
+    let message: M = serde_json::from_value(source["fields"].clone()).context("source fields")?;
     let mut out = vec![0u8; M::cdr_len(encoding)];
     message.encode_cdr(encoding, &mut out)?;
     if out != payload {
@@ -128,6 +150,17 @@ pub fn check(path: &Path) -> anyhow::Result<Vec<Outcome>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fields_compare_as_f32() {
+        let exact: Value = serde_json::from_str(r#"{"q":[0.4000000059604645,"NaN"],"mode":1}"#).unwrap();
+        let shortest: Value = serde_json::from_str(r#"{"q":[0.4,"NaN"],"mode":1}"#).unwrap();
+        assert!(same_fields(&exact, &shortest));
+        let other: Value = serde_json::from_str(r#"{"q":[0.41,"NaN"],"mode":1}"#).unwrap();
+        assert!(!same_fields(&exact, &other));
+        let missing: Value = serde_json::from_str(r#"{"q":[0.4,"NaN"]}"#).unwrap();
+        assert!(!same_fields(&exact, &missing));
+    }
 
     /// Every vector of Unitree's SDK and cyclonedds, under `cargo test`.
     #[test]

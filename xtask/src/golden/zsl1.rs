@@ -74,7 +74,7 @@ fn command_for_call(api: &str) -> Option<HighLevelCommand> {
         c.mode = 0.into();
         return Some(c);
     }
-    let (name, args, n) = zsl_proto::harness::vendor_call(api)?;
+    let (name, args, n) = robowire_fixtures::zsl1::vendor_call(api)?;
     let arg = |i: usize| (i < n).then(|| args[i]);
     let mut command = match name {
         "standUp" => HighLevelCommand::stand_up(),
@@ -177,7 +177,7 @@ fn check_low_level_command(entry: &Value, bytes: &[u8], c: &mut Checker) {
         c.problems.push("does not re-encode byte for byte".into());
     }
     let api = entry["api"].as_str().unwrap_or_default();
-    if let Some(motor) = zsl_proto::harness::fixture_motor_command(api)
+    if let Some(motor) = robowire_fixtures::zsl1::motor_command(api)
         && LowLevelCommand::new(motor).encode(Model::Zsl1) != bytes
     {
         c.problems.push("the command the call describes encodes differently".into());

@@ -13,14 +13,14 @@ use zsl_proto::udp::{
 };
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::core::{
-    CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile, client_accessors,
-};
-use super::snapshot::{BodyState, Imu, LegJoints};
+use super::session::{ClientStats, Connection, Interface, Running, Session, client_accessors};
+use super::snapshot::{BodyState, Imu, LegJoints, RobotState};
+use super::{CallError, ClientOptions, ConnectError};
 
-pub(super) struct HighLevelProfile;
+/// The HighLevel interface: 40-byte commands, 560-byte state.
+pub(super) struct HighLevelInterface;
 
-impl Profile for HighLevelProfile {
+impl Interface for HighLevelInterface {
     type Command = HighLevelCommand;
     type State = HighLevelState;
     type SendState = ActionClear;
@@ -30,10 +30,10 @@ impl Profile for HighLevelProfile {
     fn before_send(latched: &mut HighLevelCommand, clear: &mut ActionClear, state: Option<&HighLevelState>) -> bool {
         clear.before_send(latched);
         if let Some(state) = state {
-            if state.error_word.get() != 0 {
+            if state.error().is_some() {
                 latched.mode = 0.into();
             }
-            if state.sdk_mismatch.get() == 1 {
+            if state.has_sdk_mismatch() {
                 return false;
             }
         }
@@ -115,15 +115,15 @@ impl Call {
 /// # Ok(()) }
 /// ```
 pub struct HighLevel {
-    client: Client<HighLevelProfile>,
+    running: Running<HighLevelInterface>,
     acks: Mutex<[AckCounter; Call::COUNT]>,
 }
 
 impl std::fmt::Debug for HighLevel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("HighLevel")
-            .field("local", &self.core().local_addr())
-            .field("dog", &self.core().options.dog)
+            .field("local", &self.session().local_addr())
+            .field("dog", &self.session().options.dog)
             .field("connection", &self.connection())
             .finish_non_exhaustive()
     }
@@ -135,7 +135,7 @@ macro_rules! getters {
         ///
         /// `None` before the first state and after a watchdog timeout.
         pub fn $name(&self) -> Option<$ty> {
-            self.core().read(|$s| $e)
+            self.session().read(|$s| $e)
         }
     )*};
 }
@@ -149,11 +149,11 @@ impl HighLevel {
     /// (the vendor's `initRobot`). A bind failure names the address and lists this host's
     /// IPv4 addresses.
     pub async fn connect(options: ClientOptions) -> Result<Self, ConnectError> {
-        Ok(Self { client: Client::start(options).await?, acks: Mutex::new([AckCounter::default(); Call::COUNT]) })
+        Ok(Self { running: Running::start(options).await?, acks: Mutex::new([AckCounter::default(); Call::COUNT]) })
     }
 
-    fn core(&self) -> &Core<HighLevelProfile> {
-        &self.client.core
+    fn session(&self) -> &Session<HighLevelInterface> {
+        &self.running.session
     }
 
     /// The vendor's checks (spec §9.1, in its order), then latch, send, acknowledge.
@@ -163,9 +163,8 @@ impl HighLevel {
         command: impl FnOnce(Model) -> Result<HighLevelCommand, ArgumentError>,
     ) -> Result<(), CallError> {
         // Without state the vendor reads zeros (mode 0, error 0); so does robowire's rule check.
-        let state = self.core().read(|s| *s).unwrap_or_default();
-        let error = state.error();
-        if error != ReturnCode::Queued {
+        let state = self.session().read(|s| *s).unwrap_or_default();
+        if let Some(error) = state.error() {
             return Err(CallError::SelfCheck(error));
         }
         let mode = state.mode();
@@ -173,7 +172,7 @@ impl HighLevel {
         if gated && !mode_gate_passes(mode) {
             return Err(CallError::LyingDown(mode));
         }
-        if matches!(call, Call::Move) && self.core().latched().await.action_code() == Action::TwoLegStand {
+        if matches!(call, Call::Move) && self.session().latched().await.action_code() == Action::TwoLegStand {
             return Err(CallError::TwoLegStandActive);
         }
         let running = is_running(state.body_velocity[0].get(), state.body_velocity[1].get(), state.gyro[2].get());
@@ -189,8 +188,8 @@ impl HighLevel {
         if matches!(call, Call::Attitude) && state.rpy[0].get().abs() > 1.0 {
             return Err(CallError::Unbalanced(state.rpy[0].get()));
         }
-        let command = command(self.core().options.model)?;
-        self.core().submit(|latched| *latched = command).await?;
+        let command = command(self.session().options.model)?;
+        self.session().submit(|latched| *latched = command).await?;
         let target = command.control_mode();
         let acknowledged = self.acks.lock().map(|mut acks| acks[call as usize].on_call(mode, target));
         match acknowledged {
@@ -200,7 +199,7 @@ impl HighLevel {
     }
 
     fn require(&self, call: &'static str, needs: Model) -> Result<(), CallError> {
-        let model = self.core().options.model;
+        let model = self.session().options.model;
         if model == needs { Ok(()) } else { Err(CallError::WrongModel { call, needs, model }) }
     }
 
@@ -273,7 +272,7 @@ impl HighLevel {
 
     /// `cancelTwoLegStand()`: mode 21, action 0, flag 0. No checks, like the vendor's.
     pub async fn cancel_two_leg_stand(&self) -> Result<(), CallError> {
-        self.core().submit(|latched| *latched = HighLevelCommand::cancel_two_leg_stand()).await
+        self.session().submit(|latched| *latched = HighLevelCommand::cancel_two_leg_stand()).await
     }
 
     /// `attitudeControl(roll, pitch, yaw, height)`: body attitude rates, each |v| ≤ 0.6
@@ -308,13 +307,13 @@ impl HighLevel {
     /// ZSL-1W `cancelCrawl()`: mode 18, action 0, flag 0.
     pub async fn cancel_crawl(&self) -> Result<(), CallError> {
         self.require("cancel_crawl", Model::Zsl1W)?;
-        self.core().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
+        self.session().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
     }
 
     /// ZSL-1W `cancelClimb()`: the same datagram as `cancelCrawl()`.
     pub async fn cancel_climb(&self) -> Result<(), CallError> {
         self.require("cancel_climb", Model::Zsl1W)?;
-        self.core().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
+        self.session().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
     }
 
     getters! {
@@ -360,8 +359,8 @@ impl HighLevel {
         control_mode -> ControlMode = |s| s.mode();
         /// `getBatteryPower()`: %.
         battery_percent -> u32 = |s| s.battery_percent.get();
-        /// The error word (`ReturnCode::Queued` = 0 = none).
-        error -> ReturnCode = |s| s.error();
+        /// The robot's error word; `Some(None)` when it reports none.
+        error -> Option<ReturnCode> = |s| s.error();
         /// The IMU, typed.
         imu -> Imu = |s| s.into();
         /// Body velocity, position, mode, battery and error, typed.
@@ -370,15 +369,15 @@ impl HighLevel {
         joints -> LegJoints = |s| s.into();
     }
 
-    client_accessors!(HighLevelState, HighLevelCommand);
+    client_accessors!(HighLevelState, RobotState, HighLevelCommand);
 
     /// Waits until the robot reports `mode`, up to `timeout`.
-    pub async fn wait_for_mode(&self, mode: ControlMode, timeout: Duration) -> Option<HighLevelState> {
-        self.core().wait_for(timeout, |s| s.mode() == mode).await
+    pub async fn wait_for_mode(&self, mode: ControlMode, timeout: Duration) -> Option<RobotState> {
+        self.wait_for_state(timeout, |s| s.body.mode == mode).await
     }
 
     /// The robot raised "SDK mismatch" and the stream stopped for good.
     pub async fn halted(&self) -> bool {
-        self.core().halted().await
+        self.session().halted().await
     }
 }

@@ -1,22 +1,22 @@
 //! The LowLevel client: twelve motors, position/velocity/PD/torque commands.
 
 use zsl_proto::rules::check_motor_command;
-use zsl_proto::udp::{LowLevelCommand, LowLevelState, MotorCommand, MotorState};
+use zsl_proto::udp::{self as wire, LowLevelCommand};
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::core::{
-    CallError, Client, ClientOptions, ClientStats, ConnectError, Connection, Core, Profile, client_accessors,
-};
-use super::snapshot::Imu;
+use super::session::{ClientStats, Connection, Interface, Running, Session, client_accessors};
+use super::snapshot::{Imu, LowLevelState, MotorCommand, MotorState};
+use super::{CallError, ClientOptions, ConnectError};
 
-pub(super) struct LowLevelProfile;
+/// The LowLevel interface: 248-byte motor commands, 272-byte state.
+pub(super) struct LowLevelInterface;
 
-impl Profile for LowLevelProfile {
+impl Interface for LowLevelInterface {
     type Command = LowLevelCommand;
-    type State = LowLevelState;
+    type State = wire::LowLevelState;
     type SendState = ();
 
-    fn before_send(_: &mut LowLevelCommand, (): &mut (), _: Option<&LowLevelState>) -> bool {
+    fn before_send(_: &mut LowLevelCommand, (): &mut (), _: Option<&wire::LowLevelState>) -> bool {
         true
     }
 
@@ -33,14 +33,14 @@ impl Profile for LowLevelProfile {
 /// Streams the all-zero idle command (kp = kd = 0: nothing driven) until the first
 /// [`send_motor_command`](Self::send_motor_command), then the latched command every 2 ms.
 pub struct LowLevel {
-    client: Client<LowLevelProfile>,
+    running: Running<LowLevelInterface>,
 }
 
 impl std::fmt::Debug for LowLevel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LowLevel")
-            .field("local", &self.core().local_addr())
-            .field("dog", &self.core().options.dog)
+            .field("local", &self.session().local_addr())
+            .field("dog", &self.session().options.dog)
             .field("connection", &self.connection())
             .finish_non_exhaustive()
     }
@@ -54,56 +54,57 @@ impl LowLevel {
     /// Binds `options.local` and starts streaming the idle command to `options.dog`
     /// (use [`ClientOptions::low_level`]).
     pub async fn connect(options: ClientOptions) -> Result<Self, ConnectError> {
-        Ok(Self { client: Client::start(options).await? })
+        Ok(Self { running: Running::start(options).await? })
     }
 
-    fn core(&self) -> &Core<LowLevelProfile> {
-        &self.client.core
+    fn session(&self) -> &Session<LowLevelInterface> {
+        &self.running.session
     }
 
     /// `sendMotorCmd`: all 60 floats must be finite and the positions within the vendor's
     /// bounds (abad −0.7…0.7, hip −1.15…3.0, knee −2.9…−0.65 rad, compared as f64). On error
     /// nothing changes and the previous command keeps streaming (the vendor's −1).
     pub async fn send_motor_command(&self, command: &MotorCommand) -> Result<(), CallError> {
-        check_motor_command(command)?;
-        self.core().submit(|latched| latched.motor = *command).await
+        let motor = command.wire_command();
+        check_motor_command(&motor)?;
+        self.session().submit(|latched| latched.motor = motor).await
     }
 
     /// `getMotorState()`: positions, velocities, torques (`None` before the first state and
     /// after a timeout).
     pub fn motor_state(&self) -> Option<MotorState> {
-        self.core().read(|s| s.motor)
+        self.session().read(|s| (&s.motor).into())
     }
 
     /// `haveMotorData()`: the last state carried the magic `0x5AA5`.
     pub fn has_motor_data(&self) -> bool {
-        self.core().read(LowLevelState::has_motor_data).unwrap_or(false)
+        self.session().read(wire::LowLevelState::has_motor_data).unwrap_or(false)
     }
 
     /// `getQuaternion()`: w, x, y, z.
     pub fn quaternion(&self) -> Option<[f32; 4]> {
-        self.core().read(|s| floats(&s.quaternion))
+        self.session().read(|s| floats(&s.quaternion))
     }
 
     /// `getRPY()`: rad.
     pub fn rpy(&self) -> Option<[f32; 3]> {
-        self.core().read(|s| floats(&s.rpy))
+        self.session().read(|s| floats(&s.rpy))
     }
 
     /// `getBodyAcc()`: m/s².
     pub fn body_acc(&self) -> Option<[f32; 3]> {
-        self.core().read(|s| floats(&s.acc))
+        self.session().read(|s| floats(&s.acc))
     }
 
     /// `getBodyGyro()`: rad/s.
     pub fn body_gyro(&self) -> Option<[f32; 3]> {
-        self.core().read(|s| floats(&s.gyro))
+        self.session().read(|s| floats(&s.gyro))
     }
 
     /// The IMU, typed.
     pub fn imu(&self) -> Option<Imu> {
-        self.core().read(|s| s.into())
+        self.session().read(|s| s.into())
     }
 
-    client_accessors!(LowLevelState, LowLevelCommand);
+    client_accessors!(wire::LowLevelState, LowLevelState, LowLevelCommand);
 }

@@ -2,22 +2,29 @@
 //! wire-compatible with the vendor SDK v0.2.7 (spec `zsl1-udp.md`), safer where the spec's
 //! robowire decisions say so.
 //!
-//! Both stream their latched command every 2 ms on absolute deadlines, send a new command the
-//! moment it is accepted, decode state leniently by default (anomalies counted), drop state from
-//! any IP but the robot's, and keep a 3 s watchdog that reports [`Connection::Disconnected`],
-//! zeroes every latched velocity, and recovers by itself when state returns.
+//! Both are a session with the robot: they stream their latched command every 2 ms on absolute
+//! deadlines, send a new command the moment it is accepted, decode state leniently by default
+//! (anomalies counted), drop state from any IP but the robot's (its sending port is not
+//! documented, so any port of that IP), and keep a 3 s watchdog that reports
+//! [`Connection::Disconnected`], zeroes every latched velocity, and recovers by itself when state
+//! returns.
+//!
+//! State and commands come typed, with units in the names ([`RobotState`], [`LowLevelState`],
+//! [`MotorCommand`]). The datagrams as the vendor lays them out are `zsl_proto::udp`'s; the
+//! `wire_*` accessors return them for logging and inspection.
 
-mod core;
+mod error;
 mod high_level;
 mod low_level;
+mod options;
+mod session;
 mod snapshot;
 
-pub use self::core::{CallError, ClientOptions, ClientStats, ConnectError, Connection};
+pub use error::{CallError, ConnectError};
 pub use high_level::HighLevel;
 pub use low_level::LowLevel;
-pub use snapshot::{BodyState, Imu, JointArrays, LegJoints};
+pub use options::ClientOptions;
+pub use session::{ClientStats, Connection};
+pub use snapshot::{BodyState, Imu, JointArrays, LegJoints, LowLevelState, MotorCommand, MotorState, RobotState};
 pub use zsl_proto::codec::StateDecoding;
-pub use zsl_proto::udp::{
-    Action, ControlMode, HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState, Model, MotorCommand,
-    MotorState, ReturnCode,
-};
+pub use zsl_proto::udp::{Action, ControlMode, Model, ReturnCode};

@@ -1,11 +1,20 @@
-//! Typed snapshots of the state: units in the names, legs FR, FL, RR, RL, quaternion w, x, y, z.
+//! Typed state and commands: units in the names, legs FR, FL, RR, RL, quaternion w, x, y, z.
+//! The facade hands these out; the datagrams as the vendor lays them out stay in `zsl_proto`.
 
 use zsl_proto::Leg;
-use zsl_proto::udp::{ControlMode, HighLevelState, LowLevelState, ReturnCode};
+use zsl_proto::udp::{self as wire, ControlMode, ReturnCode};
 use zsl_proto::zerocopy::little_endian::F32;
 
 fn floats<const N: usize>(v: &[F32; N]) -> [f32; N] {
     v.map(F32::get)
+}
+
+fn joint_major(v: &[[F32; 4]; 3]) -> [[f32; 4]; 3] {
+    v.map(|legs| floats(&legs))
+}
+
+fn to_wire(v: &[[f32; 4]; 3]) -> [[F32; 4]; 3] {
+    v.map(|legs| legs.map(F32::new))
 }
 
 /// The IMU as both interfaces report it.
@@ -21,8 +30,8 @@ pub struct Imu {
     pub rpy_rad: [f32; 3],
 }
 
-impl From<&HighLevelState> for Imu {
-    fn from(s: &HighLevelState) -> Self {
+impl From<&wire::HighLevelState> for Imu {
+    fn from(s: &wire::HighLevelState) -> Self {
         Self {
             quaternion_wxyz: floats(&s.quaternion),
             gyro_radps: floats(&s.gyro),
@@ -32,8 +41,8 @@ impl From<&HighLevelState> for Imu {
     }
 }
 
-impl From<&LowLevelState> for Imu {
-    fn from(s: &LowLevelState) -> Self {
+impl From<&wire::LowLevelState> for Imu {
+    fn from(s: &wire::LowLevelState) -> Self {
         Self {
             quaternion_wxyz: floats(&s.quaternion),
             gyro_radps: floats(&s.gyro),
@@ -58,12 +67,12 @@ pub struct BodyState {
     pub mode: ControlMode,
     /// Battery level, % (0–100 per the vendor docs).
     pub battery_percent: u32,
-    /// Error word (`Queued` = 0 = no error).
-    pub error: ReturnCode,
+    /// The robot's error word: `None` when it reports none (self-check passed).
+    pub error: Option<ReturnCode>,
 }
 
-impl From<&HighLevelState> for BodyState {
-    fn from(s: &HighLevelState) -> Self {
+impl From<&wire::HighLevelState> for BodyState {
+    fn from(s: &wire::HighLevelState) -> Self {
         Self {
             imu: s.into(),
             body_velocity_mps: floats(&s.body_velocity),
@@ -112,12 +121,110 @@ pub struct LegJoints {
     pub torque_nm: JointArrays,
 }
 
-impl From<&HighLevelState> for LegJoints {
-    fn from(s: &HighLevelState) -> Self {
+impl From<&wire::HighLevelState> for LegJoints {
+    fn from(s: &wire::HighLevelState) -> Self {
         Self {
             position_rad: JointArrays::from_slots(&s.joint_angle),
             velocity_radps: JointArrays::from_slots(&s.joint_velocity),
             torque_nm: JointArrays::from_slots(&s.joint_torque),
         }
+    }
+}
+
+/// Everything the HighLevel state reports, typed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobotState {
+    /// Body, mode, battery, error.
+    pub body: BodyState,
+    /// Joint angles, velocities, torques.
+    pub joints: LegJoints,
+    /// The robot raised "SDK mismatch" (the vendor's client stops streaming for good on it).
+    pub sdk_mismatch: bool,
+}
+
+impl From<&wire::HighLevelState> for RobotState {
+    fn from(s: &wire::HighLevelState) -> Self {
+        Self { body: s.into(), joints: s.into(), sdk_mismatch: s.has_sdk_mismatch() }
+    }
+}
+
+/// A LowLevel motor command, `[joint][leg]`: joints abad, hip, knee; legs FR, FL, RR, RL (the
+/// vendor's `q_des_abad[4]` … `tau_knee_ff[4]`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MotorCommand {
+    /// Position targets, rad.
+    pub q_des_rad: [[f32; 4]; 3],
+    /// Velocity targets, rad/s.
+    pub qd_des_radps: [[f32; 4]; 3],
+    /// Position gains, N·m/rad.
+    pub kp: [[f32; 4]; 3],
+    /// Velocity gains, N·m·s/rad.
+    pub kd: [[f32; 4]; 3],
+    /// Feed-forward torques, N·m.
+    pub tau_ff_nm: [[f32; 4]; 3],
+}
+
+impl MotorCommand {
+    /// A PD hold: position targets `q_des_rad[joint][leg]` with one `kp` and `kd` per joint;
+    /// zero velocity targets and feed-forward torques.
+    pub fn pd_hold(q_des_rad: [[f32; 4]; 3], kp: [f32; 3], kd: [f32; 3]) -> Self {
+        Self { q_des_rad, kp: kp.map(|k| [k; 4]), kd: kd.map(|k| [k; 4]), ..Self::default() }
+    }
+
+    /// The 60 floats as the datagram carries them.
+    pub(crate) fn wire_command(&self) -> wire::MotorCommand {
+        wire::MotorCommand {
+            q_des: to_wire(&self.q_des_rad),
+            qd_des: to_wire(&self.qd_des_radps),
+            kp: to_wire(&self.kp),
+            kd: to_wire(&self.kd),
+            tau_ff: to_wire(&self.tau_ff_nm),
+        }
+    }
+}
+
+impl From<&wire::MotorCommand> for MotorCommand {
+    fn from(m: &wire::MotorCommand) -> Self {
+        Self {
+            q_des_rad: joint_major(&m.q_des),
+            qd_des_radps: joint_major(&m.qd_des),
+            kp: joint_major(&m.kp),
+            kd: joint_major(&m.kd),
+            tau_ff_nm: joint_major(&m.tau_ff),
+        }
+    }
+}
+
+/// The twelve motors as the LowLevel state reports them, `[joint][leg]`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MotorState {
+    /// Positions, rad.
+    pub q_rad: [[f32; 4]; 3],
+    /// Velocities, rad/s.
+    pub qd_radps: [[f32; 4]; 3],
+    /// Torque feedback, N·m.
+    pub tau_nm: [[f32; 4]; 3],
+}
+
+impl From<&wire::MotorState> for MotorState {
+    fn from(m: &wire::MotorState) -> Self {
+        Self { q_rad: joint_major(&m.q), qd_radps: joint_major(&m.qd), tau_nm: joint_major(&m.tau_fb) }
+    }
+}
+
+/// Everything the LowLevel state reports, typed.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LowLevelState {
+    /// The motors.
+    pub motor: MotorState,
+    /// The IMU.
+    pub imu: Imu,
+    /// The state carried the magic `0x5AA5` (`haveMotorData()`).
+    pub has_motor_data: bool,
+}
+
+impl From<&wire::LowLevelState> for LowLevelState {
+    fn from(s: &wire::LowLevelState) -> Self {
+        Self { motor: (&s.motor).into(), imu: s.into(), has_motor_data: s.has_motor_data() }
     }
 }

@@ -1,0 +1,75 @@
+//! Placing a thread: CPU affinity and `SCHED_FIFO` priority (Linux).
+
+use std::io;
+
+/// Why a thread could not be placed as asked.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RtError {
+    /// `cpu` could not be applied.
+    #[error("cannot pin the thread to CPU {cpu}")]
+    CpuAffinity {
+        /// The requested CPU index.
+        cpu: usize,
+        /// What the system said.
+        #[source]
+        source: io::Error,
+    },
+    /// `priority` could not be applied.
+    #[error(
+        "cannot run the thread at SCHED_FIFO priority {priority}: {reason} (needs CAP_SYS_NICE or an \
+         rtprio limit; leave the priority unset for normal scheduling)"
+    )]
+    RealtimePriority {
+        /// The requested priority.
+        priority: u8,
+        /// What the system said.
+        reason: String,
+    },
+}
+
+/// Pins the calling thread to `cpu`.
+#[cfg(target_os = "linux")]
+pub fn pin_current_thread(cpu: usize) -> Result<(), RtError> {
+    use rustix::thread::{CpuSet, sched_setaffinity};
+    if cpu >= CpuSet::MAX_CPU {
+        let source = io::Error::new(io::ErrorKind::InvalidInput, "CPU index beyond CPU_SETSIZE");
+        return Err(RtError::CpuAffinity { cpu, source });
+    }
+    let mut set = CpuSet::new();
+    set.set(cpu);
+    sched_setaffinity(None, &set).map_err(|e| RtError::CpuAffinity { cpu, source: e.into() })
+}
+
+/// Runs the calling thread under `SCHED_FIFO` at `priority` (1..=99).
+#[cfg(target_os = "linux")]
+pub fn set_realtime_priority(priority: u8) -> Result<(), RtError> {
+    use thread_priority::{
+        RealtimeThreadSchedulePolicy, ThreadPriority, ThreadPriorityValue, ThreadSchedulePolicy,
+        set_thread_priority_and_policy, thread_native_id,
+    };
+    let error = |reason: String| RtError::RealtimePriority { priority, reason };
+    if !(1..=99).contains(&priority) {
+        return Err(error("SCHED_FIFO priorities are 1..=99".into()));
+    }
+    let value = ThreadPriorityValue::try_from(priority).map_err(|e| error(e.to_string()))?;
+    set_thread_priority_and_policy(
+        thread_native_id(),
+        ThreadPriority::Crossplatform(value),
+        ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
+    )
+    .map_err(|e| error(format!("{e:?}")))
+}
+
+/// Pins the calling thread to `cpu` (Linux only).
+#[cfg(not(target_os = "linux"))]
+pub fn pin_current_thread(cpu: usize) -> Result<(), RtError> {
+    let source = io::Error::new(io::ErrorKind::Unsupported, "CPU pinning is implemented on Linux only");
+    Err(RtError::CpuAffinity { cpu, source })
+}
+
+/// Runs the calling thread under `SCHED_FIFO` (Linux only).
+#[cfg(not(target_os = "linux"))]
+pub fn set_realtime_priority(priority: u8) -> Result<(), RtError> {
+    Err(RtError::RealtimePriority { priority, reason: "implemented on Linux only".into() })
+}

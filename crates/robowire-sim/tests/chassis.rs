@@ -1,0 +1,90 @@
+//! The chassis simulator from the host end of the serial transport, as a driver sees it:
+//! requests answered, faults injected on the line, an unplugged and re-plugged adapter.
+
+use std::time::Duration;
+
+use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME_LEN, PcControl};
+use robowire_serial::{Backoff, SerialError, SerialLink, SerialPortOptions};
+use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
+
+/// Every wait is bounded, so a broken simulator fails the test instead of hanging it.
+const WATCHDOG: Duration = Duration::from_secs(5);
+
+fn runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
+}
+
+async fn send(link: &mut SerialLink<ChassisFrameDecoder>, frame: HostFrame) {
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let n = frame.emit(&mut buf).unwrap();
+    link.send(&buf[..n]).await.unwrap();
+}
+
+async fn recv(link: &mut SerialLink<ChassisFrameDecoder>) -> ChassisFrame {
+    tokio::time::timeout(WATCHDOG, link.recv()).await.expect("an answer in time").unwrap()
+}
+
+#[test]
+fn answers_requests_and_injects_noise_and_lost_replies() {
+    runtime().block_on(async {
+        let sim = ChassisSim::spawn(ChassisSimConfig::default()).unwrap();
+        let mut link = SerialLink::open(sim.path(), &SerialPortOptions::default(), ChassisFrameDecoder::new()).unwrap();
+        sim.inject(Fault::Garbage { bytes: 37 });
+        send(&mut link, HostFrame::VehicleSpeedRequest).await;
+        send(&mut link, HostFrame::Af(AfFrame::battery_read(0))).await;
+        send(&mut link, HostFrame::Af(AfFrame::all_state_read(1))).await;
+        assert!(matches!(recv(&mut link).await, ChassisFrame::VehicleSpeed(_)));
+        assert!(matches!(recv(&mut link).await, ChassisFrame::BatteryVoltage(b) if b.motor_id == 0 && b.volts > 20.0));
+        assert!(matches!(recv(&mut link).await, ChassisFrame::AllState(s) if s.motor_id == 1 && s.id == 2));
+        assert_eq!(link.counters().decoder.skipped_bytes, 37, "the garbage was skipped and counted");
+
+        // A lost reply: the next request is answered again.
+        sim.inject(Fault::DropResponses { count: 1 });
+        send(&mut link, HostFrame::VehicleSpeedRequest).await;
+        send(&mut link, HostFrame::Af(AfFrame::battery_read(0))).await;
+        assert!(matches!(recv(&mut link).await, ChassisFrame::BatteryVoltage(_)), "the speed answer was dropped");
+        let stats = sim.stats();
+        assert_eq!((stats.speed_requests, stats.af_reads, stats.responses_dropped), (2, 3, 1));
+        assert_eq!(stats.decoder.frames, 5, "every request decoded by the device end");
+    });
+}
+
+#[test]
+fn a_command_drives_the_model_and_the_watchdog_stops_it() {
+    runtime().block_on(async {
+        let config = ChassisSimConfig { command_watchdog: Some(Duration::from_millis(100)), ..Default::default() };
+        let sim = ChassisSim::spawn(config).unwrap();
+        let mut link = SerialLink::open(sim.path(), &SerialPortOptions::default(), ChassisFrameDecoder::new()).unwrap();
+        send(&mut link, HostFrame::PcControl(PcControl { velocity_mps: 0.5, curvature_per_m: 0.0 })).await;
+        // No further commands: the chassis's own watchdog stops the wheels.
+        let stopped = async {
+            while sim.stats().watchdog_stops == 0 {
+                tokio::time::sleep(Duration::from_millis(5)).await;
+            }
+        };
+        tokio::time::timeout(WATCHDOG, stopped).await.expect("the chassis watchdog fires");
+        assert_eq!(sim.state().commanded_velocity_mps, 0.0);
+        assert_eq!(sim.received().len(), 1);
+    });
+}
+
+#[test]
+fn an_unplugged_adapter_is_seen_and_a_replug_reopened_at_the_stable_path() {
+    runtime().block_on(async {
+        let link_path = std::env::temp_dir().join(format!("robowire-sim-chassis-{}", std::process::id()));
+        let sim = ChassisSim::spawn(ChassisSimConfig { link: Some(link_path.clone()), ..Default::default() }).unwrap();
+        let mut link = SerialLink::open(&link_path, &SerialPortOptions::default(), ChassisFrameDecoder::new()).unwrap();
+        sim.inject(Fault::HangUp);
+        let err = tokio::time::timeout(WATCHDOG, link.recv()).await.expect("disconnect in time").unwrap_err();
+        assert!(matches!(err, SerialError::Disconnected { .. }), "{err}");
+        let new_pty = sim.replug().unwrap();
+        let patient = Backoff { initial: Duration::from_millis(5), ..Backoff::default() };
+        tokio::time::timeout(WATCHDOG, link.reopen(&patient)).await.expect("reopened in time").unwrap();
+        assert_eq!(std::fs::read_link(&link_path).unwrap(), new_pty, "the stable path follows the new line");
+        send(&mut link, HostFrame::VehicleSpeedRequest).await;
+        assert!(matches!(recv(&mut link).await, ChassisFrame::VehicleSpeed(_)));
+        assert_eq!(sim.stats().hang_ups, 1);
+        drop(sim);
+        assert!(!link_path.exists(), "the simulator removes its symlink");
+    });
+}

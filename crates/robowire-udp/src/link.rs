@@ -1,0 +1,309 @@
+//! A socket, a peer and a codec: typed datagrams both ways.
+
+use std::fmt;
+use std::io;
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+
+use robowire_core::DatagramCodec;
+use tokio::net::UdpSocket;
+
+use crate::stats::{Counters, StatsHandle};
+use crate::{LinkStats, UdpError, host_ipv4_addresses};
+
+/// Whom a link talks to, and whom it accepts datagrams from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Peer {
+    /// Send to this address; accept datagrams only from it, IP and port.
+    Exact(SocketAddr),
+    /// Send to this address; accept datagrams from any port of its IP. For devices whose
+    /// sending port is not documented (the ZSL-1 sends state from a port of its own choosing).
+    AnyPortOf(SocketAddr),
+    /// The device side of a protocol: accept datagrams from anyone; send to `reply_to`, or, if
+    /// `None`, to the source of the latest datagram that decoded.
+    Any {
+        /// A fixed destination, if the device is configured with one.
+        reply_to: Option<SocketAddr>,
+    },
+}
+
+impl Peer {
+    /// Whether a datagram from `from` is accepted.
+    fn accepts(&self, from: SocketAddr) -> bool {
+        match self {
+            Self::Exact(addr) => from == *addr,
+            Self::AnyPortOf(addr) => from.ip() == addr.ip(),
+            Self::Any { .. } => true,
+        }
+    }
+
+    /// Where messages go before anything was received.
+    fn initial_destination(&self) -> Option<SocketAddr> {
+        match *self {
+            Self::Exact(addr) | Self::AnyPortOf(addr) => Some(addr),
+            Self::Any { reply_to } => reply_to,
+        }
+    }
+
+    /// Whether the destination follows the sources of what arrives.
+    fn learns(&self) -> bool {
+        matches!(self, Self::Any { reply_to: None })
+    }
+}
+
+/// The destination, shared by both halves (learned by the receiver on a [`Peer::Any`] link).
+type Destination = Arc<Mutex<Option<SocketAddr>>>;
+
+fn destination(shared: &Destination) -> Option<SocketAddr> {
+    *shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A UDP socket bound to a local address, talking to a [`Peer`] through codec `C`.
+pub struct UdpLink<C> {
+    sender: UdpSender<C>,
+    receiver: UdpReceiver<C>,
+}
+
+impl<C> fmt::Debug for UdpLink<C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("UdpLink")
+            .field("local", &self.receiver.socket.local_addr().ok())
+            .field("peer", &self.receiver.peer)
+            .field("stats", &self.sender.counters.snapshot())
+            .finish()
+    }
+}
+
+impl<C: DatagramCodec + Clone> UdpLink<C> {
+    /// Binds `local` (no `SO_REUSEADDR`: a second client on the same port fails, as with the
+    /// vendor SDKs) and talks to `peer`. Must be called inside a tokio runtime.
+    pub async fn bind(local: SocketAddr, peer: Peer, codec: C) -> Result<Self, UdpError<C::Error>> {
+        let bind_error = |source| UdpError::Bind { addr: local, source, host_ipv4: host_ipv4_addresses() };
+        let std_socket = std::net::UdpSocket::bind(local).map_err(bind_error)?;
+        std_socket.set_nonblocking(true)?;
+        // A second handle on the same socket, for sends from threads outside the runtime.
+        let sync_socket = std_socket.try_clone()?;
+        let socket = Arc::new(UdpSocket::from_std(std_socket)?);
+        let counters = Arc::new(Counters::default());
+        let destination: Destination = Arc::new(Mutex::new(peer.initial_destination()));
+        let sender = UdpSender {
+            socket: socket.clone(),
+            sync_socket,
+            destination: destination.clone(),
+            codec: codec.clone(),
+            buf: vec![0; C::MAX_DATAGRAM_LEN].into_boxed_slice(),
+            counters: counters.clone(),
+        };
+        // One byte more than the longest datagram, so that an over-long one is seen as such
+        // by the codec instead of being silently truncated by the kernel.
+        let receiver = UdpReceiver {
+            socket,
+            peer,
+            destination,
+            codec,
+            buf: vec![0; C::MAX_DATAGRAM_LEN + 1].into_boxed_slice(),
+            counters,
+        };
+        Ok(Self { sender, receiver })
+    }
+}
+
+impl<C: DatagramCodec> UdpLink<C> {
+    /// Encodes `message` and sends it to the peer.
+    pub async fn send(&mut self, message: &C::Outgoing) -> Result<(), UdpError<C::Error>> {
+        self.sender.send(message).await
+    }
+
+    /// The next message from the peer (see [`UdpReceiver::recv`]).
+    pub async fn recv(&mut self) -> Result<C::Incoming, UdpError<C::Error>> {
+        self.receiver.recv().await
+    }
+
+    /// The address the socket is bound to.
+    pub fn local_addr(&self) -> io::Result<SocketAddr> {
+        self.receiver.socket.local_addr()
+    }
+
+    /// Where messages go now (`None` on a [`Peer::Any`] link that has heard nobody yet).
+    pub fn destination(&self) -> Option<SocketAddr> {
+        self.sender.destination()
+    }
+
+    /// The counters now.
+    pub fn stats(&self) -> LinkStats {
+        self.sender.counters.snapshot()
+    }
+
+    /// A handle to the counters that outlives the link's halves.
+    pub fn stats_handle(&self) -> StatsHandle {
+        StatsHandle(self.sender.counters.clone())
+    }
+
+    /// A sender and a receiver that can live in different tasks (or threads: the sender's
+    /// [`send_now`](UdpSender::send_now) needs no runtime). Same socket, same counters.
+    pub fn into_split(self) -> (UdpSender<C>, UdpReceiver<C>) {
+        (self.sender, self.receiver)
+    }
+}
+
+/// The sending half: encodes into its own buffer, no allocation per message.
+pub struct UdpSender<C> {
+    socket: Arc<UdpSocket>,
+    sync_socket: std::net::UdpSocket,
+    destination: Destination,
+    codec: C,
+    buf: Box<[u8]>,
+    counters: Arc<Counters>,
+}
+
+impl<C> fmt::Debug for UdpSender<C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("UdpSender").field("destination", &destination(&self.destination)).finish_non_exhaustive()
+    }
+}
+
+impl<C: DatagramCodec> UdpSender<C> {
+    /// A send that failed before reaching the socket: counted, returned.
+    fn refused(&self, error: UdpError<C::Error>) -> UdpError<C::Error> {
+        Counters::bump(&self.counters.send_errors);
+        error
+    }
+
+    fn encode(&mut self, message: &C::Outgoing) -> Result<(usize, SocketAddr), UdpError<C::Error>> {
+        let to = self.destination().ok_or_else(|| self.refused(UdpError::NoPeer))?;
+        match self.codec.encode(message, &mut self.buf) {
+            Ok(len) => Ok((len, to)),
+            Err(e) => Err(self.refused(UdpError::Encode(e))),
+        }
+    }
+
+    fn count(&self, result: io::Result<usize>) -> Result<(), UdpError<C::Error>> {
+        match result {
+            Ok(_) => {
+                Counters::bump(&self.counters.sent);
+                Ok(())
+            }
+            Err(e) => {
+                Counters::bump(&self.counters.send_errors);
+                Err(e.into())
+            }
+        }
+    }
+
+    /// Encodes `message` and sends it to the peer.
+    pub async fn send(&mut self, message: &C::Outgoing) -> Result<(), UdpError<C::Error>> {
+        let (len, to) = self.encode(message)?;
+        let result = self.socket.send_to(&self.buf[..len], to).await;
+        self.count(result)
+    }
+
+    /// Encodes `message` and sends it now, from any thread, without a runtime: one
+    /// non-blocking `sendto(2)`. A full socket buffer is an error ([`io::ErrorKind::WouldBlock`],
+    /// counted), never a wait. For stream threads that must not block.
+    pub fn send_now(&mut self, message: &C::Outgoing) -> Result<(), UdpError<C::Error>> {
+        let (len, to) = self.encode(message)?;
+        let result = self.sync_socket.send_to(&self.buf[..len], to);
+        self.count(result)
+    }
+
+    /// The address the socket is bound to.
+    pub fn local_addr(&self) -> io::Result<SocketAddr> {
+        self.socket.local_addr()
+    }
+
+    /// Sends `bytes` as they are, bypassing the codec, now (like [`send_now`](Self::send_now)):
+    /// for fault injection (junk on the wire), never for messages.
+    pub fn send_bytes_now(&mut self, bytes: &[u8]) -> Result<(), UdpError<C::Error>> {
+        let to = self.destination().ok_or_else(|| self.refused(UdpError::NoPeer))?;
+        let result = self.sync_socket.send_to(bytes, to);
+        self.count(result)
+    }
+
+    /// Where messages go now (`None` on a [`Peer::Any`] link that has heard nobody yet).
+    pub fn destination(&self) -> Option<SocketAddr> {
+        destination(&self.destination)
+    }
+
+    /// The counters now.
+    pub fn stats(&self) -> LinkStats {
+        self.counters.snapshot()
+    }
+}
+
+/// The receiving half.
+pub struct UdpReceiver<C> {
+    socket: Arc<UdpSocket>,
+    peer: Peer,
+    destination: Destination,
+    codec: C,
+    buf: Box<[u8]>,
+    counters: Arc<Counters>,
+}
+
+impl<C> fmt::Debug for UdpReceiver<C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("UdpReceiver").field("peer", &self.peer).finish_non_exhaustive()
+    }
+}
+
+impl<C: DatagramCodec> UdpReceiver<C> {
+    /// The next datagram from the peer, decoded. Datagrams the [`Peer`] does not accept are
+    /// dropped and counted; one that does not decode is counted and returned as
+    /// [`UdpError::Decode`], a socket error is counted and returned as [`UdpError::Io`] (the
+    /// link stays usable after both).
+    ///
+    /// Cancel-safe: if the future is dropped before it completes, no datagram is lost.
+    pub async fn recv(&mut self) -> Result<C::Incoming, UdpError<C::Error>> {
+        self.recv_from().await.map(|(message, _)| message)
+    }
+
+    /// [`recv`](Self::recv), with the datagram's source.
+    pub async fn recv_from(&mut self) -> Result<(C::Incoming, SocketAddr), UdpError<C::Error>> {
+        loop {
+            let (len, from) = match self.socket.recv_from(&mut self.buf).await {
+                Ok(received) => received,
+                Err(e) => {
+                    Counters::bump(&self.counters.receive_errors);
+                    return Err(e.into());
+                }
+            };
+            if !self.peer.accepts(from) {
+                Counters::bump(&self.counters.foreign_dropped);
+                continue;
+            }
+            Counters::bump(&self.counters.received);
+            return match self.codec.decode(&self.buf[..len]) {
+                Ok(message) => {
+                    if self.peer.learns() {
+                        *self.destination.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(from);
+                    }
+                    Ok((message, from))
+                }
+                Err(e) => {
+                    Counters::bump(&self.counters.decode_errors);
+                    Err(UdpError::Decode(e))
+                }
+            };
+        }
+    }
+
+    /// The address the socket is bound to.
+    pub fn local_addr(&self) -> io::Result<SocketAddr> {
+        self.socket.local_addr()
+    }
+
+    /// Whom this half accepts datagrams from.
+    pub fn peer(&self) -> Peer {
+        self.peer
+    }
+
+    /// The counters now.
+    pub fn stats(&self) -> LinkStats {
+        self.counters.snapshot()
+    }
+
+    /// The codec, for codecs that keep state (to reset it after a timeout, say).
+    pub fn codec_mut(&mut self) -> &mut C {
+        &mut self.codec
+    }
+}

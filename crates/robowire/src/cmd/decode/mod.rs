@@ -1,0 +1,58 @@
+//! `robowire decode …`: frames and messages from hex, for humans or (`--json`) for scripts.
+//!
+//! The JSON of every codec is the codec's own (`serde` features, floats in robowire-core's one
+//! form); the human form is derived from it here.
+
+mod kmc;
+pub(crate) mod unitree;
+pub(crate) mod zsl;
+
+use std::process::ExitCode;
+
+use clap::Subcommand;
+use serde::Serialize;
+use serde_json::Value;
+
+use unitree::UnitreeMessage;
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum DecodeCommand {
+    /// KMC chassis UART frames (0xA5, 0xB3, 0xAF). Exit status 1 if no frame was found.
+    Kmc(kmc::KmcDecodeArgs),
+    /// A ZSL-1 / ZSL-1W UDP datagram, told by its length and magic, decoded strictly.
+    Zsl(zsl::ZslDecodeArgs),
+    /// Unitree Go2 LowCmd (812-byte struct image, or a CDR payload with --cdr).
+    Lowcmd(unitree::DecodeArgs),
+    /// Unitree Go2 LowState (1180-byte struct image, or a CDR payload with --cdr).
+    Lowstate(unitree::DecodeArgs),
+    /// Unitree HG (G1, H1-2) LowCmd (1004 bytes).
+    LowcmdHg(unitree::DecodeArgs),
+    /// Unitree HG (G1, H1-2) LowState (2092 bytes).
+    LowstateHg(unitree::DecodeArgs),
+}
+
+pub(crate) fn run(command: &DecodeCommand) -> anyhow::Result<ExitCode> {
+    match command {
+        DecodeCommand::Kmc(args) => kmc::run(args),
+        DecodeCommand::Zsl(args) => zsl::run(args),
+        DecodeCommand::Lowcmd(args) => unitree::decode(UnitreeMessage::LowCmd, args),
+        DecodeCommand::Lowstate(args) => unitree::decode(UnitreeMessage::LowState, args),
+        DecodeCommand::LowcmdHg(args) => unitree::decode(UnitreeMessage::HgLowCmd, args),
+        DecodeCommand::LowstateHg(args) => unitree::decode(UnitreeMessage::HgLowState, args),
+    }
+}
+
+/// A value's JSON, through text, so that floats keep the shortest form their codec wrote
+/// (`0.4`, not `0.4000000059604645`) when printed again.
+pub(crate) fn json_value<T: Serialize>(value: &T) -> anyhow::Result<Value> {
+    Ok(serde_json::from_str(&serde_json::to_string(value)?)?)
+}
+
+/// A JSON value in a table cell or after `name =`: strings bare, the rest as JSON.
+pub(crate) fn cell(value: &Value) -> String {
+    match value {
+        Value::String(s) => s.clone(),
+        Value::Array(items) => format!("[{}]", items.iter().map(cell).collect::<Vec<_>>().join(", ")),
+        other => other.to_string(),
+    }
+}

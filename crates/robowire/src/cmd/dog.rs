@@ -1,0 +1,329 @@
+//! `robowire dog …`: drive a ZSL-1 / ZSL-1W over UDP through the HighLevel client.
+
+use std::net::{IpAddr, SocketAddr};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::{Args, Subcommand, ValueEnum};
+use zsl::udp::{CallError, ClientOptions, ControlMode, HighLevel, Model, RobotState, StateDecoding};
+use zsl_proto::udp::{DEFAULT_LOCAL_PORT, HIGH_LEVEL_PORT};
+
+/// The robot model, as the command line spells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ModelArg {
+    /// ZSL-1 (magic 0x5AA5).
+    #[value(name = "zsl-1")]
+    Zsl1,
+    /// ZSL-1W wheel-legged (magic 0x5AA6).
+    #[value(name = "zsl-1w")]
+    Zsl1W,
+}
+
+impl From<ModelArg> for Model {
+    fn from(m: ModelArg) -> Self {
+        match m {
+            ModelArg::Zsl1 => Model::Zsl1,
+            ModelArg::Zsl1W => Model::Zsl1W,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct DogArgs {
+    /// The robot's IP address.
+    #[arg(long, default_value = "192.168.234.1")]
+    dog_ip: IpAddr,
+    /// The robot's HighLevel port.
+    #[arg(long, default_value_t = HIGH_LEVEL_PORT)]
+    dog_port: u16,
+    /// Local address to bind; the robot sends state to its configured target (default port 43988).
+    #[arg(long, default_value = "0.0.0.0")]
+    local_ip: IpAddr,
+    /// Local port (the robot's `target_port`).
+    #[arg(long, default_value_t = DEFAULT_LOCAL_PORT)]
+    local_port: u16,
+    /// Robot model.
+    #[arg(long, value_enum, default_value = "zsl-1")]
+    model: ModelArg,
+    /// Decode state strictly (exact length and header) instead of like the vendor.
+    #[arg(long)]
+    strict: bool,
+    /// Seconds to wait for the robot's first state.
+    #[arg(long, default_value_t = 3.0)]
+    connect_timeout_s: f64,
+    #[command(subcommand)]
+    command: DogCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum DogCommand {
+    /// Stand up (mode 1).
+    Stand,
+    /// Lie down, joints locked (mode 51).
+    Lie,
+    /// Motors damped (mode 0).
+    Passive,
+    /// Walk: forward m/s, left m/s, yaw rate rad/s; stops after --duration.
+    #[command(allow_negative_numbers = true)]
+    Move {
+        /// Forward velocity, m/s: 0 or 0.05–3.0 in magnitude.
+        vx_mps: f32,
+        /// Lateral velocity, m/s: 0 or 0.1–1.0 in magnitude.
+        vy_mps: f32,
+        /// Yaw rate, rad/s: 0 or 0.02–3.0 in magnitude.
+        yaw_rate_radps: f32,
+        /// Seconds to walk before stopping.
+        #[arg(long, default_value_t = 2.0)]
+        duration: f64,
+    },
+    /// Jump in place.
+    Jump,
+    /// Jump forward.
+    FrontJump,
+    /// Backflip.
+    Backflip,
+    /// Shake hands.
+    ShakeHand,
+    /// Stand on the hind legs and move: forward m/s (0 or 0.2–0.5), yaw rate rad/s (0 or 0.2–1.0).
+    #[command(allow_negative_numbers = true)]
+    TwoLegStand {
+        /// Forward velocity, m/s.
+        vx_mps: f32,
+        /// Yaw rate, rad/s.
+        yaw_rate_radps: f32,
+    },
+    /// Leave the two-leg stand.
+    CancelTwoLegStand,
+    /// Body attitude rates: roll, pitch, yaw (rad/s) and height (m/s), each |v| ≤ 0.6.
+    #[command(allow_negative_numbers = true)]
+    Attitude {
+        /// Roll rate, rad/s.
+        roll_radps: f32,
+        /// Pitch rate, rad/s.
+        pitch_radps: f32,
+        /// Yaw rate, rad/s.
+        yaw_radps: f32,
+        /// Height rate, m/s.
+        height_mps: f32,
+        /// Seconds to apply the rates before zeroing them.
+        #[arg(long, default_value_t = 1.0)]
+        duration: f64,
+    },
+    /// Print one state snapshot.
+    Status {
+        /// As JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the state live, 10 lines a second, until Ctrl-C.
+    Watch,
+}
+
+pub(crate) fn run(args: DogArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.connect_timeout_s.is_finite() && args.connect_timeout_s > 0.0,
+        "--connect-timeout-s must be positive"
+    );
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+    runtime.block_on(run_async(args))
+}
+
+fn options(args: &DogArgs) -> ClientOptions {
+    let options = ClientOptions::high_level(args.local_ip, args.local_port, args.dog_ip).with_model(args.model.into());
+    let options = if args.strict { options.with_state_decoding(StateDecoding::Strict) } else { options };
+    ClientOptions { dog: SocketAddr::new(args.dog_ip, args.dog_port), ..options }
+}
+
+fn duration(name: &str, seconds: f64) -> anyhow::Result<Duration> {
+    anyhow::ensure!(seconds.is_finite() && (0.0..=3600.0).contains(&seconds), "{name} must be 0–3600 s, got {seconds}");
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
+    let dog = HighLevel::connect(options(&args)).await.context("starting the HighLevel client")?;
+    let timeout = Duration::from_secs_f64(args.connect_timeout_s);
+    if !dog.wait_connected(timeout).await {
+        anyhow::bail!(
+            "no state from {} within {:.1} s on {}: is the robot on, and is its target_ip/target_port this \
+             address? (try --local-ip with one of this host's addresses)",
+            args.dog_ip,
+            args.connect_timeout_s,
+            dog.local_addr()
+        );
+    }
+    let outcome = match args.command {
+        DogCommand::Stand => call(&dog, "stand_up", dog.stand_up().await, Some(ControlMode::Stand)).await,
+        DogCommand::Lie => call(&dog, "lie_down", dog.lie_down().await, Some(ControlMode::LieDown)).await,
+        DogCommand::Passive => call(&dog, "passive", dog.passive().await, Some(ControlMode::Passive)).await,
+        DogCommand::Move { vx_mps, vy_mps, yaw_rate_radps, duration: seconds } => {
+            let walk = duration("--duration", seconds)?;
+            let start = dog.position();
+            let result = dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps).await;
+            let ok = call(&dog, "move", result, Some(ControlMode::Move)).await;
+            if ok {
+                watch_for(&dog, walk).await;
+                let stopped = dog.move_velocity(0.0, 0.0, 0.0).await;
+                call(&dog, "move(0, 0, 0)", stopped, None).await;
+                dog.wait_for_state(Duration::from_secs(2), |s| {
+                    s.body.body_velocity_mps[0].abs() < 0.05 && s.body.body_velocity_mps[1].abs() < 0.05
+                })
+                .await;
+                if let (Some(a), Some(b)) = (start, dog.position()) {
+                    println!("moved {:+.2} m, {:+.2} m", b[0] - a[0], b[1] - a[1]);
+                }
+            }
+            ok
+        }
+        DogCommand::Jump => trick(&dog, "jump", dog.jump().await).await,
+        DogCommand::FrontJump => trick(&dog, "front_jump", dog.front_jump().await).await,
+        DogCommand::Backflip => trick(&dog, "backflip", dog.backflip().await).await,
+        DogCommand::ShakeHand => trick(&dog, "shake_hand", dog.shake_hand().await).await,
+        DogCommand::TwoLegStand { vx_mps, yaw_rate_radps } => {
+            let result = dog.two_leg_stand(vx_mps, yaw_rate_radps).await;
+            call(&dog, "two_leg_stand", result, Some(ControlMode::Action)).await
+        }
+        DogCommand::CancelTwoLegStand => {
+            call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand().await, None).await
+        }
+        DogCommand::Attitude { roll_radps, pitch_radps, yaw_radps, height_mps, duration: seconds } => {
+            let hold = duration("--duration", seconds)?;
+            let result = dog.attitude_control(roll_radps, pitch_radps, yaw_radps, height_mps).await;
+            let ok = call(&dog, "attitude_control", result, Some(ControlMode::Action)).await;
+            if ok {
+                watch_for(&dog, hold).await;
+                let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0).await;
+                call(&dog, "attitude_control(0, 0, 0, 0)", zero, None).await;
+            }
+            ok
+        }
+        DogCommand::Status { json } => {
+            let state = dog.wire_state().context("the connection dropped before a state arrived")?;
+            if json {
+                // The datagram's JSON, as `robowire decode zsl --json` prints it.
+                println!("{}", serde_json::to_string_pretty(&state)?);
+            } else {
+                print_status(&(&state).into());
+            }
+            true
+        }
+        DogCommand::Watch => {
+            watch_until_ctrl_c(&dog).await?;
+            true
+        }
+    };
+    let stats = dog.stats();
+    eprintln!(
+        "link: sent {} received {} decode errors {} foreign dropped {} | short states {} header anomalies {} disconnects {}",
+        stats.link.sent,
+        stats.link.received,
+        stats.link.decode_errors,
+        stats.link.foreign_dropped,
+        stats.short_states,
+        stats.header_anomalies,
+        stats.disconnects
+    );
+    Ok(if outcome { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+/// Prints a call's return code; waits for `mode` when given. `true` when the call was accepted.
+async fn call(dog: &HighLevel, name: &str, result: Result<(), CallError>, mode: Option<ControlMode>) -> bool {
+    match result {
+        Ok(()) => {
+            println!("{name}: 0x0000 queued");
+            if let Some(mode) = mode {
+                match dog.wait_for_mode(mode, Duration::from_secs(2)).await {
+                    Some(_) => println!("robot reports mode {} ({mode:?})", mode.raw()),
+                    None => println!(
+                        "robot has not reported mode {} within 2 s (reports {:?})",
+                        mode.raw(),
+                        dog.control_mode()
+                    ),
+                }
+            }
+            true
+        }
+        Err(e) => {
+            println!("{name}: 0x{:04x} refused: {e}", e.return_code().raw());
+            false
+        }
+    }
+}
+
+async fn trick(dog: &HighLevel, name: &str, result: Result<(), CallError>) -> bool {
+    let ok = call(dog, name, result, Some(ControlMode::Action)).await;
+    if ok {
+        // Keep the client (and its stream) alive while the trick runs.
+        watch_for(dog, Duration::from_secs(2)).await;
+    }
+    ok
+}
+
+/// The robot's error word as text: `none`, or the code and its name.
+fn error_text(s: &RobotState) -> String {
+    s.body.error.map_or_else(|| "none".into(), |e| format!("0x{:04x} ({e:?})", e.raw()))
+}
+
+fn line(s: &RobotState) -> String {
+    let b = &s.body;
+    format!(
+        "mode {:>2} | pos {:+6.2} {:+6.2} {:+5.2} m | v {:+5.2} {:+5.2} m/s | yaw {:+5.2} rad | battery {:>3} % | error {}",
+        b.mode.raw(),
+        b.position_m[0],
+        b.position_m[1],
+        b.position_m[2],
+        b.body_velocity_mps[0],
+        b.body_velocity_mps[1],
+        b.imu.rpy_rad[2],
+        b.battery_percent,
+        error_text(s)
+    )
+}
+
+async fn watch_for(dog: &HighLevel, how_long: Duration) {
+    let end = Instant::now() + how_long;
+    while Instant::now() < end {
+        tokio::time::sleep(Duration::from_millis(250).min(end.saturating_duration_since(Instant::now()))).await;
+        match dog.state() {
+            Some(s) => println!("  {}", line(&s)),
+            None => println!("  (no state: {:?})", dog.connection()),
+        }
+    }
+}
+
+async fn watch_until_ctrl_c(dog: &HighLevel) -> anyhow::Result<()> {
+    let mut ticker = tokio::time::interval(Duration::from_millis(100));
+    let mut events = dog.connection_events();
+    loop {
+        tokio::select! {
+            signal = tokio::signal::ctrl_c() => return signal.context("waiting for Ctrl-C"),
+            changed = events.changed() => {
+                changed.context("client stopped")?;
+                println!("connection: {:?}", *events.borrow_and_update());
+            }
+            _ = ticker.tick() => {
+                if let Some(s) = dog.state() {
+                    println!("{}", line(&s));
+                }
+            }
+        }
+    }
+}
+
+fn print_status(s: &RobotState) {
+    let v = |a: &[f32]| a.iter().map(|x| format!("{x:+.3}")).collect::<Vec<_>>().join(" ");
+    let b = &s.body;
+    println!("mode           {} ({:?})", b.mode.raw(), b.mode);
+    println!("battery        {} %", b.battery_percent);
+    println!("error          {}", error_text(s));
+    println!("sdk mismatch   {}", if s.sdk_mismatch { "yes" } else { "no" });
+    println!("position m     {}", v(&b.position_m));
+    println!("body vel m/s   {}", v(&b.body_velocity_mps));
+    println!("rpy rad        {}", v(&b.imu.rpy_rad));
+    println!("quaternion     {}", v(&b.imu.quaternion_wxyz));
+    println!("gyro rad/s     {}", v(&b.imu.gyro_radps));
+    let joints = &s.joints.position_rad;
+    for (name, legs) in [("abad", joints.abad), ("hip", joints.hip), ("knee", joints.knee), ("foot", joints.foot)] {
+        println!("{name:<5} rad FR FL RR RL  {}", v(&legs));
+    }
+}

@@ -1,0 +1,208 @@
+//! `robowire sim …`: a simulator alone, until Ctrl-C.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum SimCommand {
+    /// A KMC chassis on a pseudo-terminal; prints the device path to open.
+    Kmc(KmcSimArgs),
+    /// The ZSL-1 spline daemon: a 1 kHz loop on /spline_shm and /imu_shm with a PD joint model.
+    Spline(SplineSimArgs),
+    /// A ZSL-1 / ZSL-1W dog on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
+    Dog(DogSimArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct DogSimArgs {
+    /// Address to listen on (both ports).
+    #[arg(long, default_value = "127.0.0.1")]
+    bind: std::net::IpAddr,
+    /// Send state here instead of to the address the commands come from.
+    #[arg(long)]
+    client: Option<std::net::SocketAddr>,
+    /// Robot model.
+    #[arg(long, value_enum, default_value = "zsl-1")]
+    model: crate::cmd::dog::ModelArg,
+    /// HighLevel port (0: any free port).
+    #[arg(long, default_value_t = zsl_proto::udp::HIGH_LEVEL_PORT)]
+    high_level_port: u16,
+    /// LowLevel port (0: any free port).
+    #[arg(long, default_value_t = zsl_proto::udp::LOW_LEVEL_PORT)]
+    low_level_port: u16,
+    /// Print the simulator's state every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct SplineSimArgs {
+    /// Spline object name.
+    #[arg(long, default_value = zsl_proto::shm::SPLINE_SHM_NAME)]
+    name: String,
+    /// IMU object name.
+    #[arg(long, default_value = zsl_proto::shm::IMU_SHM_NAME)]
+    imu_name: String,
+    /// Permission bits of the objects (octal), applied after creation regardless of the umask.
+    #[arg(long, default_value = "660", value_parser = parse_octal)]
+    mode: u32,
+    /// Print the simulator's counters every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
+}
+
+fn parse_octal(text: &str) -> Result<u32, String> {
+    u32::from_str_radix(text, 8).ok().filter(|m| *m <= 0o777).ok_or_else(|| format!("{text:?} is no octal mode"))
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct KmcSimArgs {
+    /// Also make a symlink here to the pty (a stable path, e.g. /tmp/kmc0).
+    #[arg(long)]
+    link: Option<PathBuf>,
+    /// Stop the wheels when no 0xA5 arrived for this long, ms (0 disables).
+    #[arg(long, default_value_t = 1000)]
+    watchdog_ms: u64,
+    /// Print the simulator's counters every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
+}
+
+pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
+    match command {
+        SimCommand::Kmc(args) => run_kmc(&args),
+        SimCommand::Spline(args) => run_spline(&args),
+        SimCommand::Dog(args) => run_dog(&args),
+    }
+}
+
+/// Runs until Ctrl-C, reporting every `every_s` seconds (0: never).
+fn until_ctrl_c(every_s: f64, mut report: impl FnMut()) -> anyhow::Result<()> {
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+    runtime.block_on(async {
+        let enabled = every_s.is_finite() && every_s > 0.0;
+        let mut ticker = tokio::time::interval(Duration::from_secs_f64(if enabled { every_s } else { 3600.0 }));
+        ticker.tick().await;
+        loop {
+            tokio::select! {
+                signal = tokio::signal::ctrl_c() => {
+                    signal.context("waiting for Ctrl-C")?;
+                    return Ok(());
+                }
+                _ = ticker.tick(), if enabled => report(),
+            }
+        }
+    })
+}
+
+fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
+    let config = robowire_sim::spline::SplineSimConfig {
+        spline_name: args.name.clone(),
+        imu_name: args.imu_name.clone(),
+        create: robowire_shm::CreateOptions { mode: args.mode, unlink_on_drop: true },
+        ..Default::default()
+    };
+    let sim = robowire_sim::spline::SplineSim::spawn(config).context("starting the spline daemon simulator")?;
+    println!("{} {}", args.name, args.imu_name);
+    eprintln!(
+        "spline daemon simulator on {} and {} (mode {:o}), 1 kHz. Try: robowire shm status --name {} --imu-name {}. Ctrl-C stops and removes the objects.",
+        args.name, args.imu_name, args.mode, args.name, args.imu_name
+    );
+    until_ctrl_c(args.report_every_s, || {
+        let s = sim.stats();
+        eprintln!(
+            "cycles {} missed {} | lateness p50 {} µs p99 {} µs max {} µs | commands fresh {} repeated {} cleared {} rejected {}",
+            s.cycles,
+            s.missed_cycles,
+            s.lateness.p50_us,
+            s.lateness.p99_us,
+            s.lateness.max_us,
+            s.daemon.fresh,
+            s.daemon.repeated,
+            s.daemon.cleared,
+            s.daemon.rejected
+        );
+    })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
+    let config = ChassisSimConfig {
+        link: args.link.clone(),
+        command_watchdog: (args.watchdog_ms > 0).then(|| Duration::from_millis(args.watchdog_ms)),
+        ..ChassisSimConfig::default()
+    };
+    let sim = ChassisSim::spawn(config).context("starting the chassis simulator")?;
+    // The first line is the path, alone, for scripts: `port=$(robowire sim kmc | head -1)`.
+    println!("{}", sim.path().display());
+    eprintln!(
+        "KMC chassis simulator on {} (pty {}). Try: robowire kmc --port {} drive --velocity 0.5 --yaw-rate 0.2. Ctrl-C stops.",
+        sim.path().display(),
+        sim.pty_path().display(),
+        sim.path().display()
+    );
+    until_ctrl_c(args.report_every_s, || {
+        let (s, st) = (sim.stats(), sim.state());
+        eprintln!(
+            "cmd {:+.2} m/s {:+.2} 1/m | speed {:+.3} m/s | battery {:.2} V | rx: control {} speed-req {} af-read {} af-write {} | sent {} | skipped {} rejected {}",
+            st.commanded_velocity_mps,
+            st.commanded_curvature_per_m,
+            st.speed_mps,
+            st.battery_volts,
+            s.control_frames,
+            s.speed_requests,
+            s.af_reads,
+            s.af_writes,
+            s.responses_sent,
+            s.decoder.skipped_bytes,
+            s.decoder.rejected_candidates
+        );
+    })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
+    use robowire_sim::dog::{DogSim, DogSimConfig};
+    let config = DogSimConfig {
+        bind: args.bind,
+        high_level_port: args.high_level_port,
+        low_level_port: args.low_level_port,
+        client: args.client,
+        model: args.model.into(),
+        ..DogSimConfig::default()
+    };
+    let sim = DogSim::spawn(config).context("starting the dog simulator")?;
+    // The first line is the two addresses, alone, for scripts.
+    println!("{} {}", sim.high_level_addr(), sim.low_level_addr());
+    eprintln!(
+        "{:?} dog simulator: HighLevel on {}, LowLevel on {}, state at 500 Hz to {}. Try: robowire dog --dog-ip {} stand. Ctrl-C stops.",
+        sim.snapshot().dog.model(),
+        sim.high_level_addr(),
+        sim.low_level_addr(),
+        args.client.map_or("the address commands come from".to_string(), |c| c.to_string()),
+        args.bind
+    );
+    until_ctrl_c(args.report_every_s, || {
+        let s = sim.snapshot();
+        let [x, y, z] = s.dog.position_m();
+        eprintln!(
+            "mode {:>2} {:?} | pos {x:+.2} {y:+.2} {z:+.2} m yaw {:+.2} rad | battery {:.1} % | HL cmds {} invalid {} states {} | LL cmds {} invalid {} states {}",
+            s.dog.mode().raw(),
+            s.dog.activity(),
+            s.dog.yaw_rad(),
+            s.dog.battery_percent(),
+            s.high_level.commands,
+            s.high_level.invalid,
+            s.high_level.states_sent,
+            s.low_level.commands,
+            s.low_level.invalid,
+            s.low_level.states_sent
+        );
+    })?;
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,141 @@
+//! JSON shapes of the datagrams (feature `serde`): what `robowire decode zsl --json` and
+//! `robowire dog status --json` print. Units are in the key names; joint arrays are per leg
+//! (FR, FL, RR, RL); floats in robowire-core's one JSON form.
+
+use robowire_core::serde_f32::F32 as Float;
+use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
+use zerocopy::little_endian::F32;
+
+use crate::udp::{HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState, Model};
+
+/// Little-endian floats as a JSON array.
+struct Floats<'a>(&'a [F32]);
+
+impl Serialize for Floats<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(self.0.len()))?;
+        for v in self.0 {
+            seq.serialize_element(&Float(v.get()))?;
+        }
+        seq.end()
+    }
+}
+
+/// `{"abad": […], "hip": […], "knee": […], "foot": […]}`.
+struct Joints<'a>(&'a [[F32; 4]; 4]);
+
+impl Serialize for Joints<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(4))?;
+        for (name, legs) in ["abad", "hip", "knee", "foot"].iter().zip(self.0) {
+            map.serialize_entry(name, &Floats(legs))?;
+        }
+        map.end()
+    }
+}
+
+fn model_name(magic: u16) -> &'static str {
+    match Model::from_magic(magic) {
+        Ok(Model::Zsl1) => "zsl-1",
+        Ok(Model::Zsl1W) => "zsl-1w",
+        Err(_) => "unknown",
+    }
+}
+
+/// `"datagram"` and `"model"` (from the magic), the first entries of a command.
+fn command_header<M: SerializeMap>(map: &mut M, datagram: &str, magic: u16) -> Result<(), M::Error> {
+    map.serialize_entry("datagram", datagram)?;
+    map.serialize_entry("model", model_name(magic))
+}
+
+/// One entry per joint: `{prefix}abad{suffix}`, `{prefix}hip{suffix}`, `{prefix}knee{suffix}`.
+fn by_joint<M: SerializeMap>(map: &mut M, names: [&str; 3], arrays: &[[F32; 4]; 3]) -> Result<(), M::Error> {
+    for (name, legs) in names.iter().zip(arrays) {
+        map.serialize_entry(name, &Floats(legs))?;
+    }
+    Ok(())
+}
+
+/// `{"datagram":"high_level_command","model":"zsl-1","mode":18,"mode_name":"Move",…}`.
+impl Serialize for HighLevelCommand {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(None)?;
+        command_header(&mut map, "high_level_command", self.magic())?;
+        map.serialize_entry("mode", &self.mode.get())?;
+        map.serialize_entry("mode_name", &format_args!("{:?}", self.control_mode()))?;
+        map.serialize_entry("action", &self.action.get())?;
+        map.serialize_entry("action_name", &format_args!("{:?}", self.action_code()))?;
+        map.serialize_entry("flag", &self.flag.get())?;
+        map.serialize_entry("vx_mps", &Float(self.vx.get()))?;
+        map.serialize_entry("vy_mps", &Float(self.vy.get()))?;
+        map.serialize_entry("roll_rate_radps", &Float(self.roll_rate.get()))?;
+        map.serialize_entry("pitch_rate_radps", &Float(self.pitch_rate.get()))?;
+        map.serialize_entry("yaw_rate_radps", &Float(self.yaw_rate.get()))?;
+        map.serialize_entry("height_rate_mps", &Float(self.height_rate.get()))?;
+        map.serialize_entry("checksum", &self.checksum())?;
+        map.end()
+    }
+}
+
+/// `{"datagram":"low_level_command","model":"zsl-1","q_des_abad":[…],…,"checksum":…}`.
+impl Serialize for LowLevelCommand {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let m = &self.motor;
+        let mut map = s.serialize_map(None)?;
+        command_header(&mut map, "low_level_command", self.magic())?;
+        by_joint(&mut map, ["q_des_abad", "q_des_hip", "q_des_knee"], &m.q_des)?;
+        by_joint(&mut map, ["qd_des_abad", "qd_des_hip", "qd_des_knee"], &m.qd_des)?;
+        by_joint(&mut map, ["kp_abad", "kp_hip", "kp_knee"], &m.kp)?;
+        by_joint(&mut map, ["kd_abad", "kd_hip", "kd_knee"], &m.kd)?;
+        by_joint(&mut map, ["tau_abad_ff", "tau_hip_ff", "tau_knee_ff"], &m.tau_ff)?;
+        map.serialize_entry("checksum", &self.checksum())?;
+        map.end()
+    }
+}
+
+/// `{"datagram":"high_level_state","mode":1,"mode_name":"Stand","battery_percent":…,
+/// "error_word":0,"error_name":"none",…}`.
+impl Serialize for HighLevelState {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(None)?;
+        map.serialize_entry("datagram", "high_level_state")?;
+        map.serialize_entry("mode", &self.control_mode.get())?;
+        map.serialize_entry("mode_name", &format_args!("{:?}", self.mode()))?;
+        map.serialize_entry("battery_percent", &self.battery_percent.get())?;
+        map.serialize_entry("error_word", &self.error_word.get())?;
+        match self.error() {
+            None => map.serialize_entry("error_name", "none")?,
+            Some(code) => map.serialize_entry("error_name", &format_args!("{code:?}"))?,
+        }
+        map.serialize_entry("sdk_mismatch", &self.sdk_mismatch.get())?;
+        map.serialize_entry("quaternion_wxyz", &Floats(&self.quaternion))?;
+        map.serialize_entry("gyro_radps", &Floats(&self.gyro))?;
+        map.serialize_entry("acc_mps2", &Floats(&self.acc))?;
+        map.serialize_entry("rpy_rad", &Floats(&self.rpy))?;
+        map.serialize_entry("body_velocity_mps", &Floats(&self.body_velocity))?;
+        map.serialize_entry("world_velocity_mps", &Floats(&self.world_velocity))?;
+        map.serialize_entry("position_m", &Floats(&self.position))?;
+        map.serialize_entry("joint_angle_rad", &Joints(&self.joint_angle))?;
+        map.serialize_entry("joint_velocity_radps", &Joints(&self.joint_velocity))?;
+        map.serialize_entry("joint_torque_nm", &Joints(&self.joint_torque))?;
+        map.end()
+    }
+}
+
+/// `{"datagram":"low_level_state","has_motor_data":true,"q_abad":[…],…,"rpy_rad":[…]}`.
+impl Serialize for LowLevelState {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let m = &self.motor;
+        let mut map = s.serialize_map(None)?;
+        map.serialize_entry("datagram", "low_level_state")?;
+        map.serialize_entry("has_motor_data", &self.has_motor_data())?;
+        by_joint(&mut map, ["q_abad", "q_hip", "q_knee"], &m.q)?;
+        by_joint(&mut map, ["qd_abad", "qd_hip", "qd_knee"], &m.qd)?;
+        by_joint(&mut map, ["tau_abad_fb", "tau_hip_fb", "tau_knee_fb"], &m.tau_fb)?;
+        map.serialize_entry("quaternion_wxyz", &Floats(&self.quaternion))?;
+        map.serialize_entry("gyro_radps", &Floats(&self.gyro))?;
+        map.serialize_entry("acc_mps2", &Floats(&self.acc))?;
+        map.serialize_entry("rpy_rad", &Floats(&self.rpy))?;
+        map.end()
+    }
+}
