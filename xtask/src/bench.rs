@@ -13,8 +13,14 @@ use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
 /// The latency and loop-jitter programs among them write their figures to `bench-meta-*.json`.
-const BENCHES: &[(&str, &str)] =
-    &[("kmc-proto", "codec"), ("kmc", "serial"), ("lowcmd-proto", "lowcmd"), ("zsl", "spline"), ("zsl", "udp")];
+const BENCHES: &[(&str, &str)] = &[
+    ("kmc-proto", "codec"),
+    ("kmc", "serial"),
+    ("lowcmd-proto", "lowcmd"),
+    ("zsl", "spline"),
+    ("zsl", "udp"),
+    ("robowire", "streams"),
+];
 
 /// One row of the table.
 #[derive(Debug, Serialize)]
@@ -54,6 +60,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let spline_meta_path = target.join("bench-meta-spline.json");
     let udp_meta_path = target.join("bench-meta-zsl-udp.json");
     let kmc_meta_path = target.join("bench-meta-kmc.json");
+    let streams_meta_path = target.join("bench-meta-streams.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -67,6 +74,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META_SPLINE", &spline_meta_path)
             .env("ROBOWIRE_BENCH_META_ZSL_UDP", &udp_meta_path)
             .env("ROBOWIRE_BENCH_META_KMC", &kmc_meta_path)
+            .env("ROBOWIRE_BENCH_META_STREAMS", &streams_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -109,7 +117,12 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     }
 
     let kmc: Value = serde_json::from_str(&std::fs::read_to_string(&kmc_meta_path).context("KMC bench metadata")?)?;
-    rows.extend(kmc_serial_rows(&kmc)?);
+    rows.extend(round_trip_rows(
+        &kmc,
+        "KMC 0xB3 request → speed frame via UartClient and the simulator (pty)",
+        "raw pty echo (1 B out, 5 B back)",
+        None,
+    )?);
 
     rows.extend(lowcmd_rows(&criterion)?);
     let spline: Value =
@@ -118,6 +131,9 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let udp: Value =
         serde_json::from_str(&std::fs::read_to_string(&udp_meta_path).context("ZSL-1 UDP bench metadata")?)?;
     rows.extend(zsl_udp_rows(&criterion, &udp)?);
+    let streams: Value =
+        serde_json::from_str(&std::fs::read_to_string(&streams_meta_path).context("streams bench metadata")?)?;
+    rows.extend(stream_rows(&streams)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
@@ -146,43 +162,6 @@ fn round_trip_rows(meta: &Value, path: &str, echo: &str, p50_max_ratio: Option<f
             })
         })
         .collect()
-}
-
-/// Rows of the KMC serial bench: request → response on a pty, the Driver's 100 Hz stream.
-fn kmc_serial_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
-    let mut rows = round_trip_rows(
-        meta,
-        "KMC 0xB3 request → speed frame via UartClient and the simulator (pty)",
-        "raw pty echo (1 B out, 5 B back)",
-        None,
-    )?;
-    let summary = |key: &str| -> anyhow::Result<(u64, u64, u64)> {
-        let s = &meta[key];
-        let field = |f: &str| s[f].as_u64().with_context(|| format!("kmc meta {key}.{f}"));
-        Ok((field("p50_us")?, field("p99_us")?, field("max_us")?))
-    };
-    let seconds = meta["stream_seconds"].as_f64().context("kmc meta stream_seconds")?;
-    let (l50, l99, lmax) = summary("stream_lateness")?;
-    let (b50, b99, bmax) = summary("sleep_loop_lateness")?;
-    rows.push(Row {
-        path: format!("KMC Driver 0xA5 stream send lateness over {seconds:.0} s"),
-        figure: format!("p50 {l50} µs, p99 {l99} µs, max {lmax} µs"),
-        baseline: format!("bare thread sleeping to the same deadlines: p50 {b50} µs, p99 {b99} µs, max {bmax} µs"),
-        ratio: format!("{:.2}× (p99)", l99 as f64 / b99.max(1) as f64),
-        target: "–".into(),
-        met: None,
-    });
-    let rate_hz = meta["stream_rate_hz"].as_f64().context("kmc meta stream_rate_hz")?;
-    let (j50, j99, jmax) = summary("stream_jitter_at_chassis")?;
-    rows.push(Row {
-        path: "KMC 0xA5 stream at the chassis: rate, |interval − 10 ms|".into(),
-        figure: format!("{rate_hz:.1} Hz; p50 {j50} µs, p99 {j99} µs, max {jmax} µs"),
-        baseline: "period 10 ms".into(),
-        ratio: format!("{:.1} % of the period (p99)", j99 as f64 / 100.0),
-        target: "~100 Hz".into(),
-        met: Some((99.0..=101.0).contains(&rate_hz)),
-    });
-    Ok(rows)
 }
 
 /// Rows of the Unitree LowCmd/LowState benchmarks.
@@ -251,7 +230,7 @@ fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Rows of the spline shared-memory benchmark (cross-process round trip, 1 kHz loop).
+/// Rows of the spline shared-memory benchmark (cross-process round trip).
 fn spline_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     let rt = &meta["spline_roundtrip"];
     let ns = |key: &str| rt[key].as_f64().with_context(|| format!("spline_roundtrip.{key}"));
@@ -268,17 +247,6 @@ fn spline_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             met: Some(facade <= 1.5 * raw),
         });
     }
-    let l = &meta["spline_loop"];
-    let us = |key: &str| l[key].as_u64().with_context(|| format!("spline_loop.{key}"));
-    let (p50, p99, max) = (us("p50_us")?, us("p99_us")?, us("max_us")?);
-    rows.push(Row {
-        path: format!("Spline daemon 1 kHz lateness over {} s", us("seconds")?),
-        figure: format!("p50 {p50} µs, p99 {p99} µs, max {max} µs"),
-        baseline: format!("{} cycles, {} missed", us("cycles")?, us("missed")?),
-        ratio: "–".into(),
-        target: "p50 ≤ 20 µs, p99 ≤ 100 µs".into(),
-        met: Some(p50 <= 20 && p99 <= 100),
-    });
     Ok(rows)
 }
 
@@ -322,6 +290,72 @@ fn zsl_udp_rows(criterion: &Path, meta: &Value) -> anyhow::Result<Vec<Row>> {
         "raw UDP echo round trip",
         Some(1.5),
     )?);
+    Ok(rows)
+}
+
+/// Send lateness of every periodic stream: p50 ≤ 20 µs, p99 ≤ 100 µs (issue 13).
+const STREAM_P50_US: u64 = 20;
+const STREAM_P99_US: u64 = 100;
+/// A stream's p99 against the bare loop's.
+const STREAM_P99_RATIO: f64 = 1.5;
+/// The ZSL-1 command interval at the dog: |interval − 2 ms| p99 ≤ 150 µs.
+const INTERVAL_AT_DOG_P99_US: u64 = 150;
+/// The ZSL-1 HighLevel stream before issue 13 (tokio's 1 ms timer wheel, `robowire demo`).
+const ZSL_BEFORE: &str = "before (tokio interval): p50 1076 µs, p99 1474 µs";
+
+/// `p50 / p99 / max` of a lateness summary in the metadata.
+fn percentiles_us(summary: &Value) -> anyhow::Result<(u64, u64, u64)> {
+    let field = |f: &str| summary[f].as_u64().with_context(|| format!("streams meta {f} in {summary}"));
+    Ok((field("p50_us")?, field("p99_us")?, field("max_us")?))
+}
+
+/// Rows of the streams bench: each periodic stream beside a bare `clock_nanosleep` loop, the
+/// ZSL-1 interval at the dog, the runner's spin.
+fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let seconds = meta["seconds"].as_f64().context("streams meta seconds")?;
+    let mut rows = Vec::new();
+    for stream in meta["streams"].as_array().context("streams meta streams")? {
+        let name = stream["name"].as_str().context("stream name")?;
+        let (p50, p99, max) = percentiles_us(&stream["lateness"])?;
+        let (b50, b99, bmax) = percentiles_us(&stream["bare_loop"])?;
+        let ratio = p99 as f64 / b99.max(1) as f64;
+        let before = if name.starts_with("ZSL-1 HighLevel") { format!("; {ZSL_BEFORE}") } else { String::new() };
+        rows.push(Row {
+            path: format!("{name}: send lateness over {seconds:.0} s"),
+            figure: format!("p50 {p50} µs, p99 {p99} µs, max {max} µs"),
+            baseline: format!(
+                "bare clock_nanosleep loop, same rate: p50 {b50} µs, p99 {b99} µs, max {bmax} µs{before}"
+            ),
+            ratio: format!("{ratio:.2}× (p99)"),
+            target: format!("p50 ≤ {STREAM_P50_US} µs, p99 ≤ {STREAM_P99_US} µs, ≤ {STREAM_P99_RATIO}× bare (p99)"),
+            met: Some(p50 <= STREAM_P50_US && p99 <= STREAM_P99_US && ratio <= STREAM_P99_RATIO),
+        });
+    }
+    let (i50, i99, imax) = percentiles_us(&meta["zsl_interval_at_dog"])?;
+    rows.push(Row {
+        path: "ZSL-1 HighLevel command interval at the simulated dog, |interval − 2 ms|".into(),
+        figure: format!("p50 {i50} µs, p99 {i99} µs, max {imax} µs"),
+        baseline: "period 2 ms".into(),
+        ratio: format!("{:.1} % of the period (p99)", i99 as f64 / 20.0),
+        target: format!("p99 ≤ {INTERVAL_AT_DOG_P99_US} µs"),
+        met: Some(i99 <= INTERVAL_AT_DOG_P99_US),
+    });
+    let spin = &meta["spin"];
+    let (b50, b99, _) = percentiles_us(&spin["bare_loop"])?;
+    for run in spin["runs"].as_array().context("streams meta spin runs")? {
+        let us = run["spin_us"].as_u64().context("spin_us")?;
+        let (p50, p99, max) = percentiles_us(&run["lateness"])?;
+        let cpu = run["cpu_percent"].as_f64().context("cpu_percent")?;
+        let chosen = if run["default"].as_bool() == Some(true) { " (the default)" } else { "" };
+        rows.push(Row {
+            path: format!("runner alone at 500 Hz, final spin {us} µs{chosen}"),
+            figure: format!("p50 {p50} µs, p99 {p99} µs, max {max} µs; CPU {cpu:.1} % of a core"),
+            baseline: format!("bare clock_nanosleep loop: p50 {b50} µs, p99 {b99} µs"),
+            ratio: format!("{:.2}× (p99)", p99 as f64 / b99.max(1) as f64),
+            target: "–".into(),
+            met: None,
+        });
+    }
     Ok(rows)
 }
 

@@ -9,6 +9,7 @@ mod error;
 mod frame;
 #[cfg(feature = "serde")]
 mod serde_impl;
+pub mod stream;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod stream_consistency;

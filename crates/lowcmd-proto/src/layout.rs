@@ -145,6 +145,24 @@ pub const fn padding_ranges<const N: usize>(layout: &StructLayout) -> [PadRange;
     out
 }
 
+/// An `L`-byte mask of `layout`'s image: 0x00 on padding, 0xFF elsewhere. ANDing an image
+/// with it zeroes the padding in one vectorizable pass. `N` is [`padding_count`].
+pub const fn padding_mask<const L: usize, const N: usize>(layout: &StructLayout) -> [u8; L] {
+    let ranges = padding_ranges::<N>(layout);
+    let mut mask = [0xFF; L];
+    let mut i = 0;
+    while i < N {
+        let (offset, len) = ranges[i];
+        let mut k = 0;
+        while k < len {
+            mask[offset + k] = 0;
+            k += 1;
+        }
+        i += 1;
+    }
+    mask
+}
+
 const fn collect_padding<const N: usize>(
     layout: &StructLayout,
     base: usize,

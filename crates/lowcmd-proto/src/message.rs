@@ -5,7 +5,7 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use crate::cdr::{self, BodyError, CdrEncoding, Transcoder};
 use crate::crc::crc32_words_in_place;
-use crate::layout::{PadRange, StructLayout, padding_count, padding_ranges};
+use crate::layout::{PadRange, StructLayout, padding_count, padding_mask, padding_ranges};
 use crate::{DecodeError, go2, hg};
 
 /// Largest struct image (HG `LowState_`).
@@ -59,14 +59,13 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
     /// The image's padding, `(offset, len)`, flattened from [`FIELDS`](Self::FIELDS) at compile
     /// time.
     const PADDING: &'static [PadRange];
+    /// The image's padding as a mask (0x00 on padding), from the same table.
+    const PADDING_MASK: &'static [u8];
 
-    /// Sets every padding byte to zero.
+    /// Sets every padding byte to zero (one AND pass with [`PADDING_MASK`](Self::PADDING_MASK)).
     fn zero_padding(&mut self) {
-        let bytes = self.as_mut_bytes();
-        for &(offset, len) in Self::PADDING {
-            if let Some(pad) = bytes.get_mut(offset..offset + len) {
-                pad.fill(0);
-            }
+        for (byte, mask) in self.as_mut_bytes().iter_mut().zip(Self::PADDING_MASK) {
+            *byte &= *mask;
         }
     }
 
@@ -217,6 +216,7 @@ macro_rules! message {
             const DDS_TYPE_NAME: &'static str = $dds;
             const TOPIC: &'static str = $topic;
             const PADDING: &'static [PadRange] = &padding_ranges::<{ padding_count(&$layout) }>(&$layout);
+            const PADDING_MASK: &'static [u8] = &padding_mask::<$len, { padding_count(&$layout) }>(&$layout);
         }
         impl $ty {
             #[doc = concat!("The sealed ", stringify!($len), "-byte struct image (zero padding, CRC).")]

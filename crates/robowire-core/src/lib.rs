@@ -4,6 +4,7 @@
 
 mod datagram;
 pub mod le;
+pub mod schedule;
 #[cfg(feature = "serde")]
 pub mod serde_f32;
 pub mod shm;

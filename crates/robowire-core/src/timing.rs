@@ -56,7 +56,14 @@ impl<const N: usize> LatenessRing<N> {
     /// Count, p50, p99 (nearest rank) and max.
     pub fn summary(&self) -> LatenessSummary {
         let mut sorted = self.samples;
-        let window = &mut sorted[..self.len];
+        LatenessSummary::of_window(&mut sorted[..self.len], self.total, self.max_us)
+    }
+}
+
+impl LatenessSummary {
+    /// The summary of a window of samples (sorted in place), with the total count and the
+    /// maximum since the start. For rings kept elsewhere (a lock-free one, say).
+    pub fn of_window(window: &mut [u32], count: u64, max_us: u32) -> Self {
         window.sort_unstable();
         let rank = |p: usize| -> u32 {
             if window.is_empty() {
@@ -67,7 +74,7 @@ impl<const N: usize> LatenessRing<N> {
                 window[index.min(window.len() - 1)]
             }
         };
-        LatenessSummary { count: self.total, p50_us: rank(50), p99_us: rank(99), max_us: self.max_us }
+        Self { count, p50_us: rank(50), p99_us: rank(99), max_us }
     }
 }
 

@@ -15,6 +15,18 @@ pub enum RtError {
         #[source]
         source: io::Error,
     },
+    /// A thread could not be started.
+    #[error("cannot start thread {name}")]
+    Thread {
+        /// The thread's name.
+        name: String,
+        /// What the system said.
+        #[source]
+        source: io::Error,
+    },
+    /// `mlockall` failed.
+    #[error("cannot lock the process's memory (needs CAP_IPC_LOCK or a memlock limit)")]
+    LockMemory(#[source] io::Error),
     /// `priority` could not be applied.
     #[error(
         "cannot run the thread at SCHED_FIFO priority {priority}: {reason} (needs CAP_SYS_NICE or an \
@@ -60,6 +72,31 @@ pub fn set_realtime_priority(priority: u8) -> Result<(), RtError> {
     )
     .map_err(|e| error(format!("{e:?}")))
 }
+
+/// Locks the process's current and future memory (`mlockall(MCL_CURRENT | MCL_FUTURE)`).
+#[cfg(target_os = "linux")]
+pub fn lock_memory() -> Result<(), RtError> {
+    use rustix::mm::{MlockAllFlags, mlockall};
+    mlockall(MlockAllFlags::CURRENT | MlockAllFlags::FUTURE).map_err(|e| RtError::LockMemory(e.into()))
+}
+
+/// Sets the calling thread's timer slack to 1 ns (Linux's default is 50 µs), so that a timed
+/// sleep ends within the kernel's wake-up latency of its target. Best effort: without it, waits
+/// only end later.
+#[cfg(target_os = "linux")]
+pub fn set_fine_timer_slack() {
+    let _ = rustix::thread::set_current_timer_slack(std::num::NonZeroU64::new(1));
+}
+
+/// Locks the process's memory (Linux only).
+#[cfg(not(target_os = "linux"))]
+pub fn lock_memory() -> Result<(), RtError> {
+    Err(RtError::LockMemory(io::Error::new(io::ErrorKind::Unsupported, "implemented on Linux only")))
+}
+
+/// Fine timer slack (Linux only; elsewhere nothing).
+#[cfg(not(target_os = "linux"))]
+pub fn set_fine_timer_slack() {}
 
 /// Pins the calling thread to `cpu` (Linux only).
 #[cfg(not(target_os = "linux"))]

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use robowire_core::{DecoderCounters, FrameBuffer, StreamDecoder};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use tokio_serial::{DataBits, FlowControl, Parity, SerialPort, SerialPortBuilderExt, SerialStream, StopBits};
+use tokio_serial::{DataBits, FlowControl, Parity, SerialPort, SerialStream, StopBits};
 
 /// Serial line settings. Character format is always 8N1 (8 data bits, no parity, 1 stop bit).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -109,9 +109,10 @@ pub const RX_BUFFER_LEN: usize = 1024;
 /// A serial port carrying frames of one stream protocol: whole-frame writes, decoded reads.
 ///
 /// Generic over any [`StreamDecoder`] of `robowire-core`; it knows nothing about the device.
-#[derive(Debug)]
 pub struct SerialLink<D: StreamDecoder> {
     port: Option<SerialStream>,
+    /// A second handle on the open port, for [`SyncWriter`]s.
+    native: Option<Box<dyn SerialPort>>,
     path: PathBuf,
     options: SerialPortOptions,
     rx: FrameBuffer<D, RX_BUFFER_LEN>,
@@ -119,14 +120,25 @@ pub struct SerialLink<D: StreamDecoder> {
     rts_asserted: bool,
 }
 
+impl<D: StreamDecoder> std::fmt::Debug for SerialLink<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SerialLink")
+            .field("path", &self.path)
+            .field("open", &self.port.is_some())
+            .field("counters", &self.counters)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<D: StreamDecoder> SerialLink<D> {
     /// Opens `path` with `options` and puts `decoder` on its receive side.
     /// Must be called inside a tokio runtime.
     pub fn open(path: impl AsRef<Path>, options: &SerialPortOptions, decoder: D) -> Result<Self, SerialError> {
         let path = path.as_ref().to_path_buf();
-        let (port, rts_asserted) = open_port(&path, options)?;
+        let (port, native, rts_asserted) = open_port(&path, options)?;
         Ok(Self {
             port: Some(port),
+            native: Some(native),
             path,
             options: options.clone(),
             rx: FrameBuffer::new(decoder),
@@ -161,8 +173,20 @@ impl<D: StreamDecoder> SerialLink<D> {
         self.rx.decoder_mut()
     }
 
+    /// A handle for whole-frame writes from another thread, without a runtime (a stream
+    /// thread that must never wait on an executor). It writes to the port as it is now: after a
+    /// disconnect its writes fail, and a new one is needed after [`reopen`](Self::reopen).
+    pub fn sync_writer(&self) -> Result<SyncWriter, SerialError> {
+        let native =
+            self.native.as_ref().ok_or_else(|| SerialError::Disconnected { path: self.path.clone(), source: None })?;
+        let mut port = native.try_clone().map_err(|source| SerialError::Open { path: self.path.clone(), source })?;
+        port.set_timeout(SYNC_WRITE_TIMEOUT).map_err(|source| SerialError::Open { path: self.path.clone(), source })?;
+        Ok(SyncWriter { port, path: self.path.clone(), bytes_written: 0, frames_written: 0 })
+    }
+
     fn disconnected(&mut self, source: Option<io::Error>) -> SerialError {
         self.port = None;
+        self.native = None;
         self.rx.clear();
         SerialError::Disconnected { path: self.path.clone(), source }
     }
@@ -211,14 +235,16 @@ impl<D: StreamDecoder> SerialLink<D> {
     /// Bytes pending from before are dropped.
     pub async fn reopen(&mut self, backoff: &Backoff) -> Result<(), SerialError> {
         self.port = None;
+        self.native = None;
         self.rx.clear();
         let mut delay = backoff.initial;
         let mut attempts = 0;
         loop {
             attempts += 1;
             match open_port(&self.path, &self.options) {
-                Ok((port, rts)) => {
+                Ok((port, native, rts)) => {
                     self.port = Some(port);
+                    self.native = Some(native);
                     self.rts_asserted = rts;
                     self.counters.reopens += 1;
                     return Ok(());
@@ -236,16 +262,63 @@ impl<D: StreamDecoder> SerialLink<D> {
     }
 }
 
-fn open_port(path: &Path, options: &SerialPortOptions) -> Result<(SerialStream, bool), SerialError> {
+/// How long a [`SyncWriter`] waits for room in the port's output buffer (a chassis holding CTS
+/// down, say) before a write fails.
+pub const SYNC_WRITE_TIMEOUT: Duration = Duration::from_millis(50);
+
+/// Whole-frame writes to an open serial port from any thread, without a runtime; see
+/// [`SerialLink::sync_writer`].
+pub struct SyncWriter {
+    port: Box<dyn SerialPort>,
+    path: PathBuf,
+    bytes_written: u64,
+    frames_written: u64,
+}
+
+impl std::fmt::Debug for SyncWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SyncWriter").field("path", &self.path).finish_non_exhaustive()
+    }
+}
+
+impl SyncWriter {
+    /// Writes one whole frame, waiting at most [`SYNC_WRITE_TIMEOUT`] for room. A failure means
+    /// the port is gone (or blocked for good): [`SerialError::Disconnected`].
+    pub fn send(&mut self, frame: &[u8]) -> Result<(), SerialError> {
+        use std::io::Write;
+        match self.port.write_all(frame) {
+            Ok(()) => {
+                self.bytes_written += frame.len() as u64;
+                self.frames_written += 1;
+                Ok(())
+            }
+            Err(e) => Err(SerialError::Disconnected { path: self.path.clone(), source: Some(e) }),
+        }
+    }
+
+    /// Bytes and frames this writer wrote.
+    pub fn written(&self) -> (u64, u64) {
+        (self.bytes_written, self.frames_written)
+    }
+}
+
+/// Opens the port, 8N1, with the options' flow control; returns the async stream, a second
+/// handle for synchronous writes, and whether RTS was asserted.
+fn open_port(
+    path: &Path,
+    options: &SerialPortOptions,
+) -> Result<(SerialStream, Box<dyn SerialPort>, bool), SerialError> {
     let open_error = |source| SerialError::Open { path: path.to_path_buf(), source };
     let flow = if options.rts_cts_flow_control { FlowControl::Hardware } else { FlowControl::None };
-    let mut port = tokio_serial::new(path.to_string_lossy(), options.baud_rate)
+    let native = tokio_serial::new(path.to_string_lossy(), options.baud_rate)
         .data_bits(DataBits::Eight)
         .parity(Parity::None)
         .stop_bits(StopBits::One)
         .flow_control(flow)
-        .open_native_async()
+        .open_native()
         .map_err(open_error)?;
+    let writer = native.try_clone_native().map_err(open_error)?;
+    let mut port = SerialStream::try_from(native).map_err(open_error)?;
     let rts_asserted = options.keep_rts_asserted && port.write_request_to_send(true).is_ok();
-    Ok((port, rts_asserted))
+    Ok((port, Box::new(writer), rts_asserted))
 }

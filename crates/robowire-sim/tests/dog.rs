@@ -8,7 +8,7 @@ use robowire_udp::{Peer, UdpError, UdpLink};
 use zsl_proto::codec::{ClientCodec, StateDecoding};
 use zsl_proto::udp::{ControlMode, DatagramError, HighLevelCommand, HighLevelState, Model};
 
-const WATCHDOG: Duration = Duration::from_secs(3);
+const WATCHDOG: Duration = Duration::from_secs(10);
 
 type Link = UdpLink<ClientCodec<HighLevelCommand, HighLevelState>>;
 

@@ -1,10 +1,19 @@
 //! The `robowire` binary as users script it.
 
 use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
+use std::process::{Command, Output, Stdio};
+use std::sync::{Mutex, PoisonError};
 
 fn robowire() -> Command {
     Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+/// `robowire demo …`, one at a time: its live timing checks measure streams that must not
+/// share two cores with another demo's.
+fn demo(args: &[&str]) -> Output {
+    static TURN: Mutex<()> = Mutex::new(());
+    let _turn = TURN.lock().unwrap_or_else(PoisonError::into_inner);
+    robowire().arg("demo").args(args).output().unwrap()
 }
 
 fn fixtures() -> Vec<serde_json::Value> {
@@ -56,7 +65,7 @@ fn decode_reports_noise_and_fails_without_frames() {
 
 #[test]
 fn demo_drives_the_simulated_chassis_and_checks_what_it_saw() {
-    let out = robowire().args(["demo", "--only", "kmc", "--duration", "1.5"]).output().unwrap();
+    let out = demo(&["--only", "kmc", "--duration", "1.5"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("demo passed"), "{stdout}");
@@ -75,7 +84,7 @@ fn demo_drives_the_simulated_chassis_and_checks_what_it_saw() {
 
 #[test]
 fn demo_refuses_a_nonsense_duration() {
-    let out = robowire().args(["demo", "--duration", "NaN"]).output().unwrap();
+    let out = demo(&["--duration", "NaN"]);
     assert!(!out.status.success());
 }
 
@@ -127,11 +136,13 @@ fn sim_and_device_commands_as_two_processes() {
 
 #[test]
 fn demo_lowcmd_loop_and_json_output() {
-    let out = robowire().args(["demo", "--only", "lowcmd", "--duration", "1", "--json"]).output().unwrap();
+    let out = demo(&["--only", "lowcmd", "--duration", "1", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");
     assert_eq!(report["passed"], true, "{report}");
-    assert_eq!(report["checks"].as_array().unwrap().len(), 2);
+    assert_eq!(report["checks"].as_array().unwrap().len(), 3);
+    let on_time = &report["checks"][2];
+    assert!(on_time["check"].as_str().unwrap().contains("send lateness p50"), "{report}");
     let device = &report["devices"][0];
     assert_eq!(device["device"], "lowcmd", "{report}");
     let rate_hz = device["rates_hz"]["loop"].as_f64().unwrap();

@@ -41,6 +41,12 @@ fn dog(port: &str, args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `robowire dog status --json`, parsed.
+fn status(port: &str) -> serde_json::Value {
+    let out = dog(port, &["status", "--json"]);
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&out)))
+}
+
 fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
@@ -52,7 +58,11 @@ fn stand_move_refuse_status_and_lie_down() {
     assert!(stand.status.success(), "{}", String::from_utf8_lossy(&stand.stderr));
     assert!(text(&stand).contains("stand_up: 0x0000 queued"), "{}", text(&stand));
     assert!(text(&stand).contains("robot reports mode 1"), "{}", text(&stand));
-    std::thread::sleep(std::time::Duration::from_millis(1300)); // standing up takes 1.2 s
+    // Standing up takes the simulated dog 1.2 s: wait until the body is at its standing height.
+    let start = std::time::Instant::now();
+    while status(&port)["position_m"][2].as_f64().is_none_or(|z| z < 0.299) {
+        assert!(start.elapsed() < std::time::Duration::from_secs(20), "the dog never stood up");
+    }
 
     let walk = dog(&port, &["move", "0.5", "0", "-0.2", "--duration", "0.6"]);
     assert!(walk.status.success(), "{}{}", text(&walk), String::from_utf8_lossy(&walk.stderr));
@@ -65,8 +75,7 @@ fn stand_move_refuse_status_and_lie_down() {
     assert!(!nan.status.success());
     assert!(text(&nan).contains("must be finite"), "{}", text(&nan));
 
-    let status = dog(&port, &["status", "--json"]);
-    let json: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+    let json = status(&port);
     assert_eq!(json["mode"], 18);
     assert!(json["position_m"][0].as_f64().unwrap() > 0.1, "{json}");
     // A state without error says so (not "Queued", a call's return code).

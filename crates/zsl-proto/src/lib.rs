@@ -10,6 +10,7 @@ pub mod rules;
 #[cfg(feature = "serde")]
 mod serde_impl;
 pub mod shm;
+pub mod stream;
 pub mod udp;
 
 pub use zerocopy;

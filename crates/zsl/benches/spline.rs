@@ -7,9 +7,9 @@
 //! - `spline_roundtrip/flags_only`: the flag ping-pong alone.
 //!
 //! After criterion, each variant's p50/p99 over individually timed round trips (10 interleaved
-//! rounds of 2000 per variant, so that a slow spell of the host hits all alike), and the spline
-//! daemon simulator's 1 kHz lateness over 10 s (3 s with `ROBOWIRE_BENCH_QUICK`), go to
-//! `$ROBOWIRE_BENCH_META` for `cargo xtask bench`.
+//! rounds of 2000 per variant, so that a slow spell of the host hits all alike), go to
+//! `$ROBOWIRE_BENCH_META_SPLINE` for `cargo xtask bench`. The daemon simulator's 1 kHz loop is
+//! measured with every other periodic stream by the `robowire` package's `streams` bench.
 
 // `criterion_group!`-style functions are undocumented by nature.
 #![allow(missing_docs)]
@@ -24,7 +24,7 @@ use criterion::Criterion;
 #[path = "../../../benches/timing.rs"]
 mod timing;
 use robowire_shm::{CreateOptions, MappedRegion, SharedRegion};
-use robowire_sim::spline::{CommandUpdate, SplineDaemon, SplineSim, SplineSimConfig};
+use robowire_sim::spline::{CommandUpdate, SplineDaemon};
 use timing::{percentiles, time_each};
 use zsl::{JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineStateBlock};
 use zsl_proto::zerocopy::IntoBytes;
@@ -188,24 +188,7 @@ fn main() {
         meta.push(format!("\"{name}_p50_ns\":{p50},\"{name}_p99_ns\":{p99}"));
     }
 
-    let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
-    let sim = SplineSim::spawn(SplineSimConfig::private("bench")).unwrap();
-    std::thread::sleep(Duration::from_secs(seconds));
-    let stats = sim.stats();
-    drop(sim);
-    println!(
-        "spline daemon 1 kHz over {seconds} s: {} cycles, {} missed, lateness p50 {} µs p99 {} µs max {} µs",
-        stats.cycles, stats.missed_cycles, stats.lateness.p50_us, stats.lateness.p99_us, stats.lateness.max_us
-    );
-    let json = format!(
-        "{{\"spline_roundtrip\":{{{}}},\"spline_loop\":{{\"seconds\":{seconds},\"cycles\":{},\"missed\":{},\"p50_us\":{},\"p99_us\":{},\"max_us\":{}}}}}",
-        meta.join(","),
-        stats.cycles,
-        stats.missed_cycles,
-        stats.lateness.p50_us,
-        stats.lateness.p99_us,
-        stats.lateness.max_us
-    );
+    let json = format!("{{\"spline_roundtrip\":{{{}}}}}", meta.join(","));
     println!("{json}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_SPLINE") {
         std::fs::write(path, json).unwrap();

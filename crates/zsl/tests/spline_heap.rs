@@ -112,6 +112,34 @@ fn a_silent_daemon_is_reported_as_stalled() {
     assert_eq!(client.counters().stalls, 1, "one stall, counted once");
 }
 
+/// The stall bound on a fake clock: exactly `stall_after` of polling without fresh state.
+#[test]
+fn the_stall_bound_on_a_fake_clock() {
+    use robowire_core::schedule::Time;
+    let shared = region();
+    let mut client = SplineClient::new(shared.clone()).unwrap(); // default bound: 10 ms
+    let mut daemon = SplineDaemon::new(shared).unwrap();
+    let t0 = Time::from_nanos(1_000_000_000);
+    let us = |n: u64| t0 + Duration::from_micros(n);
+    daemon.publish_state(&SplineStateBlock::default()).unwrap();
+    assert!(client.poll_state(us(0)).unwrap().is_some(), "fresh");
+    assert_eq!(client.poll_state(us(500)).unwrap(), None, "the stall clock starts at this poll");
+    assert_eq!(client.poll_state(us(10_499)).unwrap(), None, "not yet");
+    assert!(!client.is_stalled_at(us(10_499)) && client.is_stalled_at(us(10_500)));
+    match client.poll_state(us(10_500)) {
+        Err(SplineError::DaemonStalled { stalled_for }) => assert_eq!(stalled_for, Duration::from_millis(10)),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(client.poll_state(us(20_000)).unwrap(), None, "reported once per stall");
+    assert_eq!(client.counters().stalls, 1);
+    daemon.publish_state(&SplineStateBlock::default()).unwrap();
+    assert!(client.poll_state(us(30_000)).unwrap().is_some(), "the daemon is back");
+    assert!(!client.is_stalled_at(us(30_000)));
+    assert_eq!(client.poll_state(us(30_001)).unwrap(), None);
+    assert!(matches!(client.poll_state(us(40_001)), Err(SplineError::DaemonStalled { .. })), "a second stall");
+    assert_eq!(client.counters().stalls, 2);
+}
+
 #[test]
 fn regions_too_small_are_refused() {
     assert!(SplineClient::new(HeapRegion::new(SPLINE_DATA_LEN - 4)).is_err());

@@ -1,14 +1,34 @@
 //! The client against the 1 kHz daemon simulator on real shared memory: fault handling and a
-//! PD loop that moves the legs.
+//! PD loop that moves the legs. Order and content only: the stall bound's timing is
+//! `spline_heap.rs`'s fake-clock test. One 1 kHz simulator at a time (two cores).
 
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
 use robowire_sim::spline::{STANDING_POSE_RAD, SplineSim, SplineSimConfig};
 use zsl::spline::{ImuReader, SplineError};
 use zsl::{JointControl, JointFlags, JointIndex, Leg, SplineClient, SplineCommandBlock};
 
+/// Generous: a condition not reached within this is a failure, not slowness.
+const WATCHDOG: Duration = Duration::from_secs(20);
+
+/// Held while a simulator runs: the tests of this binary take turns.
+fn one_at_a_time() -> MutexGuard<'static, ()> {
+    static TURN: Mutex<()> = Mutex::new(());
+    TURN.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
 fn sim(tag: &str) -> SplineSim {
     SplineSim::spawn(SplineSimConfig::private(tag)).expect("simulator")
+}
+
+#[track_caller]
+fn wait_until(what: &str, mut done: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !done() {
+        assert!(start.elapsed() < WATCHDOG, "not within {WATCHDOG:?}: {what}");
+        std::thread::sleep(Duration::from_millis(1));
+    }
 }
 
 fn hold(pose: [f32; 3], kp: f32, kd: f32) -> SplineCommandBlock {
@@ -31,58 +51,54 @@ fn missing_daemon_is_a_typed_error() {
 }
 
 #[test]
-fn a_stopped_daemon_is_reported_within_the_stall_bound() {
+fn a_stopped_daemon_is_reported_as_stalled_and_recovers() {
+    let _turn = one_at_a_time();
     let sim = sim("stall");
     let mut client = SplineClient::open(&sim.config().spline_name).unwrap();
     for _ in 0..20 {
-        client.wait_state(Duration::from_millis(100)).unwrap();
+        client.wait_state(WATCHDOG).unwrap();
     }
     sim.pause(true);
-    let paused_at = Instant::now();
     let err = loop {
-        match client.wait_state(Duration::from_millis(100)) {
+        match client.wait_state(WATCHDOG) {
             Ok(_) => continue, // a state published just before the pause
             Err(e) => break e,
         }
     };
-    let noticed = paused_at.elapsed();
     assert!(matches!(err, SplineError::DaemonStalled { .. }), "{err}");
-    // Bound: 10 ms without fresh state, plus the last cycle before the pause, plus slack.
-    assert!(noticed <= Duration::from_millis(10 + 1 + 40), "stall noticed after {noticed:?}");
     assert_eq!(client.counters().stalls, 1);
     sim.pause(false);
-    client.wait_state(Duration::from_millis(100)).expect("fresh state again after the daemon resumed");
+    client.wait_state(WATCHDOG).expect("fresh state again after the daemon resumed");
     assert!(!client.is_stalled());
 }
 
 #[test]
 fn a_vanished_client_makes_the_daemon_clear_the_command() {
+    let _turn = one_at_a_time();
     let sim = sim("vanish");
     let mut client = SplineClient::open(&sim.config().spline_name).unwrap();
     client.write_command(&hold(STANDING_POSE_RAD, 40.0, 1.0)).unwrap();
+    let hip_enabled = |leg| JointFlags(sim.state().joint(leg, JointIndex::Hip).flags.get()).enabled();
+    wait_until("the command in force", || Leg::ALL.iter().all(|&leg| hip_enabled(leg)));
     drop(client);
-    let start = Instant::now();
-    while sim.stats().daemon.clears == 0 && start.elapsed() < Duration::from_secs(2) {
-        std::thread::sleep(Duration::from_millis(1));
-    }
+    wait_until("the command cleared", || sim.stats().daemon.clears == 1);
+    // Cleared: the motors go limp (kp = kd = 0: disabled) in the next published state.
+    wait_until("every hip disabled", || Leg::ALL.iter().all(|&leg| !hip_enabled(leg)));
     let stats = sim.stats();
     assert_eq!(stats.daemon.clears, 1, "{stats:?}");
-    assert!(stats.daemon.fresh >= 1);
-    // About 10 cycles after the last command: the motors are limp (kp = kd = 0: disabled).
-    std::thread::sleep(Duration::from_millis(5));
-    let state = sim.state();
-    assert!(Leg::ALL.iter().all(|&leg| !JointFlags(state.joint(leg, JointIndex::Hip).flags.get()).enabled()));
+    assert!(stats.daemon.fresh >= 1 && stats.daemon.repeated >= 9, "ten cycles without a command: {stats:?}");
 }
 
 #[test]
 fn a_pd_loop_moves_the_legs_to_the_stand_pose() {
+    let _turn = one_at_a_time();
     let sim = sim("stand");
     let mut client = SplineClient::open(&sim.config().spline_name).unwrap();
     let mut imu = ImuReader::open(&sim.config().imu_name).unwrap();
     let target = hold(STANDING_POSE_RAD, 60.0, 2.0);
     let mut last = None;
     for _ in 0..800 {
-        let state = client.wait_state(Duration::from_millis(50)).unwrap();
+        let state = client.wait_state(WATCHDOG).unwrap();
         client.write_command(&target).unwrap();
         last = Some(state);
     }
@@ -95,17 +111,18 @@ fn a_pd_loop_moves_the_legs_to_the_stand_pose() {
     }
     let sample = imu.read().unwrap();
     assert_eq!(sample.acc_mps2[2], 9.81);
-    assert!(imu.latest_age().unwrap() < Duration::from_millis(100));
+    wait_until("a newer IMU sample", || imu.read().unwrap().timestamp_ns > sample.timestamp_ns);
     assert!(sim.stats().cycles >= 800);
 }
 
 #[test]
 fn fault_bits_reach_the_client() {
+    let _turn = one_at_a_time();
     let sim = sim("fault");
     sim.inject_fault(Leg::FrontLeft, JointIndex::Knee, JointFlags::OVER_TEMPERATURE);
     let mut client = SplineClient::open(&sim.config().spline_name).unwrap();
-    client.wait_state(Duration::from_millis(100)).unwrap();
-    let state = client.wait_state(Duration::from_millis(100)).unwrap();
+    client.wait_state(WATCHDOG).unwrap();
+    let state = client.wait_state(WATCHDOG).unwrap();
     let flags = JointFlags(state.joint(Leg::FrontLeft, JointIndex::Knee).flags.get());
     assert!(flags.faults().over_temperature);
     assert!(!JointFlags(state.joint(Leg::FrontLeft, JointIndex::Hip).flags.get()).faults().any());

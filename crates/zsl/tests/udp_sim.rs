@@ -1,6 +1,8 @@
 //! The HighLevel and LowLevel clients against robowire's dog simulator and scripted peers on
 //! loopback: motion, argument checks, the watchdog and reconnect, source filtering, faults,
 //! lenient decoding, both interfaces at once. 127.0.0.2 (loopback on Linux) plays a foreign host.
+//! Conditions are awaited with a generous timeout; nothing here asserts how long anything took
+//! (the stream's timing is `zsl-proto`'s fake-clock tests).
 
 use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
@@ -10,7 +12,8 @@ use zsl::udp::{CallError, ClientOptions, Connection, ControlMode, HighLevel, Low
 use zsl_proto::rules::ArgumentError;
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
-const WAIT: Duration = Duration::from_secs(3);
+/// Generous: a condition not reached within this is a failure, not slowness.
+const WAIT: Duration = Duration::from_secs(20);
 
 fn options_to(dog: SocketAddr) -> ClientOptions {
     ClientOptions { dog, ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) }
@@ -29,13 +32,11 @@ async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
 }
 
 async fn wait_until(done: impl Fn() -> bool) {
-    for _ in 0..300 {
-        if done() {
-            return;
-        }
-        tokio::time::sleep(Duration::from_millis(10)).await;
+    let start = std::time::Instant::now();
+    while !done() {
+        assert!(start.elapsed() < WAIT, "condition not reached within {WAIT:?}");
+        tokio::time::sleep(Duration::from_millis(1)).await;
     }
-    panic!("condition not reached within 3 s");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -80,7 +81,7 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 async fn arguments_are_checked_before_anything_is_sent() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
-    let latched = client.wire_command().await;
+    let latched = client.wire_command();
     let refused = |r: Result<(), CallError>| matches!(r, Err(CallError::Argument(_)));
     for (vx, vy, wz) in [
         (0.04, 0.0, 0.0),
@@ -101,7 +102,7 @@ async fn arguments_are_checked_before_anything_is_sent() {
     ));
     assert!(refused(client.attitude_control(0.0, 0.61, 0.0, 0.0).await));
     assert!(refused(client.two_leg_stand(0.1, 0.0).await));
-    assert_eq!(client.wire_command().await, latched, "nothing was latched");
+    assert_eq!(client.wire_command(), latched, "nothing was latched");
     assert_eq!(client.move_velocity(f32::NAN, 0.0, 0.0).await.unwrap_err().return_code(), ReturnCode::SpeedTooLarge);
 
     // The band edges are inside; |v| ≤ 1e-6 is zero.
@@ -125,12 +126,11 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
     assert_eq!(*events.borrow_and_update(), Connection::Disconnected);
     assert!(!client.check_connection());
     assert_eq!(client.state(), None, "no state instead of stale or zero values");
-    let latched = client.wire_command().await;
+    let latched = client.wire_command();
     assert_eq!(latched.control_mode(), ControlMode::Move, "same mode");
     assert_eq!((latched.vx.get(), latched.yaw_rate.get()), (0.0, 0.0), "the latched motion became a stop");
     let sent = client.stats().link.sent;
-    tokio::time::sleep(Duration::from_millis(50)).await;
-    assert!(client.stats().link.sent > sent, "the stop keeps streaming while disconnected");
+    wait_until(|| client.stats().link.sent > sent + 5).await; // the stop keeps streaming while disconnected
 
     sim.clear_faults();
     tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
@@ -143,8 +143,7 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
         "the silence shows as the largest gap between states: {:?}",
         stats.state_gap
     );
-    assert!(stats.state_gap.p50_us < 10_000, "the dog streams every 2 ms: {:?}", stats.state_gap);
-    assert_eq!(client.wire_command().await.vx.get(), 0.0, "a stale motion never resumes");
+    assert_eq!(client.wire_command().vx.get(), 0.0, "a stale motion never resumes");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -168,13 +167,18 @@ async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog()
         .await
         .unwrap();
     let to = client.local_addr();
-    for _ in 0..20 {
+    let mut events = client.connection_events();
+    let mut spoofed = 0;
+    // Spoof until the watchdog, which nothing fed, expires.
+    while *events.borrow_and_update() != Connection::Disconnected {
         spoofer.send_to(&state(21), to).unwrap();
-        tokio::time::sleep(Duration::from_millis(20)).await;
+        spoofed += 1;
+        let _ = tokio::time::timeout(Duration::from_millis(20), events.changed()).await;
     }
+    wait_until(|| client.stats().link.foreign_dropped == spoofed).await;
     assert_eq!(client.state(), None, "a spoofed state never lands");
     assert_eq!(client.connection(), Connection::Disconnected, "nor keeps the connection alive");
-    assert_eq!(client.stats().link.foreign_dropped, 20);
+    assert_eq!(client.stats().states, 0);
 
     dog.send_to(&state(1), to).unwrap();
     assert!(client.wait_connected(WAIT).await);
@@ -201,7 +205,7 @@ async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
     let merged = client.wait_for_state(WAIT, |s| s.body.imu.quaternion_wxyz[0] == 1.0).await.unwrap();
     assert_eq!(merged.body.mode, ControlMode::Move, "the rest of the state is kept");
     dog.send_to(&[0u8; 561], to).unwrap();
-    tokio::time::sleep(Duration::from_millis(50)).await;
+    wait_until(|| client.stats().link.decode_errors == 1).await; // longer than the state is an error
     let stats = client.stats();
     assert_eq!((stats.states, stats.short_states, stats.header_anomalies), (3, 2, 1), "{stats:?}");
     assert_eq!(stats.link.decode_errors, 1, "longer than the state is an error");
@@ -215,8 +219,8 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
     assert!(client.wait_for_state(WAIT, |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
     assert!(matches!(client.jump().await, Err(CallError::SelfCheck(ReturnCode::MotorFault))));
-    tokio::time::sleep(Duration::from_millis(20)).await;
-    assert_eq!(client.wire_command().await.control_mode(), ControlMode::Passive, "the stream forces passive");
+    // The stream forces passive.
+    wait_until(|| client.wire_command().control_mode() == ControlMode::Passive).await;
     wait_until(|| sim.snapshot().dog.mode() == ControlMode::Passive).await;
     sim.clear_faults();
 
@@ -231,12 +235,13 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
 
     sim.inject(DogFault::SdkMismatch);
     assert!(client.wait_for_state(WAIT, |s| s.sdk_mismatch).await.is_some());
-    tokio::time::sleep(Duration::from_millis(20)).await;
-    assert!(client.halted().await, "the stream stops for good, like the vendor's");
+    wait_until(|| client.halted()).await; // the stream stops for good, like the vendor's
     assert!(matches!(client.stand_up().await, Err(CallError::SdkMismatch)));
-    let commands = sim.snapshot().high_level.commands;
+    let sent = client.stats().link.sent;
+    wait_until(|| sim.snapshot().high_level.commands == sent).await; // everything sent arrived
+    // An absence, observed over a moment: nothing more is sent.
     tokio::time::sleep(Duration::from_millis(50)).await;
-    assert_eq!(sim.snapshot().high_level.commands, commands, "nothing more is sent");
+    assert_eq!((client.stats().link.sent, sim.snapshot().high_level.commands), (sent, sent));
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -265,7 +270,7 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
     let mut nan = stand;
     nan.kp[0][0] = f32::NAN;
     assert!(matches!(low.send_motor_command(&nan).await, Err(CallError::Argument(ArgumentError::NonFinite(_)))));
-    assert_eq!(MotorCommand::from(&low.wire_command().await.motor), stand);
+    assert_eq!(MotorCommand::from(&low.wire_command().motor), stand);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -277,9 +282,9 @@ async fn a_zsl1w_crawls_and_its_wheels_turn() {
     client.crawl(0.5, 0.0, 0.0).await.unwrap();
     let rolling = client.wait_for_state(WAIT, |s| s.joints.position_rad.foot[0] > 1.0).await;
     assert!(rolling.is_some(), "the foot (wheel) joints integrate the forward speed");
-    assert_eq!(client.wire_command().await.action_code(), zsl::udp::Action::Crawl);
+    assert_eq!(client.wire_command().action_code(), zsl::udp::Action::Crawl);
     client.cancel_crawl().await.unwrap();
-    assert_eq!(client.wire_command().await.action_code(), zsl::udp::Action::None);
+    assert_eq!(client.wire_command().action_code(), zsl::udp::Action::None);
     client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
     assert!(!client.state().unwrap().sdk_mismatch, "the right magic raises no mismatch");
 
@@ -304,7 +309,7 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
         .unwrap()
         .unwrap();
     assert_eq!(low.motor_state(), None);
-    let latched = MotorCommand::from(&low.wire_command().await.motor);
+    let latched = MotorCommand::from(&low.wire_command().motor);
     assert!(latched.qd_des_radps.iter().flatten().all(|&v| v == 0.0), "velocity targets zeroed");
     assert_eq!(
         (latched.q_des_rad, latched.kp, latched.tau_ff_nm),
@@ -313,4 +318,22 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
     );
     sim.clear_faults();
     assert!(low.wait_for_state(WAIT, |_| true).await.is_some(), "reconnects");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn bad_options_and_placement_are_typed_errors() {
+    use zsl::udp::ConnectError;
+    let dog: SocketAddr = "127.0.0.1:9".parse().unwrap();
+    let base = options_to(dog);
+    let too_fast = ClientOptions { period: Duration::from_micros(10), ..base.clone() };
+    assert!(matches!(HighLevel::connect(too_fast).await, Err(ConnectError::Option { name: "period", .. })));
+    let short_watchdog = ClientOptions { watchdog: Duration::from_millis(1), ..base.clone() };
+    assert!(matches!(HighLevel::connect(short_watchdog).await, Err(ConnectError::Option { name: "watchdog", .. })));
+    let priority = ClientOptions { realtime_priority: Some(0), ..base.clone() };
+    assert!(matches!(LowLevel::connect(priority).await, Err(ConnectError::Option { name: "realtime_priority", .. })));
+    let nowhere = ClientOptions { cpu_affinity: Some(1 << 20), ..base };
+    match HighLevel::connect(nowhere).await {
+        Err(ConnectError::StreamThread(zsl::udp::RtError::CpuAffinity { cpu, .. })) => assert_eq!(cpu, 1 << 20),
+        other => panic!("{other:?}"),
+    }
 }

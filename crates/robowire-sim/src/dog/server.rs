@@ -2,17 +2,20 @@
 //! device side and the ZSL-1 dog codecs, so that the transport is exercised from both ends.
 //!
 //! A thread runs a small tokio runtime that receives commands on both ports and answers a
-//! command that changes something at once; a second thread streams state to each client every
-//! `state_period` on absolute deadlines.
+//! command that changes something at once; robowire's runner streams state to each client every
+//! `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted).
 
 use std::io;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use robowire_core::DatagramCodec;
+use robowire_core::schedule::{Periodic, Time};
+use robowire_core::timing::LatenessSummary;
+use robowire_rt::runner::{Job, Runner, RunnerOptions};
+use robowire_rt::stats::{SharedLateness, micros};
 use robowire_udp::{Peer, UdpError, UdpLink, UdpReceiver, UdpSender};
 use tokio::sync::watch;
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
@@ -73,6 +76,9 @@ pub struct PortStats {
     pub garbage_sent: u64,
     /// Where state goes (learned or configured).
     pub client: Option<SocketAddr>,
+    /// |interval − `state_period`| between consecutive valid commands as they arrive, µs: how
+    /// evenly the client streams (calls between refreshes show as outliers).
+    pub command_jitter: LatenessSummary,
 }
 
 /// What the simulator has seen and done.
@@ -86,19 +92,54 @@ pub struct DogSnapshot {
     pub low_level: PortStats,
     /// State cycles run.
     pub cycles: u64,
+    /// State cycles skipped because the stream was more than a period late.
+    pub missed_cycles: u64,
+    /// Lateness of the state stream against its absolute deadlines, µs.
+    pub state_lateness: LatenessSummary,
 }
 
 /// One port: its sending half and counters.
 struct Port<C> {
     sender: UdpSender<C>,
     stats: PortStats,
+    last_command: Option<Time>,
+}
+
+impl<C: DatagramCodec> Port<C> {
+    fn new(sender: UdpSender<C>, client: Option<SocketAddr>) -> Self {
+        Self { sender, stats: PortStats { client, ..PortStats::default() }, last_command: None }
+    }
+
+    /// A valid command arrived now; records |interval − `period`| in `jitter`.
+    fn on_command(&mut self, period: Duration, jitter: &SharedLateness<4096>) {
+        let now = robowire_rt::now();
+        self.stats.commands += 1;
+        if let Some(last) = self.last_command.replace(now) {
+            jitter.record(micros(now.saturating_duration_since(last).abs_diff(period)));
+        }
+    }
+
+    fn stats(&self, jitter: &SharedLateness<4096>) -> PortStats {
+        PortStats { client: self.sender.destination(), command_jitter: jitter.summary(), ..self.stats }
+    }
 }
 
 struct Shared {
     dog: DogModel,
     high: Port<HighLevelDogCodec>,
     low: Port<LowLevelDogCodec>,
+    period: Duration,
     cycles: u64,
+    missed_cycles: u64,
+}
+
+/// Timing statistics, kept out of the model's lock: each ring has one writer, and a reader
+/// sorts its copy without holding up the state stream.
+#[derive(Default)]
+struct Timing {
+    state_lateness: SharedLateness<4096>,
+    high_level_jitter: SharedLateness<4096>,
+    low_level_jitter: SharedLateness<4096>,
 }
 
 fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
@@ -137,9 +178,10 @@ impl Shared {
 /// The dog on two UDP ports, on its own threads; stopped on drop.
 pub struct DogSim {
     shared: Arc<Mutex<Shared>>,
-    stop: Arc<AtomicBool>,
+    timing: Arc<Timing>,
+    stream: Option<Runner<StateStream>>,
     stop_receiving: watch::Sender<bool>,
-    threads: Vec<JoinHandle<()>>,
+    receiver: Option<JoinHandle<()>>,
     high_level_addr: SocketAddr,
     low_level_addr: SocketAddr,
 }
@@ -178,9 +220,11 @@ fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<
         let (low_tx, low_rx) = low.into_split();
         let shared = Shared {
             dog: DogModel::new(config.model),
-            high: Port { sender: high_tx, stats: PortStats { client: config.client, ..PortStats::default() } },
-            low: Port { sender: low_tx, stats: PortStats { client: config.client, ..PortStats::default() } },
+            high: Port::new(high_tx, config.client),
+            low: Port::new(low_tx, config.client),
+            period: config.state_period,
             cycles: 0,
+            missed_cycles: 0,
         };
         Ok((shared, (high_rx, low_rx)))
     })
@@ -201,8 +245,9 @@ impl DogSim {
     pub fn spawn(config: DogSimConfig) -> io::Result<Self> {
         let (started_tx, started) = std::sync::mpsc::sync_channel(1);
         let (stop_receiving, mut stop_rx) = watch::channel(false);
+        let timing = Arc::new(Timing::default());
         let receiver = std::thread::Builder::new().name("dog-sim-rx".into()).spawn({
-            let config = config.clone();
+            let (config, timing) = (config.clone(), timing.clone());
             move || {
                 let setup = || -> io::Result<_> {
                     if let Some(cpu) = config.cpu {
@@ -221,7 +266,7 @@ impl DogSim {
                     }
                 };
                 let _ = started_tx.send(Ok(shared.clone()));
-                runtime.block_on(receive(shared, high, low, &mut stop_rx));
+                runtime.block_on(receive(shared, &timing, high, low, &mut stop_rx));
             }
         })?;
         let shared = started.recv().map_err(|_| io::Error::other("the dog simulator thread died"))??;
@@ -229,17 +274,23 @@ impl DogSim {
             let s = lock(&shared);
             (s.high.sender.local_addr()?, s.low.sender.local_addr()?)
         };
-        let stop = Arc::new(AtomicBool::new(false));
-        let stream = std::thread::Builder::new().name("dog-sim-state".into()).spawn({
-            let (shared, stop, config) = (shared.clone(), stop.clone(), config.clone());
-            move || {
-                if let Some(cpu) = config.cpu {
-                    let _ = robowire_rt::pin_current_thread(cpu);
-                }
-                stream_state(&shared, &stop, config.state_period);
-            }
-        })?;
-        Ok(Self { shared, stop, stop_receiving, threads: vec![receiver, stream], high_level_addr, low_level_addr })
+        let job = StateStream {
+            shared: shared.clone(),
+            timing: timing.clone(),
+            grid: Periodic::new(robowire_rt::now(), config.state_period),
+            last_step: None,
+        };
+        let stream = Runner::spawn(RunnerOptions { cpu: config.cpu, ..RunnerOptions::named("dog-sim-state") }, job)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
+        Ok(Self {
+            shared,
+            timing,
+            stream: Some(stream),
+            stop_receiving,
+            receiver: Some(receiver),
+            high_level_addr,
+            low_level_addr,
+        })
     }
 
     /// Where HighLevel commands go.
@@ -270,22 +321,25 @@ impl DogSim {
     /// The robot and the counters now.
     pub fn snapshot(&self) -> DogSnapshot {
         let s = lock(&self.shared);
-        let port = |stats: PortStats, client: Option<SocketAddr>| PortStats { client, ..stats };
         DogSnapshot {
             dog: s.dog.clone(),
-            high_level: port(s.high.stats, s.high.sender.destination()),
-            low_level: port(s.low.stats, s.low.sender.destination()),
+            high_level: s.high.stats(&self.timing.high_level_jitter),
+            low_level: s.low.stats(&self.timing.low_level_jitter),
             cycles: s.cycles,
+            missed_cycles: s.missed_cycles,
+            state_lateness: self.timing.state_lateness.summary(),
         }
     }
 }
 
 impl Drop for DogSim {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
+        if let Some(stream) = self.stream.take() {
+            stream.stop();
+        }
         let _ = self.stop_receiving.send(true);
-        for thread in self.threads.drain(..) {
-            let _ = thread.join();
+        if let Some(receiver) = self.receiver.take() {
+            let _ = receiver.join();
         }
     }
 }
@@ -295,6 +349,7 @@ impl Drop for DogSim {
 /// client's acknowledgement).
 async fn receive(
     shared: Arc<Mutex<Shared>>,
+    timing: &Timing,
     mut high: UdpReceiver<HighLevelDogCodec>,
     mut low: UdpReceiver<LowLevelDogCodec>,
     stop: &mut watch::Receiver<bool>,
@@ -306,7 +361,8 @@ async fn receive(
                 let mut s = lock(&shared);
                 match received {
                     Ok((command, model)) => {
-                        s.high.stats.commands += 1;
+                        let period = s.period;
+                        s.high.on_command(period, &timing.high_level_jitter);
                         if s.dog.on_high_level(&command, model) {
                             s.send_high_level();
                         }
@@ -320,7 +376,8 @@ async fn receive(
                 let mut s = lock(&shared);
                 match received {
                     Ok((command, _)) => {
-                        s.low.stats.commands += 1;
+                        let period = s.period;
+                        s.low.on_command(period, &timing.low_level_jitter);
                         if s.dog.on_low_level(&command) {
                             s.send_low_level();
                         }
@@ -333,26 +390,31 @@ async fn receive(
     }
 }
 
-/// Steps the dog and sends state every `period` on absolute deadlines; more than ten periods
-/// behind, the grid restarts from now.
-fn stream_state(shared: &Mutex<Shared>, stop: &AtomicBool, period: Duration) {
-    let mut next = Instant::now() + period;
-    let mut last_step = Instant::now();
-    while !stop.load(Ordering::Relaxed) {
-        std::thread::sleep(next.saturating_duration_since(Instant::now()));
-        let now = Instant::now();
-        let dt = now.duration_since(last_step).as_secs_f32().min(0.05);
-        last_step = now;
-        {
-            let mut s = lock(shared);
-            s.dog.step(dt);
-            s.cycles += 1;
-            s.send_high_level();
-            s.send_low_level();
-        }
-        next += period;
-        if now > next + period * 10 {
-            next = now + period;
-        }
+/// The state stream: steps the dog and sends state on each tick of the grid.
+struct StateStream {
+    shared: Arc<Mutex<Shared>>,
+    timing: Arc<Timing>,
+    grid: Periodic,
+    last_step: Option<Time>,
+}
+
+/// Longest step of the model, s: after a stall the dog does not jump.
+const MAX_STEP_S: f32 = 0.05;
+
+impl Job for StateStream {
+    fn next_run(&mut self) -> Option<Time> {
+        Some(self.grid.deadline())
+    }
+
+    fn run(&mut self, now: Time) {
+        let Some(tick) = self.grid.poll(now) else { return };
+        let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
+        self.timing.state_lateness.record(micros(tick.lateness));
+        let mut s = lock(&self.shared);
+        s.missed_cycles += tick.skipped;
+        s.dog.step(dt.min(MAX_STEP_S));
+        s.cycles += 1;
+        s.send_high_level();
+        s.send_low_level();
     }
 }

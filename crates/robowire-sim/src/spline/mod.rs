@@ -1,22 +1,25 @@
 //! The ZSL-1 spline daemon on POSIX shared memory (spec `spline-shm.md`): a 1 kHz loop on
-//! absolute deadlines that consumes commands like the vendor daemon, drives a PD joint model,
-//! publishes motor state and an IMU sample every cycle, and measures its own lateness.
-//!
-//! Waiting: sleep until shortly before each deadline (`spin_margin`), then spin; on this class of
-//! machine a plain sleep overshoots by 50–100 µs, the spin removes that.
+//! robowire's runner (absolute deadlines, coarse sleep then a short spin, a late cycle run once
+//! and the missed ones counted) that consumes commands like the vendor daemon, drives a PD joint
+//! model, publishes motor state and an IMU sample every cycle, and measures its own lateness.
+//! The loop takes no lock: what it shares with the handle is atomics and a seqlock.
 //!
 //! [`SplineDaemon`] and [`ImuWriter`] ([`daemon`]) are the device side of the shared memory,
 //! usable by any daemon.
 
 pub mod daemon;
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::time::Duration;
 
-use robowire_core::timing::{LatenessRing, LatenessSummary};
+use robowire_core::schedule::{Periodic, Time};
+use robowire_core::timing::LatenessSummary;
+use robowire_rt::Latest;
+use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions};
+use robowire_rt::stats::{Counter, SharedLateness, micros};
 use robowire_shm::CreateOptions;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 use zsl_proto::shm::{
     IMU_SHM_NAME, JointFlags, JointIndex, Leg, NavImu, NavImuSample, SPLINE_SHM_NAME, SplineCommandBlock,
     SplineStateBlock,
@@ -42,8 +45,8 @@ pub struct SplineSimConfig {
     pub create: CreateOptions,
     /// Cycle period (default 1 ms).
     pub period: Duration,
-    /// Sleep until this long before a deadline, then spin (default 200 µs).
-    pub spin_margin: Duration,
+    /// The last part of each wait, spent spinning (default the runner's [`DEFAULT_SPIN`]).
+    pub spin: Duration,
 }
 
 impl Default for SplineSimConfig {
@@ -53,7 +56,7 @@ impl Default for SplineSimConfig {
             imu_name: IMU_SHM_NAME.into(),
             create: CreateOptions::default(),
             period: Duration::from_millis(1),
-            spin_margin: Duration::from_micros(200),
+            spin: DEFAULT_SPIN,
         }
     }
 }
@@ -93,31 +96,49 @@ pub enum SplineSimError {
     /// An object could not be created.
     #[error(transparent)]
     Daemon(#[from] DaemonError),
-    /// The thread.
+    /// The loop's thread.
     #[error("cannot start the simulator thread")]
-    Thread(#[from] std::io::Error),
+    Thread(#[from] robowire_rt::RtError),
 }
 
+/// What the loop shares with the handle: written by the loop without a lock.
 #[derive(Debug, Default)]
 struct Shared {
-    stats: SplineSimStats,
-    lateness: LatenessRing<16384>,
-    state: SplineStateBlock,
-    fault_bits: [[u32; 4]; 4],
+    cycles: Counter,
+    missed_cycles: Counter,
+    imu_samples: Counter,
+    daemon: Latest<DaemonCounterWords>,
+    lateness: SharedLateness<16384>,
+    state: Latest<SplineStateBlock>,
+    fault_bits: [[AtomicU32; 4]; 4],
+    paused: AtomicBool,
+}
+
+/// [`SplineDaemonCounters`] as the seqlock carries them.
+#[derive(Debug, Clone, Copy, FromBytes, IntoBytes, KnownLayout, Immutable)]
+#[repr(C)]
+struct DaemonCounterWords([u64; 6]);
+
+impl From<SplineDaemonCounters> for DaemonCounterWords {
+    fn from(c: SplineDaemonCounters) -> Self {
+        Self([c.fresh, c.repeated, c.cleared, c.clears, c.rejected, c.states_published])
+    }
+}
+
+impl From<DaemonCounterWords> for SplineDaemonCounters {
+    fn from(
+        DaemonCounterWords([fresh, repeated, cleared, clears, rejected, states_published]): DaemonCounterWords,
+    ) -> Self {
+        Self { fresh, repeated, cleared, clears, rejected, states_published }
+    }
 }
 
 /// A running spline daemon simulator; dropping it stops the loop and removes its objects.
 #[derive(Debug)]
 pub struct SplineSim {
     config: SplineSimConfig,
-    shared: Arc<Mutex<Shared>>,
-    stop: Arc<AtomicBool>,
-    paused: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
-}
-
-fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
-    shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    shared: Arc<Shared>,
+    runner: Option<Runner<DaemonLoop>>,
 }
 
 impl SplineSim {
@@ -125,14 +146,19 @@ impl SplineSim {
     pub fn spawn(config: SplineSimConfig) -> Result<Self, SplineSimError> {
         let daemon = SplineDaemon::create(&config.spline_name, &config.create)?;
         let imu = ImuWriter::create(&config.imu_name, &config.create)?;
-        let shared = Arc::new(Mutex::new(Shared::default()));
-        let stop = Arc::new(AtomicBool::new(false));
-        let paused = Arc::new(AtomicBool::new(false));
-        let thread = std::thread::Builder::new().name("spline-sim".into()).spawn({
-            let (shared, stop, paused, config) = (shared.clone(), stop.clone(), paused.clone(), config.clone());
-            move || run(daemon, imu, &config, &shared, &stop, &paused)
-        })?;
-        Ok(Self { config, shared, stop, paused, thread: Some(thread) })
+        let shared = Arc::new(Shared::default());
+        let now = robowire_rt::now();
+        let job = DaemonLoop {
+            daemon,
+            imu,
+            model: JointModel::at(LYING_POSE_RAD),
+            grid: Periodic::new(now + config.period, config.period),
+            dt_s: config.period.as_secs_f32(),
+            shared: shared.clone(),
+        };
+        let options = RunnerOptions { spin: config.spin, ..RunnerOptions::named("spline-sim") };
+        let runner = Runner::spawn(options, job)?;
+        Ok(Self { config, shared, runner: Some(runner) })
     }
 
     /// The configuration (object names).
@@ -142,31 +168,36 @@ impl SplineSim {
 
     /// Counters and lateness.
     pub fn stats(&self) -> SplineSimStats {
-        let shared = lock(&self.shared);
-        SplineSimStats { lateness: shared.lateness.summary(), ..shared.stats }
+        let s = &self.shared;
+        SplineSimStats {
+            cycles: s.cycles.get(),
+            missed_cycles: s.missed_cycles.get(),
+            lateness: s.lateness.summary(),
+            daemon: s.daemon.read().map(|(_, c)| c.into()).unwrap_or_default(),
+            imu_samples: s.imu_samples.get(),
+        }
     }
 
     /// The state published last.
     pub fn state(&self) -> SplineStateBlock {
-        lock(&self.shared).state
+        self.shared.state.read().map(|(_, state)| state).unwrap_or_default()
     }
 
     /// Fault: a hung daemon (no commands consumed, no state or IMU published) while `paused`.
     pub fn pause(&self, paused: bool) {
-        self.paused.store(paused, Ordering::Relaxed);
+        self.shared.paused.store(paused, Ordering::Relaxed);
     }
 
     /// Fault: sets fault bits (1..5 of [`JointFlags`]) on a joint's state.
     pub fn inject_fault(&self, leg: Leg, joint: JointIndex, bits: u32) {
-        lock(&self.shared).fault_bits[leg.index()][joint as usize] = bits & 0x3E;
+        self.shared.fault_bits[leg.index()][joint as usize].store(bits & 0x3E, Ordering::Relaxed);
     }
 }
 
 impl Drop for SplineSim {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+        if let Some(runner) = self.runner.take() {
+            runner.stop();
         }
     }
 }
@@ -212,58 +243,47 @@ impl SplineJoints for JointModel {
     }
 }
 
-fn run(
-    mut daemon: SplineDaemon,
-    mut imu: ImuWriter,
-    config: &SplineSimConfig,
-    shared: &Mutex<Shared>,
-    stop: &AtomicBool,
-    paused: &AtomicBool,
-) {
-    let period = config.period;
-    let dt = period.as_secs_f32();
-    let mut model = JointModel::at(LYING_POSE_RAD);
-    let mut next = Instant::now() + period;
-    while !stop.load(Ordering::Relaxed) {
-        let now = Instant::now();
-        if next > now + config.spin_margin {
-            std::thread::sleep(next - config.spin_margin - now);
+/// The daemon's cycle on the runner.
+struct DaemonLoop {
+    daemon: SplineDaemon,
+    imu: ImuWriter,
+    model: JointModel,
+    grid: Periodic,
+    dt_s: f32,
+    shared: Arc<Shared>,
+}
+
+impl Job for DaemonLoop {
+    fn next_run(&mut self) -> Option<Time> {
+        Some(self.grid.deadline())
+    }
+
+    fn run(&mut self, now: Time) {
+        let Some(tick) = self.grid.poll(now) else { return };
+        let s = &self.shared;
+        s.missed_cycles.add(tick.skipped);
+        if s.paused.load(Ordering::Relaxed) {
+            return;
         }
-        while Instant::now() < next {
-            std::hint::spin_loop();
-        }
-        let started = Instant::now();
-        let lateness_us = u32::try_from(started.duration_since(next).as_micros()).unwrap_or(u32::MAX);
-        if !paused.load(Ordering::Relaxed) {
-            // Fresh, repeated or cleared: the daemon's command is what the motors get. (Region
-            // errors cannot happen: the object is ours and large enough.)
-            let _update: Result<CommandUpdate, _> = daemon.take_command();
-            model.step_command(daemon.command(), dt);
-            let fault_bits = lock(shared).fault_bits;
-            let state = model.state(daemon.command(), &fault_bits);
-            let _ = daemon.publish_state(&state);
-            let record = NavImu {
-                timestamp_ns: robowire_rt::monotonic_ns().into(),
-                sample: NavImuSample {
-                    acc: [0.0, 0.0, 9.81].map(Into::into),
-                    gyro: [0.0; 3].map(Into::into),
-                    q: [1.0, 0.0, 0.0, 0.0].map(Into::into),
-                },
-            };
-            let imu_ok = imu.publish(&record).is_ok();
-            let mut s = lock(shared);
-            s.state = state;
-            s.stats.cycles += 1;
-            s.stats.daemon = daemon.counters();
-            s.stats.imu_samples += u64::from(imu_ok);
-            s.lateness.record(lateness_us);
-        }
-        next += period;
-        let after = Instant::now();
-        if after > next {
-            let behind = (after - next).as_nanos() / period.as_nanos().max(1) + 1;
-            next += period * behind as u32;
-            lock(shared).stats.missed_cycles += behind as u64;
-        }
+        s.lateness.record(micros(tick.lateness));
+        // Fresh, repeated or cleared: the daemon's command is what the motors get. (Region
+        // errors cannot happen: the object is ours and large enough.)
+        let _update: Result<CommandUpdate, _> = self.daemon.take_command();
+        self.model.step_command(self.daemon.command(), self.dt_s);
+        let fault_bits = s.fault_bits.each_ref().map(|leg| leg.each_ref().map(|bits| bits.load(Ordering::Relaxed)));
+        let state = self.model.state(self.daemon.command(), &fault_bits);
+        let _ = self.daemon.publish_state(&state);
+        let record = NavImu {
+            timestamp_ns: now.as_nanos().into(),
+            sample: NavImuSample {
+                acc: [0.0, 0.0, 9.81].map(Into::into),
+                gyro: [0.0; 3].map(Into::into),
+                q: [1.0, 0.0, 0.0, 0.0].map(Into::into),
+            },
+        };
+        s.imu_samples.add(u64::from(self.imu.publish(&record).is_ok()));
+        s.state.write(now, &state);
+        s.daemon.write(now, &self.daemon.counters().into());
+        s.cycles.add(1);
     }
 }

@@ -1,6 +1,8 @@
 //! [`SplineClient`]: the motion controller's side of `/spline_shm`.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use robowire_rt::Time;
 
 use robowire_shm::{MappedRegion, RegionError, SharedRegion, ShmError};
 use zsl_proto::shm::{
@@ -90,7 +92,7 @@ pub struct SplineClient<R: SharedRegion = MappedRegion> {
     stall_after: Duration,
     /// The first poll that found no fresh state since the last fresh one: the stall clock runs
     /// from here. Stamped once per gap, so the fresh path never reads the clock.
-    waiting_since: Option<Instant>,
+    waiting_since: Option<Time>,
     stalled: bool,
     counters: SplineClientCounters,
 }
@@ -164,10 +166,34 @@ impl<R: SharedRegion> SplineClient<R> {
 
     /// The state, if the daemon published one since the last read.
     pub fn try_read_state(&mut self) -> Result<Option<SplineStateBlock>, SplineError> {
+        self.take_state(robowire_rt::now)
+    }
+
+    /// The state if the daemon published one since the last read; else, at `now` on the
+    /// monotonic clock, whether the daemon just crossed the stall bound (no fresh state for
+    /// `stall_after`, counted from the first poll that found none): then
+    /// [`SplineError::DaemonStalled`], once per stall. The sans-IO core of
+    /// [`wait_state`](Self::wait_state), for a loop that keeps its own time.
+    pub fn poll_state(&mut self, now: Time) -> Result<Option<SplineStateBlock>, SplineError> {
+        if let Some(state) = self.take_state(|| now)? {
+            return Ok(Some(state));
+        }
+        let since_fresh = self.stalled_for(now);
+        if since_fresh >= self.stall_after && !self.stalled {
+            self.stalled = true;
+            self.counters.stalls += 1;
+            return Err(SplineError::DaemonStalled { stalled_for: since_fresh });
+        }
+        Ok(None)
+    }
+
+    /// Takes fresh state; without any, starts the stall clock at `now()` (read only then, so the
+    /// fresh path never reads the clock).
+    fn take_state(&mut self, now: impl FnOnce() -> Time) -> Result<Option<SplineStateBlock>, SplineError> {
         let mut state = SplineStateBlock::new_zeroed();
         if !self.region.take(&self.consumer.state(), state.legs.as_mut_bytes())? {
             if self.waiting_since.is_none() {
-                self.waiting_since = Some(Instant::now());
+                self.waiting_since = Some(now());
             }
             return Ok(None);
         }
@@ -177,30 +203,27 @@ impl<R: SharedRegion> SplineClient<R> {
         Ok(Some(state))
     }
 
+    fn stalled_for(&self, now: Time) -> Duration {
+        self.waiting_since.map_or(Duration::ZERO, |t| now.saturating_duration_since(t))
+    }
+
     /// Waits for fresh state: spins briefly, then sleeps in short steps.
     ///
-    /// Crossing the stall bound (no fresh state for `stall_after` of polling, counted from the
-    /// first poll that found none) returns
-    /// [`SplineError::DaemonStalled`] at once, the first time. While stalled, a call waits up to
-    /// `timeout` for the daemon to come back and returns `DaemonStalled` again if it does not.
-    /// A healthy daemon that is merely slower than `timeout` gives [`SplineError::Timeout`].
+    /// Crossing the stall bound returns [`SplineError::DaemonStalled`] at once, the first time
+    /// ([`poll_state`](Self::poll_state)). While stalled, a call waits up to `timeout` for the
+    /// daemon to come back and returns `DaemonStalled` again if it does not. A healthy daemon
+    /// that is merely slower than `timeout` gives [`SplineError::Timeout`].
     pub fn wait_state(&mut self, timeout: Duration) -> Result<SplineStateBlock, SplineError> {
-        let start = Instant::now();
+        let start = robowire_rt::now();
         loop {
-            if let Some(state) = self.try_read_state()? {
+            let now = robowire_rt::now();
+            if let Some(state) = self.poll_state(now)? {
                 return Ok(state);
-            }
-            let now = Instant::now();
-            let since_fresh = self.waiting_since.map_or(Duration::ZERO, |t| now.saturating_duration_since(t));
-            if since_fresh >= self.stall_after && !self.stalled {
-                self.stalled = true;
-                self.counters.stalls += 1;
-                return Err(SplineError::DaemonStalled { stalled_for: since_fresh });
             }
             let waited = now.saturating_duration_since(start);
             if waited >= timeout {
                 return Err(if self.stalled {
-                    SplineError::DaemonStalled { stalled_for: since_fresh }
+                    SplineError::DaemonStalled { stalled_for: self.stalled_for(now) }
                 } else {
                     SplineError::Timeout { timeout }
                 });
@@ -213,9 +236,14 @@ impl<R: SharedRegion> SplineClient<R> {
         }
     }
 
+    /// Polled for longer than the stall bound without fresh state, at `now`?
+    pub fn is_stalled_at(&self, now: Time) -> bool {
+        self.waiting_since.is_some() && self.stalled_for(now) >= self.stall_after
+    }
+
     /// Polled for longer than the stall bound without fresh state?
     pub fn is_stalled(&self) -> bool {
-        self.waiting_since.is_some_and(|t| t.elapsed() >= self.stall_after)
+        self.is_stalled_at(robowire_rt::now())
     }
 
     /// Counters.

@@ -1,12 +1,31 @@
 //! Why a call was refused or a client could not start; each call error maps to the vendor's
 //! return code.
 
+use robowire_rt::RtError;
 use robowire_udp::UdpError;
 use zsl_proto::rules::ArgumentError;
 use zsl_proto::udp::{ControlMode, DatagramError, Model, ReturnCode};
 
 /// Why a client could not start.
-pub type ConnectError = UdpError<DatagramError>;
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConnectError {
+    /// The socket could not be bound (the message names the address and lists this host's
+    /// IPv4 addresses).
+    #[error(transparent)]
+    Link(#[from] UdpError<DatagramError>),
+    /// The stream thread could not be placed (priority, CPU, memory lock) or started.
+    #[error("the stream thread: {0}")]
+    StreamThread(#[from] RtError),
+    /// An option is out of range.
+    #[error("option {name}: {reason}")]
+    Option {
+        /// The option.
+        name: &'static str,
+        /// Why it is refused.
+        reason: String,
+    },
+}
 
 /// Why a call was refused, or what went wrong after it was accepted. Each maps to the vendor's
 /// return code ([`CallError::return_code`]).
@@ -56,10 +75,6 @@ pub enum CallError {
     /// streaming for good, like the vendor's. Check the model (ZSL-1 vs ZSL-1W).
     #[error("the robot reported an SDK mismatch; this client stopped streaming (check --model)")]
     SdkMismatch,
-    /// The command is latched but the immediate send failed (a socket error, counted in the
-    /// link's statistics); the 2 ms stream retries it.
-    #[error("the command is latched, but sending it failed; the 2 ms stream retries it")]
-    Send(#[source] UdpError<DatagramError>),
 }
 
 impl CallError {
@@ -75,7 +90,6 @@ impl CallError {
             | Self::NotAcknowledged { .. }
             | Self::WrongModel { .. }
             | Self::SdkMismatch => ReturnCode::SwitchFailed,
-            Self::Send(_) => ReturnCode::Queued,
         }
     }
 }

@@ -3,58 +3,17 @@
 use std::sync::Mutex;
 use std::time::Duration;
 
-use zsl_proto::codec::StateReceived;
 use zsl_proto::rules::{
-    ATTITUDE_RANGES, AckCounter, ActionClear, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running,
-    mode_gate_passes, move_ranges,
+    ATTITUDE_RANGES, AckCounter, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running, mode_gate_passes,
+    move_ranges,
 };
-use zsl_proto::udp::{
-    Action, ControlMode, HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model, ReturnCode,
-};
+use zsl_proto::stream::{Connection, HighLevelInterface};
+use zsl_proto::udp::{Action, ControlMode, HighLevelCommand, HighLevelState, Model, ReturnCode};
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::session::{ClientStats, Connection, Interface, Running, Session, client_accessors};
+use super::session::{ClientStats, Running, Session, client_accessors};
 use super::snapshot::{BodyState, Imu, LegJoints, RobotState};
 use super::{CallError, ClientOptions, ConnectError};
-
-/// The HighLevel interface: 40-byte commands, 560-byte state.
-pub(super) struct HighLevelInterface;
-
-impl Interface for HighLevelInterface {
-    type Command = HighLevelCommand;
-    type State = HighLevelState;
-    type SendState = ActionClear;
-
-    /// The vendor sender's per-cycle rules (spec §3.1): action auto-clear; a non-zero error word
-    /// forces mode 0 (passive); the SDK-mismatch flag ends the stream.
-    fn before_send(latched: &mut HighLevelCommand, clear: &mut ActionClear, state: Option<&HighLevelState>) -> bool {
-        clear.before_send(latched);
-        if let Some(state) = state {
-            if state.error().is_some() {
-                latched.mode = 0.into();
-            }
-            if state.has_sdk_mismatch() {
-                return false;
-            }
-        }
-        true
-    }
-
-    /// Every velocity and rate becomes 0; mode and action stay (spec decision 6).
-    fn stop_motion(latched: &mut HighLevelCommand) {
-        let zero = F32::new(0.0);
-        latched.vx = zero;
-        latched.vy = zero;
-        latched.roll_rate = zero;
-        latched.pitch_rate = zero;
-        latched.yaw_rate = zero;
-        latched.height_rate = zero;
-    }
-
-    fn header_ok(received: &StateReceived<HighLevelState>) -> bool {
-        received.state.header[..2] == HIGH_LEVEL_STATE_HEADER[..2]
-    }
-}
 
 /// When the "robot is running" check refuses a call (spec §9.1 step 4).
 #[derive(Clone, Copy)]
@@ -99,11 +58,11 @@ impl Call {
 }
 
 /// The ZSL-1 HighLevel client (the vendor's `HighLevel`). Needs a tokio runtime with the time
-/// and I/O drivers; the stream and the receive loop run as two tasks, stopped on drop.
+/// and I/O drivers for the receive task; the stream runs on its own thread. Both stop on drop.
 ///
 /// Every motion call validates first (the vendor's checks in the vendor's order, plus NaN and
-/// infinities), then latches the command and sends it at once. `Ok(())` is the vendor's 0,
-/// "queued": whether the robot obeys shows in [`control_mode`](Self::control_mode).
+/// infinities), then latches the command, which the stream thread sends at once. `Ok(())` is
+/// the vendor's 0, "queued": whether the robot obeys shows in [`control_mode`](Self::control_mode).
 ///
 /// ```no_run
 /// # async fn demo() -> Result<(), Box<dyn std::error::Error>> {
@@ -172,7 +131,7 @@ impl HighLevel {
         if gated && !mode_gate_passes(mode) {
             return Err(CallError::LyingDown(mode));
         }
-        if matches!(call, Call::Move) && self.session().latched().await.action_code() == Action::TwoLegStand {
+        if matches!(call, Call::Move) && self.session().latched().action_code() == Action::TwoLegStand {
             return Err(CallError::TwoLegStandActive);
         }
         let running = is_running(state.body_velocity[0].get(), state.body_velocity[1].get(), state.gyro[2].get());
@@ -189,7 +148,7 @@ impl HighLevel {
             return Err(CallError::Unbalanced(state.rpy[0].get()));
         }
         let command = command(self.session().options.model)?;
-        self.session().submit(|latched| *latched = command).await?;
+        self.session().submit(command)?;
         let target = command.control_mode();
         let acknowledged = self.acks.lock().map(|mut acks| acks[call as usize].on_call(mode, target));
         match acknowledged {
@@ -272,7 +231,7 @@ impl HighLevel {
 
     /// `cancelTwoLegStand()`: mode 21, action 0, flag 0. No checks, like the vendor's.
     pub async fn cancel_two_leg_stand(&self) -> Result<(), CallError> {
-        self.session().submit(|latched| *latched = HighLevelCommand::cancel_two_leg_stand()).await
+        self.session().submit(HighLevelCommand::cancel_two_leg_stand())
     }
 
     /// `attitudeControl(roll, pitch, yaw, height)`: body attitude rates, each |v| ≤ 0.6
@@ -307,13 +266,13 @@ impl HighLevel {
     /// ZSL-1W `cancelCrawl()`: mode 18, action 0, flag 0.
     pub async fn cancel_crawl(&self) -> Result<(), CallError> {
         self.require("cancel_crawl", Model::Zsl1W)?;
-        self.session().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
+        self.session().submit(HighLevelCommand::cancel_crawl_or_climb())
     }
 
     /// ZSL-1W `cancelClimb()`: the same datagram as `cancelCrawl()`.
     pub async fn cancel_climb(&self) -> Result<(), CallError> {
         self.require("cancel_climb", Model::Zsl1W)?;
-        self.session().submit(|latched| *latched = HighLevelCommand::cancel_crawl_or_climb()).await
+        self.session().submit(HighLevelCommand::cancel_crawl_or_climb())
     }
 
     getters! {
@@ -377,7 +336,7 @@ impl HighLevel {
     }
 
     /// The robot raised "SDK mismatch" and the stream stopped for good.
-    pub async fn halted(&self) -> bool {
-        self.session().halted().await
+    pub fn halted(&self) -> bool {
+        self.session().halted()
     }
 }

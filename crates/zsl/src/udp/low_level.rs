@@ -1,34 +1,16 @@
 //! The LowLevel client: twelve motors, position/velocity/PD/torque commands.
 
 use zsl_proto::rules::check_motor_command;
+use zsl_proto::stream::{Connection, LowLevelInterface};
 use zsl_proto::udp::{self as wire, LowLevelCommand};
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::session::{ClientStats, Connection, Interface, Running, Session, client_accessors};
+use super::session::{ClientStats, Running, Session, client_accessors};
 use super::snapshot::{Imu, LowLevelState, MotorCommand, MotorState};
 use super::{CallError, ClientOptions, ConnectError};
 
-/// The LowLevel interface: 248-byte motor commands, 272-byte state.
-pub(super) struct LowLevelInterface;
-
-impl Interface for LowLevelInterface {
-    type Command = LowLevelCommand;
-    type State = wire::LowLevelState;
-    type SendState = ();
-
-    fn before_send(_: &mut LowLevelCommand, (): &mut (), _: Option<&wire::LowLevelState>) -> bool {
-        true
-    }
-
-    /// Velocity targets become 0: the PD terms hold the last position, no joint is driven on.
-    /// Feed-forward torques stay (they may be holding the body up).
-    fn stop_motion(latched: &mut LowLevelCommand) {
-        latched.motor.qd_des = [[F32::new(0.0); 4]; 3];
-    }
-}
-
-/// The ZSL-1 LowLevel client (the vendor's `LowLevel`). Needs a tokio runtime; the stream and
-/// the receive loop run as two tasks, stopped on drop.
+/// The ZSL-1 LowLevel client (the vendor's `LowLevel`). Needs a tokio runtime for the receive
+/// task; the stream runs on its own thread. Both stop on drop.
 ///
 /// Streams the all-zero idle command (kp = kd = 0: nothing driven) until the first
 /// [`send_motor_command`](Self::send_motor_command), then the latched command every 2 ms.
@@ -67,7 +49,7 @@ impl LowLevel {
     pub async fn send_motor_command(&self, command: &MotorCommand) -> Result<(), CallError> {
         let motor = command.wire_command();
         check_motor_command(&motor)?;
-        self.session().submit(|latched| latched.motor = motor).await
+        self.session().submit(LowLevelCommand::new(motor))
     }
 
     /// `getMotorState()`: positions, velocities, torques (`None` before the first state and

@@ -3,8 +3,12 @@
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::time::Duration;
 
+use robowire_rt::runner::RunnerOptions;
 use zsl_proto::codec::StateDecoding;
+use zsl_proto::stream::{COMMAND_PERIOD, WATCHDOG_TIMEOUT};
 use zsl_proto::udp::{DEFAULT_LOCAL_PORT, HIGH_LEVEL_PORT, LOW_LEVEL_PORT, Model};
+
+use super::ConnectError;
 
 /// Where a client binds and whom it talks to (the vendor's `initRobot(local_ip, local_port, dog_ip)`).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -22,7 +26,16 @@ pub struct ClientOptions {
     pub period: Duration,
     /// Silence after which the connection is lost. Default 3 s (the vendor's).
     pub watchdog: Duration,
+    /// `SCHED_FIFO` priority 1..=99 for the stream thread; `None` keeps normal scheduling.
+    pub realtime_priority: Option<u8>,
+    /// CPU to pin the stream thread to; `None` does not pin.
+    pub cpu_affinity: Option<usize>,
+    /// Lock the process's memory (`mlockall`) when the stream starts.
+    pub lock_memory: bool,
 }
+
+/// Shortest accepted command period.
+pub const MIN_PERIOD: Duration = Duration::from_micros(100);
 
 impl ClientOptions {
     /// The robot's address on its own network.
@@ -34,8 +47,11 @@ impl ClientOptions {
             dog: SocketAddr::new(dog_ip, dog_port),
             model: Model::Zsl1,
             state_decoding: StateDecoding::Lenient,
-            period: Duration::from_millis(2),
-            watchdog: Duration::from_secs(3),
+            period: COMMAND_PERIOD,
+            watchdog: WATCHDOG_TIMEOUT,
+            realtime_priority: None,
+            cpu_affinity: None,
+            lock_memory: false,
         }
     }
 
@@ -65,6 +81,38 @@ impl ClientOptions {
     pub fn with_watchdog(mut self, watchdog: Duration) -> Self {
         self.watchdog = watchdog;
         self
+    }
+
+    /// Runs the stream thread `SCHED_FIFO` at `priority` (1..=99), pinned to `cpu` if given.
+    pub fn with_realtime(mut self, priority: u8, cpu: Option<usize>) -> Self {
+        self.realtime_priority = Some(priority);
+        self.cpu_affinity = cpu;
+        self
+    }
+
+    pub(super) fn validate(&self) -> Result<(), ConnectError> {
+        let bad = |name: &'static str, reason: String| Err(ConnectError::Option { name, reason });
+        if self.period < MIN_PERIOD {
+            return bad("period", format!("{:?} is shorter than {MIN_PERIOD:?}", self.period));
+        }
+        if self.watchdog <= self.period {
+            return bad("watchdog", format!("{:?} is not longer than the period {:?}", self.watchdog, self.period));
+        }
+        if let Some(priority) = self.realtime_priority
+            && !(1..=99).contains(&priority)
+        {
+            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
+        }
+        Ok(())
+    }
+
+    pub(super) fn runner_options(&self) -> RunnerOptions {
+        RunnerOptions {
+            realtime_priority: self.realtime_priority,
+            cpu: self.cpu_affinity,
+            lock_memory: self.lock_memory,
+            ..RunnerOptions::named("zsl-stream")
+        }
     }
 }
 

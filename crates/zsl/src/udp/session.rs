@@ -1,40 +1,73 @@
-//! The session with the robot that HighLevel and LowLevel share: the latched command and its
-//! 2 ms stream, the receive loop and its watchdog, connection events and statistics. What
-//! differs between the two is an [`Interface`].
+//! The session with the robot that HighLevel and LowLevel share, on two threads of control.
+//!
+//! - The **stream thread** (robowire's runner) owns `zsl-proto`'s sans-IO [`CommandStream`]:
+//!   it sends the latched command the moment a call changes it and every 2 ms on absolute
+//!   deadlines ([`stream`](super::stream)).
+//! - The **receive task** (tokio) decodes state, feeds `zsl-proto`'s [`Watchdog`], publishes
+//!   state and connection events to the user, and tells the stream about states and
+//!   disconnects.
+//!
+//! Nothing the stream thread reads is behind a lock another thread holds: calls and states
+//! reach it through seqlocks ([`Latest`]), disconnects through an atomic, and what it sent
+//! and how late comes back as a seqlock and atomics.
 
-use std::fmt;
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
-use robowire_core::timing::{LatenessRing, LatenessSummary};
-use robowire_udp::{LinkStats, Peer, StatsHandle, UdpError, UdpLink, UdpReceiver, UdpSender};
+use robowire_core::timing::LatenessSummary;
+use robowire_rt::runner::{Runner, Waker};
+use robowire_rt::stats::{Counter, SharedLateness, micros};
+use robowire_rt::{Latest, Time};
+use robowire_udp::{LinkStats, Peer, StatsHandle, UdpError, UdpLink, UdpReceiver};
 use tokio::sync::watch;
 use tokio::task::JoinHandle;
-use tokio::time::{Instant, MissedTickBehavior};
-use zsl_proto::codec::{ClientCodec, CommandDatagram, StateDatagram, StateReceived};
+use zsl_proto::codec::{ClientCodec, StateReceived};
+use zsl_proto::stream::{CommandStream, Connection, Event, Interface, Watchdog};
+use zsl_proto::zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
+use super::stream::{Input, StreamJob, in_order};
 use super::{CallError, ClientOptions, ConnectError};
 
-/// The connection as the watchdog sees it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Connection {
-    /// No state yet since the client started.
-    Waiting,
-    /// State arrived within the watchdog timeout.
-    Connected,
-    /// No state for the watchdog timeout: state accessors return `None`, latched velocities
-    /// are zero; the client returns to `Connected` by itself when state arrives.
-    Disconnected,
+/// An [`Interface`] whose datagrams can cross threads through a seqlock.
+pub(super) trait Wire:
+    Interface<
+        Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+        State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+        Memory: Send,
+        Observed: Send,
+    > + Send
+    + 'static
+{
 }
+
+impl<I> Wire for I where
+    I: Interface<
+            Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+            State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+            Memory: Send,
+            Observed: Send,
+            Observed: Send,
+        > + Send
+        + 'static
+{
+}
+
+pub(super) type Codec<I> = ClientCodec<<I as Interface>::Command, <I as Interface>::State>;
 
 /// Statistics of one client.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ClientStats {
     /// The socket's counters: commands sent, state datagrams received, decode errors, datagrams
-    /// dropped from foreign sources.
+    /// dropped from foreign sources, send errors.
     pub link: LinkStats,
+    /// Datagrams sent at once because a call changed the command.
+    pub calls_sent: u64,
+    /// Periodic refreshes sent.
+    pub refreshes_sent: u64,
+    /// Refresh slots skipped because the stream thread was more than a period late.
+    pub missed_ticks: u64,
     /// State datagrams accepted.
     pub states: u64,
     /// Accepted state datagrams shorter than the full state (lenient mode).
@@ -46,146 +79,147 @@ pub struct ClientStats {
     pub disconnects: u64,
     /// Returns to `Connected` after a timeout.
     pub reconnects: u64,
-    /// Lateness of the 2 ms stream against its absolute deadlines.
+    /// Lateness of the refreshes against their absolute deadlines, µs.
     pub stream_lateness: LatenessSummary,
     /// Time between consecutive accepted state datagrams, µs (the robot sends every 2 ms; the
     /// maximum shows how close the link came to the watchdog).
     pub state_gap: LatenessSummary,
 }
 
+/// What the stream thread reads and writes; every field lock-free for it.
+pub(super) struct StreamShared<I: Interface> {
+    /// The latest call's command (calls write, the stream takes).
+    pub(super) calls: Latest<I::Command>,
+    /// The latest state, for the per-datagram rules (the receive task writes).
+    pub(super) states: Latest<I::State>,
+    /// When the watchdog last expired, ns on the monotonic clock (0: never).
+    pub(super) disconnected_at: AtomicU64,
+    /// The last datagram sent, stamped with when the stream took its inputs.
+    pub(super) streamed: Latest<I::Command>,
+    /// The robot's SDK-mismatch flag stopped the stream for good.
+    pub(super) halted: AtomicBool,
+    pub(super) lateness: SharedLateness<4096>,
+    pub(super) calls_sent: Counter,
+    pub(super) refreshes_sent: Counter,
+    pub(super) missed_ticks: Counter,
+}
+
+/// What the receive task counts.
 #[derive(Debug, Default)]
 struct StateCounters {
-    states: AtomicU64,
-    short_states: AtomicU64,
-    header_anomalies: AtomicU64,
-    disconnects: AtomicU64,
-    reconnects: AtomicU64,
+    states: Counter,
+    short_states: Counter,
+    header_anomalies: Counter,
+    disconnects: Counter,
+    reconnects: Counter,
+    gaps: SharedLateness<1024>,
 }
 
-fn bump(counter: &AtomicU64) {
-    counter.fetch_add(1, Ordering::Relaxed);
-}
-
-/// What distinguishes the HighLevel and the LowLevel interface of a session: their datagrams
-/// and the vendor sender's per-datagram rules.
-pub(super) trait Interface: Send + Sync + 'static {
-    type Command: CommandDatagram + fmt::Debug;
-    type State: StateDatagram + fmt::Debug;
-    /// Per-stream memory of [`Interface::before_send`].
-    type SendState: Default + Send + 'static;
-
-    /// Applied to the latched command before every datagram; `false` halts the stream for good.
-    fn before_send(latched: &mut Self::Command, memory: &mut Self::SendState, state: Option<&Self::State>) -> bool;
-
-    /// Replaces a latched motion with a stop (watchdog timeout, spec decision 6).
-    fn stop_motion(latched: &mut Self::Command);
-
-    /// Whether the header or magic of an accepted state was as expected.
-    fn header_ok(received: &StateReceived<Self::State>) -> bool {
-        received.update.header_ok
-    }
-}
-
-type Codec<P> = ClientCodec<<P as Interface>::Command, <P as Interface>::State>;
-
-struct Outbox<P: Interface> {
-    latched: P::Command,
-    sender: UdpSender<Codec<P>>,
-    memory: P::SendState,
-    halted: bool,
-}
-
-pub(super) struct Session<P: Interface> {
-    outbox: tokio::sync::Mutex<Outbox<P>>,
-    pub(super) state: watch::Sender<Option<P::State>>,
+pub(super) struct Session<I: Interface> {
+    pub(super) stream: StreamShared<I>,
+    /// Wakes the stream thread when a call arrives (set once the thread runs).
+    waker: OnceLock<Waker>,
+    state: watch::Sender<Option<I::State>>,
     connection: watch::Sender<Connection>,
     counters: StateCounters,
-    lateness: Mutex<LatenessRing<1024>>,
-    /// When the last state was accepted, and the gaps between states.
-    state_gaps: Mutex<(Option<Instant>, LatenessRing<1024>)>,
     link: StatsHandle,
     local: SocketAddr,
     pub(super) options: ClientOptions,
 }
 
-/// A running session: the shared state plus its two tasks, stopped on drop.
-pub(super) struct Running<P: Interface> {
-    pub(super) session: Arc<Session<P>>,
-    tasks: [JoinHandle<()>; 2],
+/// A running session: the shared state, the stream thread and the receive task, both stopped
+/// on drop.
+pub(super) struct Running<I: Wire> {
+    pub(super) session: Arc<Session<I>>,
+    stream: Option<Runner<StreamJob<I>>>,
+    receive: JoinHandle<()>,
 }
 
-impl<P: Interface> Drop for Running<P> {
+impl<I: Wire> Drop for Running<I> {
     fn drop(&mut self) {
-        for task in &self.tasks {
-            task.abort();
+        self.receive.abort();
+        if let Some(stream) = self.stream.take() {
+            stream.stop();
         }
     }
 }
 
-impl<P: Interface> Running<P> {
-    /// Binds, starts the stream (idle command at once, like the vendor) and the receive loop.
+impl<I: Wire> Running<I> {
+    /// Binds, starts the stream (idle command at once, like the vendor) and the receive task.
     pub(super) async fn start(options: ClientOptions) -> Result<Self, ConnectError> {
-        let codec = Codec::<P>::new(options.model, options.state_decoding);
+        options.validate()?;
+        let codec = Codec::<I>::new(options.model, options.state_decoding);
         // The robot's sending port is not documented (spec §2): accept state from any port of its
         // IP, nothing from anyone else.
         let link = UdpLink::bind(options.local, Peer::AnyPortOf(options.dog), codec).await?;
-        let local = link.local_addr()?;
+        let local = link.local_addr().map_err(UdpError::from)?;
         let stats = link.stats_handle();
         let (sender, receiver) = link.into_split();
         let session = Arc::new(Session {
-            outbox: tokio::sync::Mutex::new(Outbox {
-                latched: P::Command::default(),
-                sender,
-                memory: P::SendState::default(),
-                halted: false,
-            }),
+            stream: StreamShared {
+                calls: Latest::new(),
+                states: Latest::new(),
+                disconnected_at: AtomicU64::new(0),
+                streamed: Latest::new(),
+                halted: AtomicBool::new(false),
+                lateness: SharedLateness::new(),
+                calls_sent: Counter::default(),
+                refreshes_sent: Counter::default(),
+                missed_ticks: Counter::default(),
+            },
+            waker: OnceLock::new(),
             state: watch::Sender::new(None),
             connection: watch::Sender::new(Connection::Waiting),
             counters: StateCounters::default(),
-            lateness: Mutex::new(LatenessRing::new()),
-            state_gaps: Mutex::new((None, LatenessRing::new())),
             link: stats,
             local,
             options,
         });
-        let stream = tokio::spawn(stream(session.clone()));
-        let receive = tokio::spawn(receive(session.clone(), receiver));
-        Ok(Self { session, tasks: [stream, receive] })
+        let now = robowire_rt::now();
+        let watchdog = Watchdog::new(now, session.options.watchdog);
+        let job = StreamJob::new(CommandStream::new(now, session.options.period), sender, session.clone());
+        let stream = Runner::spawn(session.options.runner_options(), job)?;
+        let _ = session.waker.set(stream.waker());
+        let receive = tokio::spawn(receive(session.clone(), receiver, watchdog));
+        Ok(Self { session, stream: Some(stream), receive })
     }
 }
 
-impl<P: Interface> Session<P> {
-    /// Rewrites the latched command and puts it on the wire at once.
-    pub(super) async fn submit(&self, write: impl FnOnce(&mut P::Command)) -> Result<(), CallError> {
-        let mut outbox = self.outbox.lock().await;
-        if outbox.halted {
+impl<I: Wire> Session<I> {
+    /// Latches `command`; the stream thread sends it at once. `Ok` means queued (the vendor's
+    /// 0); a failed send is counted in the link's statistics and retried by the refresh.
+    pub(super) fn submit(&self, command: I::Command) -> Result<(), CallError> {
+        if self.halted() {
             return Err(CallError::SdkMismatch);
         }
-        write(&mut outbox.latched);
-        self.transmit(&mut outbox).await
-    }
-
-    async fn transmit(&self, outbox: &mut Outbox<P>) -> Result<(), CallError> {
-        let proceed = {
-            let state = self.state.borrow();
-            P::before_send(&mut outbox.latched, &mut outbox.memory, state.as_ref())
-        };
-        if !proceed {
-            outbox.halted = true;
-            return Err(CallError::SdkMismatch);
+        self.stream.calls.write(robowire_rt::now(), &command);
+        if let Some(waker) = self.waker.get() {
+            waker.wake();
         }
-        let command = outbox.latched;
-        outbox.sender.send(&command).await.map_err(CallError::Send)
+        Ok(())
     }
 
-    /// The latched command (what the stream is sending).
-    pub(super) async fn latched(&self) -> P::Command {
-        self.outbox.lock().await.latched
+    /// The command being streamed: the last one sent, with what the stream thread has not
+    /// taken yet applied (a call latches, a disconnect stops the motion): what goes out next,
+    /// the per-datagram rules aside.
+    pub(super) fn latched(&self) -> I::Command {
+        let shared = &self.stream;
+        let (sent_at, mut latched) = shared.streamed.read().unwrap_or((Time::ZERO, I::Command::default()));
+        let call = shared.calls.read().filter(|(at, _)| *at > sent_at);
+        let disconnected_at = Time::from_nanos(shared.disconnected_at.load(Ordering::Acquire));
+        let disconnect = (disconnected_at > sent_at).then_some(disconnected_at);
+        for input in in_order(call, disconnect) {
+            match input {
+                Input::Call(command) => latched = command,
+                Input::Disconnect => I::stop_motion(&mut latched),
+            }
+        }
+        latched
     }
 
     /// Whether the stream halted on the robot's SDK-mismatch flag.
-    pub(super) async fn halted(&self) -> bool {
-        self.outbox.lock().await.halted
+    pub(super) fn halted(&self) -> bool {
+        self.stream.halted.load(Ordering::Acquire)
     }
 
     pub(super) fn connection(&self) -> Connection {
@@ -201,26 +235,29 @@ impl<P: Interface> Session<P> {
     }
 
     pub(super) fn stats(&self) -> ClientStats {
-        let c = &self.counters;
+        let (c, s) = (&self.counters, &self.stream);
         ClientStats {
             link: self.link.get(),
-            states: c.states.load(Ordering::Relaxed),
-            short_states: c.short_states.load(Ordering::Relaxed),
-            header_anomalies: c.header_anomalies.load(Ordering::Relaxed),
-            disconnects: c.disconnects.load(Ordering::Relaxed),
-            reconnects: c.reconnects.load(Ordering::Relaxed),
-            stream_lateness: self.lateness.lock().map(|r| r.summary()).unwrap_or_default(),
-            state_gap: self.state_gaps.lock().map(|g| g.1.summary()).unwrap_or_default(),
+            calls_sent: s.calls_sent.get(),
+            refreshes_sent: s.refreshes_sent.get(),
+            missed_ticks: s.missed_ticks.get(),
+            states: c.states.get(),
+            short_states: c.short_states.get(),
+            header_anomalies: c.header_anomalies.get(),
+            disconnects: c.disconnects.get(),
+            reconnects: c.reconnects.get(),
+            stream_lateness: s.lateness.summary(),
+            state_gap: c.gaps.summary(),
         }
     }
 
     /// The state, or `None` before the first state and after a timeout.
-    pub(super) fn read<T>(&self, f: impl FnOnce(&P::State) -> T) -> Option<T> {
+    pub(super) fn read<T>(&self, f: impl FnOnce(&I::State) -> T) -> Option<T> {
         self.state.borrow().as_ref().map(f)
     }
 
     /// Waits until a state satisfies `accept`, up to `timeout`.
-    pub(super) async fn wait_for(&self, timeout: Duration, accept: impl Fn(&P::State) -> bool) -> Option<P::State> {
+    pub(super) async fn wait_for(&self, timeout: Duration, accept: impl Fn(&I::State) -> bool) -> Option<I::State> {
         let mut rx = self.state.subscribe();
         let wait = rx.wait_for(|s| s.as_ref().is_some_and(&accept));
         match tokio::time::timeout(timeout, wait).await {
@@ -230,42 +267,34 @@ impl<P: Interface> Session<P> {
     }
 }
 
-/// The 2 ms command stream on absolute deadlines (a late tick does not shift the grid).
-async fn stream<P: Interface>(session: Arc<Session<P>>) {
-    let mut ticks = tokio::time::interval(session.options.period);
-    ticks.set_missed_tick_behavior(MissedTickBehavior::Skip);
-    loop {
-        let deadline = ticks.tick().await;
-        let late_us = u32::try_from(deadline.elapsed().as_micros()).unwrap_or(u32::MAX);
-        if let Ok(mut ring) = session.lateness.lock() {
-            ring.record(late_us);
-        }
-        let mut outbox = session.outbox.lock().await;
-        if outbox.halted {
-            continue;
-        }
-        // A failed send is counted by the link; the next tick tries again.
-        let _ = session.transmit(&mut outbox).await;
-    }
+/// The tokio instant of a monotonic-clock time.
+fn tokio_instant(at: Time) -> tokio::time::Instant {
+    tokio::time::Instant::now() + at.saturating_duration_since(robowire_rt::now())
 }
 
-/// Receives state, feeds the watchdog, and handles its timeout (spec decisions 2, 3, 6).
-async fn receive<P: Interface>(session: Arc<Session<P>>, mut receiver: UdpReceiver<Codec<P>>) {
-    let watchdog = session.options.watchdog;
-    // As the vendor's: the first timeout is `watchdog` after start if nothing ever arrives.
-    let mut deadline = Some(Instant::now() + watchdog);
+/// Receives state and runs the watchdog (spec decisions 2, 3, 6).
+async fn receive<I: Wire>(session: Arc<Session<I>>, mut receiver: UdpReceiver<Codec<I>>, mut watchdog: Watchdog) {
+    let mut last_state: Option<Time> = None;
     loop {
+        let expires = watchdog.poll_timeout();
         let timeout = async {
-            match deadline {
-                Some(at) => tokio::time::sleep_until(at).await,
+            match expires {
+                Some(at) => tokio::time::sleep_until(tokio_instant(at)).await,
                 None => std::future::pending().await,
             }
         };
         tokio::select! {
             received = receiver.recv() => match received {
                 Ok(received) => {
-                    deadline = Some(Instant::now() + watchdog);
-                    on_state(&session, &received);
+                    let now = robowire_rt::now();
+                    let event = watchdog.handle_datagram(now);
+                    if let Some(last) = last_state.replace(now) {
+                        session.counters.gaps.record(micros(now.saturating_duration_since(last)));
+                    }
+                    on_state(&session, &received, now);
+                    if event.is_some() {
+                        on_connected(&session, &watchdog);
+                    }
                 }
                 // Counted by the link; a datagram that does not decode does not feed the watchdog.
                 Err(UdpError::Decode(_)) => {}
@@ -274,48 +303,46 @@ async fn receive<P: Interface>(session: Arc<Session<P>>, mut receiver: UdpReceiv
                 Err(_) => tokio::time::sleep(RECEIVE_ERROR_BACKOFF).await,
             },
             () = timeout => {
-                deadline = None;
-                bump(&session.counters.disconnects);
-                session.state.send_replace(None);
-                receiver.codec_mut().reset();
-                P::stop_motion(&mut session.outbox.lock().await.latched);
-                session.connection.send_replace(Connection::Disconnected);
+                let now = robowire_rt::now();
+                if watchdog.poll_event(now) == Some(Event::Disconnected) {
+                    receiver.codec_mut().reset();
+                    on_disconnected(&session, &watchdog, now);
+                }
             }
         }
     }
 }
 
-fn on_state<P: Interface>(session: &Session<P>, received: &StateReceived<P::State>) {
+fn on_state<I: Wire>(session: &Session<I>, received: &StateReceived<I::State>, now: Time) {
     let c = &session.counters;
-    bump(&c.states);
-    if let Ok(mut gaps) = session.state_gaps.lock() {
-        let now = Instant::now();
-        if let Some(last) = gaps.0.replace(now) {
-            gaps.1.record(u32::try_from((now - last).as_micros()).unwrap_or(u32::MAX));
-        }
-    }
+    c.states.add(1);
     if received.update.short {
-        bump(&c.short_states);
+        c.short_states.add(1);
     }
     if received.update.len > 0 {
-        if !P::header_ok(received) {
-            bump(&c.header_anomalies);
+        if !received.update.header_ok {
+            c.header_anomalies.add(1);
         }
         // A 0-byte datagram only feeds the watchdog: zeros never pose as a state.
+        session.stream.states.write(now, &received.state);
         session.state.send_replace(Some(received.state));
     }
-    session.connection.send_if_modified(|connection| match *connection {
-        Connection::Connected => false,
-        Connection::Disconnected => {
-            bump(&c.reconnects);
-            *connection = Connection::Connected;
-            true
-        }
-        Connection::Waiting => {
-            *connection = Connection::Connected;
-            true
-        }
-    });
+}
+
+fn on_connected<I: Wire>(session: &Session<I>, watchdog: &Watchdog) {
+    session.counters.reconnects.set(watchdog.counters().reconnects);
+    session.connection.send_replace(watchdog.connection());
+}
+
+/// The watchdog expired: the stream stops the latched motion, the user sees no state.
+fn on_disconnected<I: Wire>(session: &Session<I>, watchdog: &Watchdog, now: Time) {
+    session.stream.disconnected_at.store(now.as_nanos(), Ordering::Release);
+    if let Some(waker) = session.waker.get() {
+        waker.wake();
+    }
+    session.counters.disconnects.set(watchdog.counters().disconnects);
+    session.state.send_replace(None);
+    session.connection.send_replace(Connection::Disconnected);
 }
 
 /// After a socket error on receive, wait this long before the next receive.
@@ -365,12 +392,13 @@ macro_rules! client_accessors {
             self.session().wait_for(timeout, |_| true).await.is_some()
         }
 
-        /// The command datagram being streamed now, in the vendor's layout (`zsl_proto::udp`).
-        pub async fn wire_command(&self) -> $wire_command {
-            self.session().latched().await
+        /// The command datagram being streamed, in the vendor's layout (`zsl_proto::udp`): the
+        /// last one sent, or a call's that goes out next.
+        pub fn wire_command(&self) -> $wire_command {
+            self.session().latched()
         }
 
-        /// Counters: link, state anomalies, disconnects, stream lateness.
+        /// Counters: link, calls and refreshes, state anomalies, disconnects, stream lateness.
         pub fn stats(&self) -> ClientStats {
             self.session().stats()
         }

@@ -227,7 +227,7 @@ async fn steps(
     calls.record("jump", &result);
     let airborne = dog.wait_for_state(WAIT, |s| s.body.position_m[2] > STANDING_HEIGHT_M + 0.05).await.is_some();
     let landed = dog.wait_for_state(WAIT, |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
-    let action_cleared = dog.wire_command().await.action_code() == Action::None;
+    let action_cleared = dog.wire_command().action_code() == Action::None;
     let tricks = sim.snapshot().dog.tricks_done() - tricks_before;
     out.line(format_args!(
         "  trick    jump -> airborne {airborne}, landed standing {landed}, action cleared after 6 datagrams {action_cleared} {}",
@@ -273,7 +273,7 @@ async fn steps(
     let silent_at = Instant::now();
     let lost = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Disconnected)).await.is_ok();
     let noticed = silent_at.elapsed();
-    let latched_vx = dog.wire_command().await.vx.get();
+    let latched_vx = dog.wire_command().vx.get();
     sim.clear_faults();
     let back = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Connected)).await.is_ok();
     let stopped = settle(dog).await;
@@ -332,7 +332,14 @@ async fn steps(
     let seconds = started.elapsed().as_secs_f64();
     report.rates_hz =
         vec![("commands sent", stats.link.sent as f64 / seconds), ("states in", stats.states as f64 / seconds)];
-    report.timings = vec![("stream lateness", stats.stream_lateness), ("state gap", stats.state_gap)];
+    report.timings = vec![
+        ("send lateness", stats.stream_lateness),
+        ("at dog |Δ-2ms|", snapshot.high_level.command_jitter),
+        ("dog send lateness", snapshot.state_lateness),
+        ("state gap", stats.state_gap),
+    ];
+    report.checks.push(Check::on_time("dog: client command stream", &stats.stream_lateness));
+    report.checks.push(Check::on_time("dog: simulator state stream", &snapshot.state_lateness));
     report.counters = vec![
         ("states", stats.states),
         ("decode errors", stats.link.decode_errors),

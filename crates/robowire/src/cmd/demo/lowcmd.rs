@@ -1,4 +1,5 @@
-//! The LowCmd/LowState scenario: a 500 Hz loop on absolute deadlines that does what a Unitree
+//! The LowCmd/LowState scenario: a 500 Hz loop on absolute deadlines (robowire's schedule, each
+//! wait finished the runner's way) that does what a Unitree
 //! low-level controller does each cycle: build a `LowCmd`, encode it (struct image with CRC, and
 //! the XCDR1 payload published on `rt/lowcmd`), decode and verify it as the robot would, answer
 //! with a `LowState` and verify that too. Every 50th image gets a flipped bit, which must be
@@ -7,7 +8,10 @@
 use std::time::{Duration, Instant};
 
 use lowcmd_proto::{CdrEncoding, DecodeError, LowCmd, LowState, Message, MotorCmd};
+use robowire_core::schedule::Periodic;
 use robowire_core::timing::LatenessRing;
+use robowire_rt::runner::{DEFAULT_SPIN, sleep_until};
+use robowire_rt::stats::micros;
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
@@ -25,17 +29,15 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
     let mut progress = Progress::new("lowcmd", out);
     let mut window_late_us = 0u32;
     let start = Instant::now();
-    let mut next = start + PERIOD;
+    robowire_rt::set_fine_timer_slack();
+    let mut grid = Periodic::new(robowire_rt::now() + PERIOD, PERIOD);
     while start.elapsed() < run_for {
-        let now = Instant::now();
-        if next > now {
-            std::thread::sleep(next - now);
-        }
+        sleep_until(grid.deadline(), DEFAULT_SPIN);
         let woke = Instant::now();
-        let late_us = u32::try_from(woke.saturating_duration_since(next).as_micros()).unwrap_or(u32::MAX);
+        let Some(tick) = grid.poll(robowire_rt::now()) else { continue };
+        let late_us = micros(tick.lateness);
         lateness.record(late_us);
         window_late_us = window_late_us.max(late_us);
-        next += PERIOD;
 
         // The controller: a slow sway of the calves around the stand pose.
         let t = start.elapsed().as_secs_f32();
@@ -124,6 +126,7 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
             corrupted > 0 && caught == corrupted,
             format!("{caught} of {corrupted}"),
         ),
+        Check::on_time("lowcmd: 500 Hz loop", &late),
     ];
     Ok(report)
 }

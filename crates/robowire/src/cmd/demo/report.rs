@@ -24,6 +24,21 @@ impl Check {
     }
 }
 
+/// The demo's live bound on a periodic stream's median send lateness, µs: loose enough for a
+/// shared machine (`cargo xtask bench` holds the tight targets).
+pub(crate) const MAX_P50_LATENESS_US: u32 = 100;
+
+impl Check {
+    /// "`stream` sends on time": its median lateness within [`MAX_P50_LATENESS_US`].
+    pub(crate) fn on_time(stream: &str, lateness: &LatenessSummary) -> Self {
+        Self::new(
+            format!("{stream}: send lateness p50 ≤ {MAX_P50_LATENESS_US} µs"),
+            lateness.count > 0 && lateness.p50_us <= MAX_P50_LATENESS_US,
+            format!("p50 {} µs, p99 {} µs over {} sends", lateness.p50_us, lateness.p99_us, lateness.count),
+        )
+    }
+}
+
 /// A fault the scenario injected, and whether the client side detected it.
 #[derive(Debug)]
 pub(crate) struct InjectedFault {

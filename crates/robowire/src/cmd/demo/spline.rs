@@ -169,6 +169,7 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
             noticed.is_some_and(|d| d <= Duration::from_millis(25)) && recovered,
             format!("after {:.1} ms", noticed.unwrap_or_default().as_secs_f64() * 1e3),
         ),
+        Check::on_time("low level: daemon 1 kHz loop", &sim_stats.lateness),
     ];
     Ok(report)
 }
