@@ -333,7 +333,7 @@ fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     }
     let (i50, i99, imax) = percentiles_us(&meta["zsl_interval_at_dog"])?;
     rows.push(Row {
-        path: "ZSL-1 HighLevel command interval at the simulated dog, |interval − 2 ms|".into(),
+        path: "ZSL-1 HighLevel command interval at the simulated dog: deviation from 2 ms".into(),
         figure: format!("p50 {i50} µs, p99 {i99} µs, max {imax} µs"),
         baseline: "period 2 ms".into(),
         ratio: format!("{:.1} % of the period (p99)", i99 as f64 / 20.0),
