@@ -2,6 +2,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 
+pub mod api;
 mod cdr;
 pub mod crc;
 #[cfg(feature = "fuzzing")]
@@ -12,8 +13,11 @@ pub mod go2;
 pub mod hg;
 pub mod layout;
 mod message;
+pub mod plan;
+pub mod robot;
 #[cfg(feature = "serde")]
 mod serde_impl;
+pub mod stream;
 
 pub use cdr::CdrEncoding;
 pub use error::DecodeError;

@@ -3,9 +3,10 @@
 use robowire_core::BufferTooSmall;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
-use crate::cdr::{self, BodyError, CdrEncoding, Transcoder};
+use crate::cdr::CdrEncoding;
 use crate::crc::crc32_words_in_place;
 use crate::layout::{PadRange, StructLayout, padding_count, padding_mask, padding_ranges};
+use crate::plan::{CdrPlan, PlanError, header_count, plan_body_len, plan_headers, plan_runs, run_count};
 use crate::{DecodeError, go2, hg};
 
 /// Largest struct image (HG `LowState_`).
@@ -61,6 +62,18 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
     const PADDING: &'static [PadRange];
     /// The image's padding as a mask (0x00 on padding), from the same table.
     const PADDING_MASK: &'static [u8];
+    /// The XCDR1 copy plan, from the same table at compile time.
+    const XCDR1: CdrPlan;
+    /// The XCDR2 copy plan.
+    const XCDR2: CdrPlan;
+
+    /// The copy plan of `encoding`.
+    fn cdr_plan(encoding: CdrEncoding) -> &'static CdrPlan {
+        match encoding {
+            CdrEncoding::Xcdr1 => &Self::XCDR1,
+            CdrEncoding::Xcdr2 => &Self::XCDR2,
+        }
+    }
 
     /// Sets every padding byte to zero (one AND pass with [`PADDING_MASK`](Self::PADDING_MASK)).
     fn zero_padding(&mut self) {
@@ -131,21 +144,24 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
 
     /// Length of the CDR payload, header included.
     fn cdr_len(encoding: CdrEncoding) -> usize {
-        4 + cdr::body_len(Self::FIELDS, encoding)
+        4 + Self::cdr_plan(encoding).body_len
     }
 
     /// Writes the CDR payload of the sealed message (header, body) into `out`; returns its length.
     fn encode_cdr(&self, encoding: CdrEncoding, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
         let (needed, available) = (Self::cdr_len(encoding), out.len());
         let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
-        dst.fill(0);
         dst[..4].copy_from_slice(&encoding.header());
-        let sealed = self.sealed();
-        let mut encoder = Transcoder::encoder(sealed.as_bytes(), &mut dst[4..]);
-        let mut pos = 0;
-        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut encoder)
-            .and_then(|()| encoder.finish())
-            .map_err(|_| BufferTooSmall { needed, available })?;
+        Self::cdr_plan(encoding).encode(self.sealed().as_bytes(), &mut dst[4..]);
+        Ok(needed)
+    }
+
+    /// Writes the CDR body of the sealed message (no encapsulation header: for a DDS library
+    /// that writes the header itself) into `out`; returns its length.
+    fn encode_cdr_body(&self, encoding: CdrEncoding, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let (needed, available) = (Self::cdr_plan(encoding).body_len, out.len());
+        let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
+        Self::cdr_plan(encoding).encode(self.sealed().as_bytes(), dst);
         Ok(needed)
     }
 
@@ -156,27 +172,39 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
             .and_then(|h| h.try_into().ok())
             .ok_or(DecodeError::NoEncapsulation { found: bytes.len() })?;
         let encoding = CdrEncoding::from_header(header).ok_or(DecodeError::Encapsulation { found: header })?;
-        let expected = Self::cdr_len(encoding);
-        let length = DecodeError::CdrLength { encoding, expected, found: bytes.len() };
-        if bytes.len() != expected {
-            return Err(length);
+        let (unverified, _) = Self::decode_cdr_body_unverified(encoding, &bytes[4..]).map_err(|e| match e {
+            // The length in the error counts the header, as the caller's bytes do.
+            DecodeError::CdrLength { encoding, expected, found } => {
+                DecodeError::CdrLength { encoding, expected: expected + 4, found: found + 4 }
+            }
+            other => other,
+        })?;
+        Ok((unverified, encoding))
+    }
+
+    /// Decodes a CDR body in `encoding` (no encapsulation header: a DDS library read it) without
+    /// verifying the CRC.
+    fn decode_cdr_body_unverified(
+        encoding: CdrEncoding,
+        body: &[u8],
+    ) -> Result<(Unverified<Self>, CdrEncoding), DecodeError<Self>> {
+        let plan = Self::cdr_plan(encoding);
+        if body.len() != plan.body_len {
+            return Err(DecodeError::CdrLength { encoding, expected: plan.body_len, found: body.len() });
         }
-        let mut image = [0u8; MAX_IMAGE_LEN];
-        let image = &mut image[..Self::IMAGE_LEN];
-        let mut decoder = Transcoder::decoder(&bytes[4..], image);
-        let mut pos = 0;
-        cdr::walk(Self::FIELDS, 0, &mut pos, encoding == CdrEncoding::Xcdr2, &mut decoder)
-            .and_then(|()| decoder.finish())
-            .map_err(|e| match e {
-                BodyError::ArrayHeader { field, expected, found } => {
-                    DecodeError::ArrayHeader { field, expected, found }
-                }
-                BodyError::OutOfBounds => DecodeError::CdrLength { encoding, expected, found: bytes.len() },
-            })?;
-        let message = Self::read_from_bytes(image).map_err(|_| length)?;
+        let mut message = Self::new_zeroed();
+        plan.decode(body, message.as_mut_bytes()).map_err(|e| match e {
+            PlanError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
+        })?;
+        // Alignment bytes of the body landed on the image's padding: zero it.
+        message.zero_padding();
         let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
-        // CDR carries no struct padding: the rebuilt image is zero-padded by construction.
         Ok((Unverified { message, crc, padding: None }, encoding))
+    }
+
+    /// Decodes a CDR body in `encoding` and verifies the CRC over the rebuilt image.
+    fn decode_cdr_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<Self>> {
+        Self::decode_cdr_body_unverified(encoding, body)?.0.verify()
     }
 
     /// Decodes a CDR payload (XCDR1 or XCDR2) and verifies the CRC over the rebuilt image.
@@ -217,6 +245,16 @@ macro_rules! message {
             const TOPIC: &'static str = $topic;
             const PADDING: &'static [PadRange] = &padding_ranges::<{ padding_count(&$layout) }>(&$layout);
             const PADDING_MASK: &'static [u8] = &padding_mask::<$len, { padding_count(&$layout) }>(&$layout);
+            const XCDR1: CdrPlan = CdrPlan {
+                runs: &plan_runs::<{ run_count(&$layout, false) }>(&$layout, false),
+                headers: &plan_headers::<{ header_count(&$layout, false) }>(&$layout, false),
+                body_len: plan_body_len(&$layout, false),
+            };
+            const XCDR2: CdrPlan = CdrPlan {
+                runs: &plan_runs::<{ run_count(&$layout, true) }>(&$layout, true),
+                headers: &plan_headers::<{ header_count(&$layout, true) }>(&$layout, true),
+                body_len: plan_body_len(&$layout, true),
+            };
         }
         impl $ty {
             #[doc = concat!("The sealed ", stringify!($len), "-byte struct image (zero padding, CRC).")]
@@ -224,6 +262,24 @@ macro_rules! message {
                 let mut out = [0u8; $len];
                 out.copy_from_slice(self.sealed().as_bytes());
                 out
+            }
+        }
+        impl robowire_core::cdr::CdrType for $ty {
+            const TYPE_NAME: &'static str = $dds;
+            type Error = DecodeError<()>;
+            fn body_len(&self) -> usize {
+                Self::XCDR1.body_len
+            }
+            /// The sealed message (zero padding, CRC) in XCDR1.
+            fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+                self.encode_cdr_body(CdrEncoding::Xcdr1, out)
+            }
+            /// Decodes and verifies the CRC.
+            fn decode_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<()>> {
+                Self::decode_cdr_body(encoding, body).map_err(DecodeError::without_message)
+            }
+            fn is_checksum_error(error: &DecodeError<()>) -> bool {
+                matches!(error, DecodeError::CrcMismatch { .. })
             }
         }
         const _: () = assert!(size_of::<$ty>() == $len && $len <= MAX_IMAGE_LEN);

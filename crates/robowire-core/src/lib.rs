@@ -2,6 +2,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod cdr;
 mod datagram;
 pub mod le;
 pub mod schedule;

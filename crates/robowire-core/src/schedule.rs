@@ -1,5 +1,5 @@
 //! Periodic schedules with caller-supplied time: the sans-IO part of every periodic stream
-//! (a command stream, its polls, a watchdog). Nothing here reads a clock or sleeps; a runner
+//! (a command stream, its polls, a watchdog: [`Watchdog`]). Nothing here reads a clock or sleeps; a runner
 //! asks for the next deadline, sleeps until then, and hands `now` back.
 //!
 //! **Missed-tick policy.** A [`Periodic`] keeps the absolute grid `first + k · period`. Served
@@ -148,6 +148,121 @@ impl Periodic {
 /// The earliest of some deadlines, if any.
 pub fn earliest(deadlines: impl IntoIterator<Item = Option<Time>>) -> Option<Time> {
     deadlines.into_iter().flatten().min()
+}
+
+/// The connection as the watchdog sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Connection {
+    /// Nothing heard yet since the start.
+    Waiting,
+    /// Heard from within the watchdog timeout.
+    Connected,
+    /// Nothing for the watchdog timeout; the next sign of life reconnects.
+    Disconnected,
+}
+
+/// A change of the connection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Event {
+    /// The first sign of life.
+    Connected,
+    /// The watchdog expired.
+    Disconnected,
+    /// A sign of life again after a disconnect.
+    Reconnected,
+}
+
+/// What the watchdog has seen.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WatchdogCounters {
+    /// Timeouts.
+    pub disconnects: u64,
+    /// Returns to `Connected` after a timeout.
+    pub reconnects: u64,
+}
+
+/// A watchdog on a peer: any sign of life re-arms it; silence for the timeout disconnects; the
+/// next sign of life reconnects. Sans-IO: the caller hands it time.
+///
+/// ```
+/// use core::time::Duration;
+/// use robowire_core::schedule::{Event, Time, Watchdog};
+///
+/// let t0 = Time::from_nanos(1_000_000_000);
+/// let mut watchdog = Watchdog::new(t0, Duration::from_secs(3));
+/// assert_eq!(watchdog.feed(t0 + Duration::from_millis(2)), Some(Event::Connected));
+/// assert_eq!(watchdog.poll_timeout(), Some(t0 + Duration::from_millis(3002)));
+/// assert_eq!(watchdog.poll_event(t0 + Duration::from_secs(4)), Some(Event::Disconnected));
+/// assert_eq!(watchdog.feed(t0 + Duration::from_secs(9)), Some(Event::Reconnected));
+/// ```
+#[derive(Debug, Clone)]
+pub struct Watchdog {
+    timeout: Duration,
+    /// When it expires; `None` while disconnected (nothing left to expire).
+    deadline: Option<Time>,
+    connection: Connection,
+    counters: WatchdogCounters,
+}
+
+impl Watchdog {
+    /// Started at `now`: it expires `timeout` from now if nothing ever arrives (like the
+    /// vendor's).
+    pub fn new(now: Time, timeout: Duration) -> Self {
+        Self::waiting_until(now + timeout, timeout)
+    }
+
+    /// Waiting for a first sign of life until `first_deadline` (a peer that takes longer to
+    /// appear than to fall silent: DDS discovery), then `timeout` between signs of life.
+    pub fn waiting_until(first_deadline: Time, timeout: Duration) -> Self {
+        Self {
+            timeout,
+            deadline: Some(first_deadline),
+            connection: Connection::Waiting,
+            counters: WatchdogCounters::default(),
+        }
+    }
+
+    /// A sign of life at `now` (a datagram, a sample): re-arms the watchdog; the connection
+    /// event, if any.
+    pub fn feed(&mut self, now: Time) -> Option<Event> {
+        self.deadline = Some(now + self.timeout);
+        let event = match self.connection {
+            Connection::Connected => None,
+            Connection::Waiting => Some(Event::Connected),
+            Connection::Disconnected => {
+                self.counters.reconnects += 1;
+                Some(Event::Reconnected)
+            }
+        };
+        self.connection = Connection::Connected;
+        event
+    }
+
+    /// [`Event::Disconnected`] if the watchdog has expired at `now` (once per silence).
+    pub fn poll_event(&mut self, now: Time) -> Option<Event> {
+        if self.deadline.is_none_or(|deadline| now < deadline) {
+            return None;
+        }
+        self.deadline = None;
+        self.connection = Connection::Disconnected;
+        self.counters.disconnects += 1;
+        Some(Event::Disconnected)
+    }
+
+    /// When it expires; `None` while disconnected.
+    pub fn poll_timeout(&self) -> Option<Time> {
+        self.deadline
+    }
+
+    /// The connection now.
+    pub fn connection(&self) -> Connection {
+        self.connection
+    }
+
+    /// What it has seen.
+    pub fn counters(&self) -> WatchdogCounters {
+        self.counters
+    }
 }
 
 #[cfg(test)]

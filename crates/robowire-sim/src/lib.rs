@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 pub mod dog;
+pub mod go2;
 mod joints;
 pub mod kmc;
 pub mod spline;

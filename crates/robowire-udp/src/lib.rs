@@ -57,18 +57,24 @@ impl fmt::Display for HostAddresses<'_> {
     }
 }
 
-/// The host's IPv4 addresses (loopback included), or none if the interfaces cannot be listed.
-pub fn host_ipv4_addresses() -> Vec<Ipv4Addr> {
-    let mut ips: Vec<Ipv4Addr> = if_addrs::get_if_addrs()
+/// The host's network interfaces with their IPv4 addresses (name, address), or none if they
+/// cannot be listed. An interface with several addresses appears once per address.
+pub fn host_interfaces() -> Vec<(String, Ipv4Addr)> {
+    if_addrs::get_if_addrs()
         .map(|ifs| {
             ifs.into_iter()
                 .filter_map(|i| match i.ip() {
-                    IpAddr::V4(v4) => Some(v4),
+                    IpAddr::V4(v4) => Some((i.name, v4)),
                     IpAddr::V6(_) => None,
                 })
                 .collect()
         })
-        .unwrap_or_default();
+        .unwrap_or_default()
+}
+
+/// The host's IPv4 addresses (loopback included), or none if the interfaces cannot be listed.
+pub fn host_ipv4_addresses() -> Vec<Ipv4Addr> {
+    let mut ips: Vec<Ipv4Addr> = host_interfaces().into_iter().map(|(_, ip)| ip).collect();
     ips.sort();
     ips.dedup();
     ips

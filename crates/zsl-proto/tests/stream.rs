@@ -82,12 +82,12 @@ fn the_watchdog_disconnects_the_stream_stops_the_motion_and_state_reconnects() {
     let mut stream = High::new(T0, COMMAND_PERIOD);
     let mut watchdog = Watchdog::new(T0, WATCHDOG_TIMEOUT);
     assert_eq!(watchdog.connection(), Connection::Waiting);
-    assert_eq!(watchdog.handle_datagram(T0 + 5 * MS), Some(Event::Connected));
+    assert_eq!(watchdog.feed(T0 + 5 * MS), Some(Event::Connected));
     stream.handle_state(&state(1));
     stream.handle_call(HighLevelCommand::move_velocity(0.5, 0.0, 0.3)).unwrap();
     run(&mut stream, T0, T0 + 100 * MS);
     let last_state = T0 + 100 * MS;
-    assert_eq!(watchdog.handle_datagram(last_state), None);
+    assert_eq!(watchdog.feed(last_state), None);
     assert_eq!(watchdog.poll_timeout(), Some(last_state + Duration::from_secs(3)));
     assert_eq!(watchdog.poll_event(last_state + Duration::from_secs(3) - MS), None, "not yet");
     assert_eq!(watchdog.poll_event(last_state + Duration::from_secs(3)), Some(Event::Disconnected));
@@ -102,7 +102,7 @@ fn the_watchdog_disconnects_the_stream_stops_the_motion_and_state_reconnects() {
     let after = run(&mut stream, last_state + Duration::from_secs(3), last_state + Duration::from_secs(3) + 10 * MS);
     assert!(after.iter().all(|s| s.1.vx.get() == 0.0) && !after.is_empty());
     // State returns: reconnected, and the stale motion never resumes.
-    assert_eq!(watchdog.handle_datagram(last_state + Duration::from_secs(5)), Some(Event::Reconnected));
+    assert_eq!(watchdog.feed(last_state + Duration::from_secs(5)), Some(Event::Reconnected));
     stream.handle_state(&state(18));
     assert_eq!(stream.latched().vx.get(), 0.0);
     let c = watchdog.counters();
@@ -115,7 +115,7 @@ fn the_first_timeout_is_a_watchdog_period_after_start_and_an_empty_datagram_feed
     assert_eq!(silent.poll_timeout(), Some(T0 + 300 * MS));
     assert_eq!(silent.poll_event(T0 + 300 * MS), Some(Event::Disconnected), "nothing ever arrived");
     let mut fed = Watchdog::new(T0, 300 * MS);
-    assert_eq!(fed.handle_datagram(T0 + 200 * MS), Some(Event::Connected));
+    assert_eq!(fed.feed(T0 + 200 * MS), Some(Event::Connected));
     assert_eq!(fed.poll_event(T0 + 300 * MS), None, "a datagram re-armed it");
     assert_eq!(fed.poll_event(T0 + 500 * MS), Some(Event::Disconnected));
 }

@@ -32,14 +32,16 @@
 //! ```
 
 mod interface;
-mod watchdog;
 
 use core::time::Duration;
 
 use robowire_core::schedule::{Periodic, Tick, Time};
 
 pub use interface::{HighLevelInterface, HighLevelObserved, Interface, LowLevelInterface};
-pub use watchdog::{Connection, Event, WATCHDOG_TIMEOUT, Watchdog, WatchdogCounters};
+pub use robowire_core::schedule::{Connection, Event, Watchdog, WatchdogCounters};
+
+/// The vendor's watchdog timeout (spec §3.2): 3 s.
+pub const WATCHDOG_TIMEOUT: Duration = Duration::from_secs(3);
 
 /// The vendor's command period: 2 ms.
 pub const COMMAND_PERIOD: Duration = Duration::from_millis(2);

@@ -287,7 +287,7 @@ async fn receive<I: Wire>(session: Arc<Session<I>>, mut receiver: UdpReceiver<Co
             received = receiver.recv() => match received {
                 Ok(received) => {
                     let now = robowire_rt::now();
-                    let event = watchdog.handle_datagram(now);
+                    let event = watchdog.feed(now);
                     if let Some(last) = last_state.replace(now) {
                         session.counters.gaps.record(micros(now.saturating_duration_since(last)));
                     }

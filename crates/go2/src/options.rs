@@ -1,0 +1,94 @@
+//! [`LowLevelOptions`]: where the client lives on the network, its stream, its watchdog.
+
+use std::time::Duration;
+
+use lowcmd_proto::stream::StreamConfig;
+use robowire_dds::ParticipantOptions;
+use robowire_rt::runner::RunnerOptions;
+
+use crate::Go2Error;
+
+/// `rt/lowstate` silent for this long: `Disconnected` (the robot sends at 500 Hz: 50 missed
+/// states).
+pub const STATE_TIMEOUT: Duration = Duration::from_millis(100);
+
+/// How long the first state may take to arrive (DDS discovery) before the watchdog reports
+/// `Disconnected`.
+pub const FIRST_STATE_TIMEOUT: Duration = Duration::from_secs(3);
+
+/// How a [`LowLevel`](crate::LowLevel) client is set up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LowLevelOptions {
+    /// DDS domain (0) and network interface by name (`eth0`, `enp3s0`; the robot's network is
+    /// 192.168.123.x).
+    pub participant: ParticipantOptions,
+    /// The LowCmd stream: 2 ms period, 100 ms command timeout to damping, damping kd.
+    pub stream: StreamConfig,
+    /// Silence after which the connection is lost. Default [`STATE_TIMEOUT`].
+    pub state_timeout: Duration,
+    /// How long a service call (motion_switcher, sport) may take. Default 5 s (Unitree's examples).
+    pub service_timeout: Duration,
+    /// `SCHED_FIFO` priority 1..=99 for the stream thread; `None` keeps normal scheduling.
+    pub realtime_priority: Option<u8>,
+    /// CPU to pin the stream thread to.
+    pub cpu_affinity: Option<usize>,
+    /// Lock the process's memory when the stream starts.
+    pub lock_memory: bool,
+}
+
+impl Default for LowLevelOptions {
+    /// Domain 0, the library's choice of interface, Unitree's timing.
+    fn default() -> Self {
+        Self {
+            participant: ParticipantOptions::default(),
+            stream: StreamConfig::default(),
+            state_timeout: STATE_TIMEOUT,
+            service_timeout: Duration::from_secs(5),
+            realtime_priority: None,
+            cpu_affinity: None,
+            lock_memory: false,
+        }
+    }
+}
+
+impl LowLevelOptions {
+    /// Domain `domain` on interface `interface` (`None`: the library chooses).
+    pub fn on(interface: Option<&str>, domain: u16) -> Self {
+        Self { participant: ParticipantOptions::new(domain, interface), ..Self::default() }
+    }
+
+    pub(crate) fn validate(&self) -> Result<(), Go2Error> {
+        let bad = |name: &'static str, reason: String| Err(Go2Error::Option { name, reason });
+        let s = &self.stream;
+        if s.period < Duration::from_micros(100) || s.period > Duration::from_secs(1) {
+            return bad("stream.period", format!("{:?} is outside 100 µs..=1 s", s.period));
+        }
+        if s.command_timeout < s.period {
+            return bad("stream.command_timeout", format!("{:?} is shorter than the period", s.command_timeout));
+        }
+        if !(s.damping_kd.is_finite() && (0.0..=lowcmd_proto::robot::KD_MAX).contains(&s.damping_kd)) {
+            return bad(
+                "stream.damping_kd",
+                format!("{} is outside 0..={}", s.damping_kd, lowcmd_proto::robot::KD_MAX),
+            );
+        }
+        if self.state_timeout < s.period {
+            return bad("state_timeout", format!("{:?} is shorter than the period", self.state_timeout));
+        }
+        if let Some(priority) = self.realtime_priority
+            && !(1..=99).contains(&priority)
+        {
+            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn runner_options(&self) -> RunnerOptions {
+        RunnerOptions {
+            realtime_priority: self.realtime_priority,
+            cpu: self.cpu_affinity,
+            lock_memory: self.lock_memory,
+            ..RunnerOptions::named("go2-lowcmd")
+        }
+    }
+}

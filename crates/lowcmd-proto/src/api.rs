@@ -1,0 +1,555 @@
+//! The robot's services (spec `unitree-dds.md`): `unitree_api::msg::dds_::Request_` and
+//! `Response_` on `rt/api/<service>/request` and `/response`, and the API ids of the services
+//! robowire speaks (`motion_switcher`, `sport`).
+//!
+//! ```text
+//! Request_  { header { identity { int64 id; int64 api_id; }  lease { int64 id; }
+//!                      policy { int32 priority; boolean noreply; } }
+//!             string parameter; sequence<uint8> binary; }
+//! Response_ { header { identity { int64 id; int64 api_id; }  status { int32 code; } }
+//!             string data; sequence<uint8> binary; }
+//! ```
+//!
+//! Both are `@final`: their XCDR1 and XCDR2 bodies are the same bytes (the int64 fields sit at
+//! body offsets 0, 8 and 16, aligned either way; a primitive sequence has no DHEADER). Strings
+//! carry their NUL, counted in their length. The views here borrow; with the `alloc` feature,
+//! [`ApiRequest`] and [`ApiResponse`] own their strings and are `CdrType`s.
+//!
+//! ```
+//! use lowcmd_proto::api::{self, Request, RequestHeader};
+//!
+//! let request = Request { header: RequestHeader::call(7, api::motion_switcher::CHECK_MODE), parameter: "{}", binary: &[] };
+//! let mut body = [0u8; 64];
+//! let n = request.encode_body(&mut body).unwrap();
+//! assert_eq!(n, request.body_len());
+//! assert_eq!(Request::decode_body(&body[..n]), Ok(request));
+//! ```
+
+use robowire_core::BufferTooSmall;
+
+/// Service names and API ids of `motion_switcher` (API version "1.0.0.1").
+pub mod motion_switcher {
+    /// Service name: topics `rt/api/motion_switcher/request` and `/response`.
+    pub const SERVICE: &str = "motion_switcher";
+    /// API version.
+    pub const API_VERSION: &str = "1.0.0.1";
+    /// CheckMode: parameter `{}`; data `{"form":"0","name":"<mode>"}`, name empty when no sport
+    /// mode owns the motors.
+    pub const CHECK_MODE: i64 = 1001;
+    /// SelectMode: parameter `{"name":"<mode>"}`.
+    pub const SELECT_MODE: i64 = 1002;
+    /// ReleaseMode: parameter `{}`.
+    pub const RELEASE_MODE: i64 = 1003;
+    /// SetSilent.
+    pub const SET_SILENT: i64 = 1004;
+    /// GetSilent.
+    pub const GET_SILENT: i64 = 1005;
+
+    pub use super::mode_name;
+
+    /// The CheckMode answer's data for `name` (empty: no sport mode owns the motors).
+    pub fn check_mode_data(name: &str) -> impl core::fmt::Display + '_ {
+        CheckModeData(name)
+    }
+
+    struct CheckModeData<'a>(&'a str);
+
+    impl core::fmt::Display for CheckModeData<'_> {
+        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            write!(f, r#"{{"form":"0","name":"{}"}}"#, self.0)
+        }
+    }
+}
+
+/// The mode name in a CheckMode answer (`{"form":"0","name":"normal"}`) or a SelectMode
+/// parameter (`{"name":"ai"}`): the string value of `"name"` in a flat JSON object (no
+/// escapes, as Unitree's services write it). `None` if there is none.
+///
+/// ```
+/// use lowcmd_proto::api::motion_switcher::mode_name;
+/// assert_eq!(mode_name(r#"{"form":"0","name":"normal"}"#), Some("normal"));
+/// assert_eq!(mode_name(r#"{"form": "0", "name": ""}"#), Some(""));
+/// assert_eq!(mode_name("{}"), None);
+/// ```
+pub fn mode_name(json: &str) -> Option<&str> {
+    let rest = &json[json.find("\"name\"")? + 6..];
+    let rest = rest.trim_start().strip_prefix(':')?.trim_start().strip_prefix('"')?;
+    Some(&rest[..rest.find('"')?])
+}
+
+/// Service name and the API ids of `sport` that robowire uses (API version "1.0.0.1").
+pub mod sport {
+    /// Service name.
+    pub const SERVICE: &str = "sport";
+    /// API version.
+    pub const API_VERSION: &str = "1.0.0.1";
+    /// Damp.
+    pub const DAMP: i64 = 1001;
+    /// BalanceStand.
+    pub const BALANCE_STAND: i64 = 1002;
+    /// StopMove.
+    pub const STOP_MOVE: i64 = 1003;
+    /// StandUp.
+    pub const STAND_UP: i64 = 1004;
+    /// StandDown (lie down before the sport mode is released).
+    pub const STAND_DOWN: i64 = 1005;
+}
+
+/// The internal API every service answers: its API version.
+pub const API_VERSION_ID: i64 = 1;
+
+/// Status codes of the RPC layer (unitree_sdk2's `rpc/internal`).
+pub mod status {
+    /// Success.
+    pub const OK: i32 = 0;
+    /// The server has no such API.
+    pub const SERVER_API_NOT_IMPLEMENTED: i32 = 3203;
+    /// The server refused the parameter.
+    pub const SERVER_API_PARAMETER: i32 = 3204;
+    /// The server failed internally.
+    pub const SERVER_INTERNAL: i32 = 3202;
+}
+
+/// DDS type name of [`Request`].
+pub const REQUEST_TYPE_NAME: &str = "unitree_api::msg::dds_::Request_";
+/// DDS type name of [`Response`].
+pub const RESPONSE_TYPE_NAME: &str = "unitree_api::msg::dds_::Response_";
+
+/// The request topic of `service` (`rt/api/<service>/request`).
+pub fn request_topic(service: &str) -> impl core::fmt::Display + '_ {
+    Topic { service, suffix: "request" }
+}
+
+/// The response topic of `service` (`rt/api/<service>/response`).
+pub fn response_topic(service: &str) -> impl core::fmt::Display + '_ {
+    Topic { service, suffix: "response" }
+}
+
+struct Topic<'a> {
+    service: &'a str,
+    suffix: &'static str,
+}
+
+impl core::fmt::Display for Topic<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "rt/api/{}/{}", self.service, self.suffix)
+    }
+}
+
+/// `RequestHeader_`, flattened.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RequestHeader {
+    /// `identity.id`: the caller's request id, echoed by the answer (Unitree's SDKs use the
+    /// monotonic clock in ns).
+    pub id: i64,
+    /// `identity.api_id`.
+    pub api_id: i64,
+    /// `lease.id` (0 without a lease).
+    pub lease_id: i64,
+    /// `policy.priority`.
+    pub priority: i32,
+    /// `policy.noreply`: the server sends no answer.
+    pub noreply: bool,
+}
+
+impl RequestHeader {
+    /// A call that wants an answer: no lease, priority 0.
+    pub const fn call(id: i64, api_id: i64) -> Self {
+        Self { id, api_id, lease_id: 0, priority: 0, noreply: false }
+    }
+}
+
+/// `Request_`, borrowing its string and bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Request<'a> {
+    /// The header.
+    pub header: RequestHeader,
+    /// `parameter`, JSON by convention.
+    pub parameter: &'a str,
+    /// `binary`.
+    pub binary: &'a [u8],
+}
+
+/// `Response_`, borrowing its string and bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Response<'a> {
+    /// `identity.id`: the request's.
+    pub id: i64,
+    /// `identity.api_id`: the request's.
+    pub api_id: i64,
+    /// `status.code`: 0 on success.
+    pub code: i32,
+    /// `data`, JSON by convention.
+    pub data: &'a str,
+    /// `binary`.
+    pub binary: &'a [u8],
+}
+
+/// Why a body is not a `Request_` or `Response_`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ApiError {
+    /// The body ends before field `field`.
+    #[error("the body ends in field {field}: {needed} bytes needed, {found} given")]
+    Truncated {
+        /// The field.
+        field: &'static str,
+        /// Bytes the field needs from the start of the body.
+        needed: usize,
+        /// The body's length.
+        found: usize,
+    },
+    /// A string without its terminating NUL (or with a length of 0).
+    #[error("string {field} is not NUL-terminated")]
+    NoNul {
+        /// The field.
+        field: &'static str,
+    },
+    /// A string that is not UTF-8.
+    #[error("string {field} is not UTF-8")]
+    NotUtf8 {
+        /// The field.
+        field: &'static str,
+    },
+    /// A boolean byte other than 0 or 1.
+    #[error("boolean {field} is {value}, not 0 or 1")]
+    Bool {
+        /// The field.
+        field: &'static str,
+        /// The byte.
+        value: u8,
+    },
+    /// Bytes left after the last field beyond alignment padding.
+    #[error("{extra} bytes after the last field")]
+    Trailing {
+        /// Bytes left.
+        extra: usize,
+    },
+}
+
+/// Bytes after the last field that are taken as padding (a writer may pad the body to 4 or 8).
+const MAX_TRAILING_PADDING: usize = 7;
+
+/// A cursor writing CDR little-endian with alignment counted from the body's start.
+struct Writer<'a> {
+    out: &'a mut [u8],
+    pos: usize,
+    needed: usize,
+}
+
+impl Writer<'_> {
+    fn bytes(&mut self, align: usize, bytes: &[u8]) {
+        let start = self.pos.next_multiple_of(align);
+        let end = start + bytes.len();
+        self.needed = self.needed.max(end);
+        if let Some(dst) = self.out.get_mut(self.pos..end) {
+            dst[..start - self.pos].fill(0);
+            dst[start - self.pos..].copy_from_slice(bytes);
+        }
+        self.pos = end;
+    }
+
+    fn string(&mut self, s: &str) {
+        self.bytes(4, &(s.len() as u32 + 1).to_le_bytes());
+        self.bytes(1, s.as_bytes());
+        self.bytes(1, &[0]);
+    }
+
+    fn sequence(&mut self, bytes: &[u8]) {
+        self.bytes(4, &(bytes.len() as u32).to_le_bytes());
+        self.bytes(1, bytes);
+    }
+
+    fn finish(self) -> Result<usize, BufferTooSmall> {
+        let available = self.out.len();
+        if self.needed <= available { Ok(self.pos) } else { Err(BufferTooSmall { needed: self.needed, available }) }
+    }
+}
+
+/// A cursor reading CDR little-endian.
+struct Reader<'a> {
+    body: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, field: &'static str, align: usize, len: usize) -> Result<&'a [u8], ApiError> {
+        let start = self.pos.next_multiple_of(align);
+        let end = start + len;
+        let bytes =
+            self.body.get(start..end).ok_or(ApiError::Truncated { field, needed: end, found: self.body.len() })?;
+        self.pos = end;
+        Ok(bytes)
+    }
+
+    fn array<const N: usize>(&mut self, field: &'static str) -> Result<[u8; N], ApiError> {
+        let bytes = self.take(field, N, N)?;
+        let mut out = [0u8; N];
+        out.copy_from_slice(bytes);
+        Ok(out)
+    }
+
+    fn i64(&mut self, field: &'static str) -> Result<i64, ApiError> {
+        self.array(field).map(i64::from_le_bytes)
+    }
+
+    fn i32(&mut self, field: &'static str) -> Result<i32, ApiError> {
+        self.array(field).map(i32::from_le_bytes)
+    }
+
+    fn bool(&mut self, field: &'static str) -> Result<bool, ApiError> {
+        match self.take(field, 1, 1)?[0] {
+            0 => Ok(false),
+            1 => Ok(true),
+            value => Err(ApiError::Bool { field, value }),
+        }
+    }
+
+    fn string(&mut self, field: &'static str) -> Result<&'a str, ApiError> {
+        let len = u32::from_le_bytes(self.array(field)?) as usize;
+        let bytes = self.take(field, 1, len)?;
+        let (&nul, text) = bytes.split_last().ok_or(ApiError::NoNul { field })?;
+        if nul != 0 {
+            return Err(ApiError::NoNul { field });
+        }
+        core::str::from_utf8(text).map_err(|_| ApiError::NotUtf8 { field })
+    }
+
+    fn sequence(&mut self, field: &'static str) -> Result<&'a [u8], ApiError> {
+        let len = u32::from_le_bytes(self.array(field)?) as usize;
+        self.take(field, 1, len)
+    }
+
+    fn finish(self) -> Result<(), ApiError> {
+        let extra = self.body.len() - self.pos.min(self.body.len());
+        if extra <= MAX_TRAILING_PADDING { Ok(()) } else { Err(ApiError::Trailing { extra }) }
+    }
+}
+
+impl<'a> Request<'a> {
+    /// Body length, bytes.
+    pub fn body_len(&self) -> usize {
+        let mut w = Writer { out: &mut [], pos: 0, needed: 0 };
+        self.write(&mut w);
+        w.pos
+    }
+
+    fn write(&self, w: &mut Writer<'_>) {
+        let h = &self.header;
+        w.bytes(8, &h.id.to_le_bytes());
+        w.bytes(8, &h.api_id.to_le_bytes());
+        w.bytes(8, &h.lease_id.to_le_bytes());
+        w.bytes(4, &h.priority.to_le_bytes());
+        w.bytes(1, &[u8::from(h.noreply)]);
+        w.string(self.parameter);
+        w.sequence(self.binary);
+    }
+
+    /// Writes the body into `out`; its length.
+    pub fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let mut w = Writer { out, pos: 0, needed: 0 };
+        self.write(&mut w);
+        w.finish()
+    }
+
+    /// Reads a body (XCDR1 or XCDR2: the same bytes).
+    pub fn decode_body(body: &'a [u8]) -> Result<Self, ApiError> {
+        let mut r = Reader { body, pos: 0 };
+        let header = RequestHeader {
+            id: r.i64("header.identity.id")?,
+            api_id: r.i64("header.identity.api_id")?,
+            lease_id: r.i64("header.lease.id")?,
+            priority: r.i32("header.policy.priority")?,
+            noreply: r.bool("header.policy.noreply")?,
+        };
+        let request = Self { header, parameter: r.string("parameter")?, binary: r.sequence("binary")? };
+        r.finish()?;
+        Ok(request)
+    }
+}
+
+impl<'a> Response<'a> {
+    /// The answer to `request` with `code` and `data`.
+    pub fn to(request: &RequestHeader, code: i32, data: &'a str) -> Self {
+        Self { id: request.id, api_id: request.api_id, code, data, binary: &[] }
+    }
+
+    /// Body length, bytes.
+    pub fn body_len(&self) -> usize {
+        let mut w = Writer { out: &mut [], pos: 0, needed: 0 };
+        self.write(&mut w);
+        w.pos
+    }
+
+    fn write(&self, w: &mut Writer<'_>) {
+        w.bytes(8, &self.id.to_le_bytes());
+        w.bytes(8, &self.api_id.to_le_bytes());
+        w.bytes(4, &self.code.to_le_bytes());
+        w.string(self.data);
+        w.sequence(self.binary);
+    }
+
+    /// Writes the body into `out`; its length.
+    pub fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let mut w = Writer { out, pos: 0, needed: 0 };
+        self.write(&mut w);
+        w.finish()
+    }
+
+    /// Reads a body (XCDR1 or XCDR2: the same bytes).
+    pub fn decode_body(body: &'a [u8]) -> Result<Self, ApiError> {
+        let mut r = Reader { body, pos: 0 };
+        let response = Self {
+            id: r.i64("header.identity.id")?,
+            api_id: r.i64("header.identity.api_id")?,
+            code: r.i32("header.status.code")?,
+            data: r.string("data")?,
+            binary: r.sequence("binary")?,
+        };
+        r.finish()?;
+        Ok(response)
+    }
+}
+
+#[cfg(feature = "alloc")]
+mod owned {
+    extern crate alloc;
+    use alloc::string::String;
+    use alloc::vec::Vec;
+
+    use robowire_core::BufferTooSmall;
+    use robowire_core::cdr::{CdrEncoding, CdrType};
+
+    use super::{ApiError, REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, RequestHeader, Response};
+
+    /// `Request_`, owning its string and bytes: what a DDS topic carries.
+    #[derive(Debug, Clone, PartialEq, Eq, Default)]
+    pub struct ApiRequest {
+        /// The header.
+        pub header: RequestHeader,
+        /// `parameter`.
+        pub parameter: String,
+        /// `binary`.
+        pub binary: Vec<u8>,
+    }
+
+    impl ApiRequest {
+        /// The borrowed view.
+        pub fn view(&self) -> Request<'_> {
+            Request { header: self.header, parameter: &self.parameter, binary: &self.binary }
+        }
+    }
+
+    impl From<Request<'_>> for ApiRequest {
+        fn from(r: Request<'_>) -> Self {
+            Self { header: r.header, parameter: r.parameter.into(), binary: r.binary.into() }
+        }
+    }
+
+    /// `Response_`, owning its string and bytes.
+    #[derive(Debug, Clone, PartialEq, Eq, Default)]
+    pub struct ApiResponse {
+        /// `identity.id`.
+        pub id: i64,
+        /// `identity.api_id`.
+        pub api_id: i64,
+        /// `status.code`.
+        pub code: i32,
+        /// `data`.
+        pub data: String,
+        /// `binary`.
+        pub binary: Vec<u8>,
+    }
+
+    impl ApiResponse {
+        /// The borrowed view.
+        pub fn view(&self) -> Response<'_> {
+            Response { id: self.id, api_id: self.api_id, code: self.code, data: &self.data, binary: &self.binary }
+        }
+    }
+
+    impl From<Response<'_>> for ApiResponse {
+        fn from(r: Response<'_>) -> Self {
+            Self { id: r.id, api_id: r.api_id, code: r.code, data: r.data.into(), binary: r.binary.into() }
+        }
+    }
+
+    impl CdrType for ApiRequest {
+        const TYPE_NAME: &'static str = REQUEST_TYPE_NAME;
+        type Error = ApiError;
+        fn body_len(&self) -> usize {
+            self.view().body_len()
+        }
+        fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+            self.view().encode_body(out)
+        }
+        fn decode_body(_: CdrEncoding, body: &[u8]) -> Result<Self, ApiError> {
+            Request::decode_body(body).map(Self::from)
+        }
+    }
+
+    impl CdrType for ApiResponse {
+        const TYPE_NAME: &'static str = RESPONSE_TYPE_NAME;
+        type Error = ApiError;
+        fn body_len(&self) -> usize {
+            self.view().body_len()
+        }
+        fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+            self.view().encode_body(out)
+        }
+        fn decode_body(_: CdrEncoding, body: &[u8]) -> Result<Self, ApiError> {
+            Response::decode_body(body).map(Self::from)
+        }
+    }
+}
+
+#[cfg(feature = "alloc")]
+pub use owned::{ApiRequest, ApiResponse};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn request_layout_by_the_cdr_rules() {
+        let request = Request {
+            header: RequestHeader { id: 0x0102, api_id: 1001, lease_id: 0, priority: 3, noreply: true },
+            parameter: "{}",
+            binary: &[9, 8],
+        };
+        let mut body = [0xAAu8; 64];
+        let n = request.encode_body(&mut body).unwrap();
+        let expected: &[u8] = &[
+            0x02, 0x01, 0, 0, 0, 0, 0, 0, // id
+            0xE9, 0x03, 0, 0, 0, 0, 0, 0, // api_id 1001
+            0, 0, 0, 0, 0, 0, 0, 0, // lease
+            3, 0, 0, 0, // priority
+            1, 0, 0, 0, // noreply, then alignment for the string length
+            3, 0, 0, 0, b'{', b'}', 0, // "{}" with its NUL
+            0, // alignment
+            2, 0, 0, 0, 9, 8, // binary
+        ];
+        assert_eq!(&body[..n], expected);
+        assert_eq!(Request::decode_body(expected), Ok(request));
+        assert_eq!(request.body_len(), expected.len());
+    }
+
+    #[test]
+    fn response_round_trip_and_errors() {
+        let header = RequestHeader::call(42, motion_switcher::CHECK_MODE);
+        let response = Response::to(&header, status::OK, r#"{"form":"0","name":"normal"}"#);
+        let mut body = [0u8; 128];
+        let n = response.encode_body(&mut body).unwrap();
+        assert_eq!(Response::decode_body(&body[..n]), Ok(response));
+        // Padding after the last field is fine; more is not.
+        assert!(Response::decode_body(&body[..n + 3]).is_ok());
+        assert_eq!(Response::decode_body(&body[..n + 8]), Err(ApiError::Trailing { extra: 8 }));
+        assert!(matches!(Response::decode_body(&body[..n - 1]), Err(ApiError::Truncated { field: "binary", .. })));
+        let mut short = [0u8; 8];
+        assert_eq!(response.encode_body(&mut short), Err(BufferTooSmall { needed: n, available: 8 }));
+        // A string without its NUL.
+        let mut bad = body;
+        bad[20 + 4 + response.data.len()] = b'x';
+        assert_eq!(Response::decode_body(&bad[..n]), Err(ApiError::NoNul { field: "data" }));
+    }
+}

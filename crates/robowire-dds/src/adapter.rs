@@ -1,0 +1,96 @@
+//! rustdds's (de)serializer adapters over robowire's codecs: the codec writes and reads the CDR
+//! body, rustdds the 4-byte encapsulation header. A body that does not decode is not an error
+//! for rustdds: it becomes a [`Decoded::Err`] sample, so that the reader counts it.
+
+use std::marker::PhantomData;
+
+use bytes::Bytes;
+use robowire_core::cdr::{CdrEncoding, CdrType};
+use rustdds::RepresentationIdentifier;
+use rustdds::no_key::{Decode, DefaultDecoder, DeserializerAdapter, SerializerAdapter};
+
+/// A sample as read: the message, or why its body did not decode.
+pub(crate) type Decoded<T> = Result<T, DecodeFailure>;
+
+/// Why a sample's body did not decode.
+#[derive(Debug, Clone)]
+pub(crate) struct DecodeFailure {
+    pub(crate) checksum: bool,
+    pub(crate) reason: String,
+}
+
+/// The adapter for `T`.
+pub(crate) struct CdrAdapter<T>(PhantomData<fn(T) -> T>);
+
+/// The encodings robowire reads: XCDR1 and XCDR2, little endian.
+const READ: [RepresentationIdentifier; 2] = [RepresentationIdentifier::CDR_LE, RepresentationIdentifier::CDR2_LE];
+
+/// Never fails: the codec's error becomes a value.
+#[derive(Debug, thiserror::Error)]
+#[error("unreachable")]
+pub(crate) struct Never;
+
+fn encoding(id: RepresentationIdentifier) -> Option<CdrEncoding> {
+    CdrEncoding::from_identifier(id.to_bytes())
+}
+
+impl<T: CdrType> SerializerAdapter<T> for CdrAdapter<T> {
+    type Error = EncodeError;
+
+    fn output_encoding() -> RepresentationIdentifier {
+        let [a, b] = T::ENCODING.identifier();
+        RepresentationIdentifier::from_bytes(&[a, b]).unwrap_or(RepresentationIdentifier::CDR_LE)
+    }
+
+    /// One allocation per sample: rustdds takes `Bytes`.
+    fn to_bytes(value: &T) -> Result<Bytes, EncodeError> {
+        let mut body = vec![0u8; value.body_len()];
+        let n = value.encode_body(&mut body).map_err(|e| EncodeError(e.to_string()))?;
+        body.truncate(n);
+        Ok(Bytes::from(body))
+    }
+}
+
+/// A message the codec could not write (never with robowire's fixed-size messages).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct EncodeError(String);
+
+impl<T: CdrType> DeserializerAdapter<Decoded<T>> for CdrAdapter<T> {
+    type Error = Never;
+    type Decoded = Decoded<T>;
+
+    fn supported_encodings() -> &'static [RepresentationIdentifier] {
+        &READ
+    }
+
+    fn transform_decoded(decoded: Decoded<T>) -> Decoded<T> {
+        decoded
+    }
+}
+
+/// The decoder value rustdds hands bytes to.
+pub(crate) struct Decoder<T>(PhantomData<fn(T) -> T>);
+
+impl<T> Clone for Decoder<T> {
+    fn clone(&self) -> Self {
+        Self(PhantomData)
+    }
+}
+
+impl<'de, T: CdrType> Decode<'de, Decoded<T>> for Decoder<T> {
+    type Error = Never;
+
+    fn decode_bytes(self, body: &'de [u8], id: RepresentationIdentifier) -> Result<Decoded<T>, Never> {
+        let Some(encoding) = encoding(id) else {
+            return Ok(Err(DecodeFailure { checksum: false, reason: format!("unsupported representation {id:?}") }));
+        };
+        Ok(T::decode_body(encoding, body)
+            .map_err(|e| DecodeFailure { checksum: T::is_checksum_error(&e), reason: e.to_string() }))
+    }
+}
+
+impl<T: CdrType> DefaultDecoder<Decoded<T>> for CdrAdapter<T> {
+    type Decoder = Decoder<T>;
+    const DECODER: Decoder<T> = Decoder(PhantomData);
+}

@@ -1,0 +1,14 @@
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+
+mod adapter;
+mod error;
+pub mod netns;
+mod participant;
+pub mod qos;
+pub mod rpc;
+mod topic;
+
+pub use error::DdsError;
+pub use participant::{DiscoveredTopic, Participant, ParticipantOptions};
+pub use topic::{Reader, Sample, StatsHandle, TopicStats, Writer};

@@ -1,0 +1,134 @@
+//! [`Participant`]: one DDS domain participant on a named interface, the factory of typed
+//! writers and readers.
+
+use std::collections::BTreeMap;
+use std::net::{IpAddr, Ipv4Addr};
+
+use robowire_core::cdr::CdrType;
+use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, Subscriber, TopicKind};
+
+use crate::DdsError;
+use crate::adapter::CdrAdapter;
+use crate::qos::Qos;
+use crate::topic::{Reader, Writer};
+
+/// Where a participant lives.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ParticipantOptions {
+    /// DDS domain (Unitree's robots: 0).
+    pub domain: u16,
+    /// The network interface by name (`eth0`, `enp3s0`, `lo`), as Unitree's
+    /// `ChannelFactoryInitialize(0, iface)`; `None` lets the library choose.
+    pub interface: Option<String>,
+}
+
+impl ParticipantOptions {
+    /// Domain `domain` on `interface`.
+    pub fn new(domain: u16, interface: Option<&str>) -> Self {
+        Self { domain, interface: interface.map(str::to_owned) }
+    }
+}
+
+/// A topic seen on the network, with its type and how many writers and readers it has.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DiscoveredTopic {
+    /// Topic name.
+    pub name: String,
+    /// DDS type name.
+    pub type_name: String,
+    /// Remote writers.
+    pub writers: usize,
+    /// Remote readers.
+    pub readers: usize,
+}
+
+/// A domain participant; see the [crate docs](crate).
+pub struct Participant {
+    inner: DomainParticipant,
+    publisher: Publisher,
+    subscriber: Subscriber,
+    options: ParticipantOptions,
+}
+
+impl std::fmt::Debug for Participant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Participant").field("options", &self.options).finish_non_exhaustive()
+    }
+}
+
+/// The IPv4 addresses of interface `name`.
+fn interface_addresses(name: &str) -> Result<Vec<Ipv4Addr>, DdsError> {
+    let interfaces = robowire_udp::host_interfaces();
+    let ips: Vec<Ipv4Addr> = interfaces.iter().filter(|(n, _)| n == name).map(|(_, ip)| *ip).collect();
+    if ips.is_empty() {
+        let available = interfaces.iter().map(|(n, ip)| format!("{n} {ip}")).collect::<Vec<_>>().join(", ");
+        return Err(DdsError::NoInterface { name: name.into(), available });
+    }
+    Ok(ips)
+}
+
+impl Participant {
+    /// Joins `options.domain` on `options.interface`.
+    pub fn new(options: ParticipantOptions) -> Result<Self, DdsError> {
+        let mut builder = DomainParticipantBuilder::new(options.domain);
+        if let Some(name) = &options.interface {
+            let ips = interface_addresses(name)?;
+            builder = builder.with_only_networks(ips.into_iter().map(IpAddr::V4));
+        }
+        let failed =
+            |e: &dyn std::fmt::Display| DdsError::Participant { domain: options.domain, reason: e.to_string() };
+        let inner = builder.build().map_err(|e| failed(&e))?;
+        let qos = Qos::WRITER.policies();
+        let publisher = inner.create_publisher(&qos).map_err(|e| failed(&e))?;
+        let subscriber = inner.create_subscriber(&Qos::READER.policies()).map_err(|e| failed(&e))?;
+        Ok(Self { inner, publisher, subscriber, options })
+    }
+
+    /// Where it lives.
+    pub fn options(&self) -> &ParticipantOptions {
+        &self.options
+    }
+
+    fn topic<T: CdrType>(&self, name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
+        self.inner
+            .create_topic(name.into(), T::TYPE_NAME.into(), &qos.policies(), TopicKind::NoKey)
+            .map_err(|e| DdsError::Create { what, topic: name.into(), reason: e.to_string() })
+    }
+
+    /// A writer of `T` on topic `name`.
+    pub fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
+        let topic = self.topic::<T>(name, qos, "writer")?;
+        let inner = self
+            .publisher
+            .create_datawriter_no_key::<T, CdrAdapter<T>>(&topic, Some(qos.policies()))
+            .map_err(|e| DdsError::Create { what: "writer", topic: name.into(), reason: e.to_string() })?;
+        Ok(Writer::new(inner, name))
+    }
+
+    /// A reader of `T` on topic `name`. It yields samples from a tokio task (any executor).
+    pub fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
+        let topic = self.topic::<T>(name, qos, "reader")?;
+        let inner = self
+            .subscriber
+            .create_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))
+            .map_err(|e| DdsError::Create { what: "reader", topic: name.into(), reason: e.to_string() })?;
+        Ok(Reader::new(inner, name))
+    }
+
+    /// Topics seen from other participants' writers and readers, by name.
+    pub fn discovered_topics(&self) -> Vec<DiscoveredTopic> {
+        let mut topics: BTreeMap<(String, String), (usize, usize)> = BTreeMap::new();
+        for w in self.inner.discovered_writers() {
+            let data = &w.publication_topic_data;
+            topics.entry((data.topic_name.clone(), data.type_name.clone())).or_default().0 += 1;
+        }
+        for r in self.inner.discovered_readers() {
+            let data = &r.subscription_topic_data;
+            topics.entry((data.topic_name().clone(), data.type_name().clone())).or_default().1 += 1;
+        }
+        topics
+            .into_iter()
+            .map(|((name, type_name), (writers, readers))| DiscoveredTopic { name, type_name, writers, readers })
+            .collect()
+    }
+}

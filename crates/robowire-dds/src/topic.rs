@@ -1,0 +1,197 @@
+//! Typed writers and readers with their counters.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
+
+use futures::StreamExt;
+use robowire_core::cdr::CdrType;
+use rustdds::no_key::{DataReader, DataReaderStream, DataWriter};
+use rustdds::{DataWriterStatus, StatusEvented};
+
+use crate::DdsError;
+use crate::adapter::{CdrAdapter, Decoded};
+
+/// What a writer or reader has done.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TopicStats {
+    /// Samples written, or received and decoded.
+    pub samples: u64,
+    /// Writes that failed.
+    pub write_errors: u64,
+    /// Received samples whose body did not decode (checksum failures not included).
+    pub decode_errors: u64,
+    /// Received samples whose integrity check (CRC) failed.
+    pub checksum_errors: u64,
+}
+
+#[derive(Debug, Default)]
+struct Counters {
+    samples: AtomicU64,
+    write_errors: AtomicU64,
+    decode_errors: AtomicU64,
+    checksum_errors: AtomicU64,
+}
+
+impl Counters {
+    fn bump(counter: &AtomicU64) {
+        counter.fetch_add(1, Ordering::Relaxed);
+    }
+
+    fn get(&self) -> TopicStats {
+        TopicStats {
+            samples: self.samples.load(Ordering::Relaxed),
+            write_errors: self.write_errors.load(Ordering::Relaxed),
+            decode_errors: self.decode_errors.load(Ordering::Relaxed),
+            checksum_errors: self.checksum_errors.load(Ordering::Relaxed),
+        }
+    }
+}
+
+/// A handle on a writer's or reader's counters, usable from any thread.
+#[derive(Debug, Clone)]
+pub struct StatsHandle(Arc<Counters>);
+
+impl StatsHandle {
+    /// The counters now.
+    pub fn get(&self) -> TopicStats {
+        self.0.get()
+    }
+}
+
+/// Writes `T` to one topic. Usable from any thread; a write never waits for a reader (keep
+/// last 1).
+pub struct Writer<T: CdrType + 'static> {
+    inner: DataWriter<T, CdrAdapter<T>>,
+    topic: String,
+    counters: Arc<Counters>,
+    /// Matched readers, from the last publication-matched status seen.
+    matched: AtomicI64,
+}
+
+impl<T: CdrType + 'static> std::fmt::Debug for Writer<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Writer").field("topic", &self.topic).field("type", &T::TYPE_NAME).finish_non_exhaustive()
+    }
+}
+
+impl<T: CdrType + 'static> Writer<T> {
+    pub(crate) fn new(inner: DataWriter<T, CdrAdapter<T>>, topic: &str) -> Self {
+        Self { inner, topic: topic.into(), counters: Arc::default(), matched: AtomicI64::new(0) }
+    }
+
+    /// Encodes `sample` with its codec and publishes it.
+    pub fn write(&self, sample: T) -> Result<(), DdsError> {
+        match self.inner.write(sample, None) {
+            Ok(()) => {
+                Counters::bump(&self.counters.samples);
+                Ok(())
+            }
+            Err(e) => {
+                Counters::bump(&self.counters.write_errors);
+                Err(DdsError::Write { topic: self.topic.clone(), reason: e.to_string() })
+            }
+        }
+    }
+
+    /// Readers of this topic matched so far.
+    pub fn matched_readers(&self) -> usize {
+        while let Some(status) = self.inner.try_recv_status() {
+            if let DataWriterStatus::PublicationMatched { current, .. } = status {
+                self.matched.store(i64::from(current.count()), Ordering::Relaxed);
+            }
+        }
+        usize::try_from(self.matched.load(Ordering::Relaxed)).unwrap_or(0)
+    }
+
+    /// The topic.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> TopicStats {
+        self.counters.get()
+    }
+
+    /// A handle on the counters.
+    pub fn stats_handle(&self) -> StatsHandle {
+        StatsHandle(self.counters.clone())
+    }
+}
+
+/// A sample as received.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample<T> {
+    /// The message.
+    pub value: T,
+}
+
+/// Reads `T` from one topic, asynchronously (any executor). Samples whose body does not decode
+/// are counted and skipped.
+pub struct Reader<T: CdrType + 'static> {
+    stream: DataReaderStream<Decoded<T>, CdrAdapter<T>>,
+    topic: String,
+    counters: Arc<Counters>,
+    last_error: Option<String>,
+}
+
+impl<T: CdrType + 'static> std::fmt::Debug for Reader<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Reader").field("topic", &self.topic).field("type", &T::TYPE_NAME).finish_non_exhaustive()
+    }
+}
+
+impl<T: CdrType + 'static> Reader<T> {
+    pub(crate) fn new(inner: DataReader<Decoded<T>, CdrAdapter<T>>, topic: &str) -> Self {
+        Self { stream: inner.async_sample_stream(), topic: topic.into(), counters: Arc::default(), last_error: None }
+    }
+
+    /// The next sample that decodes.
+    pub async fn recv(&mut self) -> Result<Sample<T>, DdsError> {
+        loop {
+            match self.stream.next().await {
+                Some(Ok(sample)) => match sample.into_value() {
+                    Ok(value) => {
+                        Counters::bump(&self.counters.samples);
+                        return Ok(Sample { value });
+                    }
+                    Err(failure) => {
+                        let counter = if failure.checksum {
+                            &self.counters.checksum_errors
+                        } else {
+                            &self.counters.decode_errors
+                        };
+                        Counters::bump(counter);
+                        self.last_error = Some(failure.reason);
+                    }
+                },
+                // A read error of the library (a sample it could not take): counted, next.
+                Some(Err(e)) => {
+                    Counters::bump(&self.counters.decode_errors);
+                    self.last_error = Some(e.to_string());
+                }
+                None => return Err(DdsError::Closed { topic: self.topic.clone() }),
+            }
+        }
+    }
+
+    /// Why the last rejected sample was rejected (the codec's words).
+    pub fn last_error(&self) -> Option<&str> {
+        self.last_error.as_deref()
+    }
+
+    /// The topic.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> TopicStats {
+        self.counters.get()
+    }
+
+    /// A handle on the counters.
+    pub fn stats_handle(&self) -> StatsHandle {
+        StatsHandle(self.counters.clone())
+    }
+}

@@ -1,0 +1,185 @@
+//! The Go2's body, sans I/O: 12 joints under the shared PD joint model, driven by the latched
+//! `LowCmd`, and the `LowState` it reports (IMU at rest, foot forces from the calf torques,
+//! battery, tick).
+//!
+//! The firmware's sentinels are modelled as torque terms that vanish with their gain: `PosStopF`
+//! with kp 0 and `VelStopF` with kd 0 contribute nothing (a `VelStopF` with kd > 0 would be a
+//! 16000 rad/s target: clamped to the torque limit, as a real drive would saturate).
+
+use lowcmd_proto::{LowCmd, LowState};
+
+use crate::joints::{JointModel, PdTarget};
+
+/// The pose Unitree's stand example starts from, per motor (hip, thigh, calf × FR, FL, RR, RL):
+/// lying, rear hips turned out.
+pub const LYING_POSE_RAD: [f32; 12] = [0.0, 1.36, -2.65, 0.0, 1.36, -2.65, -0.2, 1.36, -2.65, 0.2, 1.36, -2.65];
+/// The stand pose of Unitree's examples, per leg (hip, thigh, calf).
+pub const STAND_POSE_RAD: [f32; 3] = [0.0, 0.67, -1.3];
+/// Motors driven on the Go2.
+pub const JOINTS: usize = 12;
+
+/// Without a LowCmd for this long the motors go passive (kp = kd = 0).
+pub const COMMAND_HOLD_S: f32 = 0.1;
+
+/// The body.
+#[derive(Debug, Clone)]
+pub struct Go2Body {
+    joints: JointModel,
+    command: Option<LowCmd>,
+    command_age_s: f32,
+    /// Motors that failed: they report mode 0, produce no torque, count lost frames.
+    faulted: [bool; JOINTS],
+    lost: [u32; JOINTS],
+    tick_ms: u32,
+    elapsed_s: f64,
+}
+
+impl Default for Go2Body {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Go2Body {
+    /// Lying, at rest, motors passive.
+    pub fn new() -> Self {
+        let mut joints = JointModel::at([LYING_POSE_RAD[0], LYING_POSE_RAD[1], LYING_POSE_RAD[2]]);
+        for (motor, q) in LYING_POSE_RAD.iter().enumerate() {
+            joints.q_rad[motor / 3][motor % 3] = *q;
+        }
+        Self {
+            joints,
+            command: None,
+            command_age_s: 0.0,
+            faulted: [false; JOINTS],
+            lost: [0; JOINTS],
+            tick_ms: 0,
+            elapsed_s: 0.0,
+        }
+    }
+
+    /// A LowCmd the robot accepted: the motors follow it.
+    pub fn command(&mut self, command: &LowCmd) {
+        self.command = Some(*command);
+        self.command_age_s = 0.0;
+    }
+
+    /// Fault: motor `motor` fails (or recovers).
+    pub fn set_motor_fault(&mut self, motor: usize, faulted: bool) {
+        if let Some(f) = self.faulted.get_mut(motor) {
+            *f = faulted;
+        }
+    }
+
+    /// Joint positions, rad, in motor order.
+    pub fn joint_positions(&self) -> [f32; JOINTS] {
+        core::array::from_fn(|m| self.joints.q_rad[m / 3][m % 3])
+    }
+
+    /// Advances the body by `dt_s` seconds.
+    pub fn step(&mut self, dt_s: f32) {
+        self.command_age_s += dt_s;
+        self.elapsed_s += f64::from(dt_s);
+        self.tick_ms = (self.elapsed_s * 1e3) as u32;
+        let active = self.command.filter(|_| self.command_age_s <= COMMAND_HOLD_S);
+        let faulted = self.faulted;
+        self.joints.step(dt_s, |leg, joint| {
+            let motor = leg * 3 + joint;
+            match active {
+                Some(cmd) if joint < 3 && !faulted[motor] => {
+                    let m = &cmd.motor_cmd[motor];
+                    let (kp, kd) = (m.kp.get(), m.kd.get());
+                    PdTarget {
+                        // A term without its gain contributes nothing, sentinel or not.
+                        q_rad: if kp == 0.0 { 0.0 } else { m.q.get() },
+                        qd_radps: if kd == 0.0 { 0.0 } else { m.dq.get() },
+                        kp,
+                        kd,
+                        tau_ff_nm: m.tau.get(),
+                    }
+                }
+                _ => PdTarget::default(),
+            }
+        });
+        for (motor, faulted) in self.faulted.iter().enumerate() {
+            if *faulted {
+                self.lost[motor] = self.lost[motor].wrapping_add(1);
+            }
+        }
+    }
+
+    /// The state the robot reports now (the CRC is written by the encoder).
+    pub fn low_state(&self) -> LowState {
+        let mut state = LowState::default();
+        state.head = lowcmd_proto::go2::HEAD;
+        state.imu_state.quaternion = [1.0, 0.0, 0.0, 0.0].map(Into::into);
+        state.imu_state.accelerometer = [0.0, 0.0, 9.81].map(Into::into);
+        state.imu_state.temperature = 40;
+        let mut total_torque = 0.0;
+        for motor in 0..JOINTS {
+            let (leg, joint) = (motor / 3, motor % 3);
+            let s = &mut state.motor_state[motor];
+            let tau = self.joints.tau_nm[leg][joint];
+            s.mode = u8::from(!self.faulted[motor]);
+            s.q = self.joints.q_rad[leg][joint].into();
+            s.dq = self.joints.qd_radps[leg][joint].into();
+            s.tau_est = tau.into();
+            s.q_raw = s.q;
+            s.dq_raw = s.dq;
+            s.temperature = 30 + (tau.abs() / 3.0) as u8;
+            s.lost = self.lost[motor].into();
+            total_torque += tau.abs();
+        }
+        for leg in 0..4 {
+            // Raw foot force: the calf's load, in the robot's raw units (about 10 per N·m).
+            let calf = self.joints.tau_nm[leg][2].abs();
+            let force = (calf * 10.0).clamp(0.0, f32::from(i16::MAX)) as i16;
+            state.foot_force[leg] = force.into();
+            state.foot_force_est[leg] = force.into();
+        }
+        state.bms_state.soc = 90;
+        state.bms_state.current = (-2000 - (total_torque * 50.0) as i32).into();
+        state.bms_state.cell_vol = [3600u16; 15].map(Into::into);
+        state.power_v = 28.8.into();
+        state.power_a = (2.0 + total_torque * 0.05).into();
+        state.tick = self.tick_ms.into();
+        state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lowcmd_proto::go2::MotorCmd;
+
+    fn stand() -> LowCmd {
+        let mut cmd = LowCmd::default();
+        for (motor, m) in cmd.motor_cmd.iter_mut().take(JOINTS).enumerate() {
+            *m = MotorCmd::servo(STAND_POSE_RAD[motor % 3], 0.0, 60.0, 5.0, 0.0);
+        }
+        cmd
+    }
+
+    #[test]
+    fn the_stand_command_stands_and_damping_stops_the_joints() {
+        let mut body = Go2Body::new();
+        assert_eq!(body.joint_positions(), LYING_POSE_RAD);
+        for _ in 0..1000 {
+            body.command(&stand());
+            body.step(0.002);
+        }
+        let q = body.joint_positions();
+        assert!(q.iter().enumerate().all(|(m, q)| (q - STAND_POSE_RAD[m % 3]).abs() < 0.01), "{q:?}");
+        let state = body.low_state();
+        assert_eq!(state.tick.get(), 2000);
+        assert_eq!(state.motor_state[2].mode, 1);
+        // The vendor's "hold nothing" command (PosStopF, VelStopF, no gains) exerts no torque.
+        body.command(&LowCmd::default());
+        body.step(0.002);
+        assert!(body.low_state().motor_state[..JOINTS].iter().all(|m| m.tau_est.get() == 0.0));
+        body.set_motor_fault(4, true);
+        body.step(0.002);
+        let state = body.low_state();
+        assert_eq!((state.motor_state[4].mode, state.motor_state[4].lost.get()), (0, 1));
+    }
+}

@@ -1,0 +1,93 @@
+//! The simulator's services thread: a small tokio runtime reading `rt/lowcmd` and answering
+//! `motion_switcher` and `sport` requests like the robot.
+
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use lowcmd_proto::api::{self, ApiRequest, motion_switcher, sport, status};
+use robowire_dds::rpc::RpcServer;
+use tokio::sync::watch;
+
+use super::{LowCmdReader, Shared, Stats, lock, on_lowcmd};
+
+/// Runs until `stop` says so.
+pub(super) fn run(
+    shared: Arc<Mutex<Shared>>,
+    stats: Arc<Stats>,
+    mut reader: LowCmdReader,
+    switcher: RpcServer,
+    sport: RpcServer,
+    period: Duration,
+    mut stop: watch::Receiver<bool>,
+) {
+    let Ok(runtime) = tokio::runtime::Builder::new_current_thread().enable_all().build() else {
+        lock(&shared).say("cannot start the services' runtime; the simulator answers nothing");
+        return;
+    };
+    runtime.block_on(async {
+        let commands = async {
+            while let Ok(sample) = reader.recv().await {
+                on_lowcmd(&shared, &stats, period, &sample.value, robowire_rt::now());
+            }
+        };
+        tokio::select! {
+            _ = stop.changed() => {}
+            () = commands => {}
+            () = serve(switcher, &shared, &stats, answer_motion_switcher) => {}
+            () = serve(sport, &shared, &stats, answer_sport) => {}
+        }
+    });
+}
+
+/// Answers every request of one service with `answer`.
+async fn serve(
+    mut server: RpcServer,
+    shared: &Mutex<Shared>,
+    stats: &Stats,
+    answer: fn(&mut Shared, &ApiRequest) -> (i32, String),
+) {
+    while let Ok(request) = server.next_request().await {
+        let (code, data) = answer(&mut lock(shared), &request);
+        stats.requests.add(1);
+        // A lost answer: the client writes its request again.
+        let _ = server.answer(&request.header, code, &data);
+    }
+}
+
+fn answer_motion_switcher(s: &mut Shared, request: &ApiRequest) -> (i32, String) {
+    match request.header.api_id {
+        api::API_VERSION_ID => (status::OK, motion_switcher::API_VERSION.into()),
+        motion_switcher::CHECK_MODE => (status::OK, motion_switcher::check_mode_data(&s.sport_mode).to_string()),
+        motion_switcher::SELECT_MODE => match motion_switcher::mode_name(&request.parameter).map(str::to_owned) {
+            Some(name) => {
+                s.say(format!("SelectMode: sport mode \"{name}\" owns the motors"));
+                s.sport_mode = name;
+                s.ignore_logged = false;
+                (status::OK, String::new())
+            }
+            None => (status::SERVER_API_PARAMETER, String::new()),
+        },
+        motion_switcher::RELEASE_MODE => {
+            if !s.sport_mode.is_empty() {
+                s.say(format!("ReleaseMode: sport mode \"{}\" released; LowCmds now drive the motors", s.sport_mode));
+            }
+            s.sport_mode.clear();
+            (status::OK, String::new())
+        }
+        motion_switcher::SET_SILENT => (status::OK, String::new()),
+        motion_switcher::GET_SILENT => (status::OK, r#"{"silent":false}"#.into()),
+        _ => (status::SERVER_API_NOT_IMPLEMENTED, String::new()),
+    }
+}
+
+fn answer_sport(s: &mut Shared, request: &ApiRequest) -> (i32, String) {
+    match request.header.api_id {
+        api::API_VERSION_ID => (status::OK, sport::API_VERSION.into()),
+        sport::STAND_DOWN => {
+            s.say("sport StandDown: lying down");
+            (status::OK, String::new())
+        }
+        sport::DAMP | sport::BALANCE_STAND | sport::STOP_MOVE | sport::STAND_UP => (status::OK, String::new()),
+        _ => (status::SERVER_API_NOT_IMPLEMENTED, String::new()),
+    }
+}
