@@ -10,7 +10,7 @@ use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, Subscriber
 use crate::DdsError;
 use crate::adapter::CdrAdapter;
 use crate::qos::Qos;
-use crate::topic::{Reader, Writer};
+use crate::topic::{RawSample, Reader, Writer};
 
 /// Where a participant lives.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -89,15 +89,15 @@ impl Participant {
         &self.options
     }
 
-    fn topic<T: CdrType>(&self, name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
+    fn topic(&self, name: &str, type_name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
         self.inner
-            .create_topic(name.into(), T::TYPE_NAME.into(), &qos.policies(), TopicKind::NoKey)
+            .create_topic(name.into(), type_name.into(), &qos.policies(), TopicKind::NoKey)
             .map_err(|e| DdsError::Create { what, topic: name.into(), reason: e.to_string() })
     }
 
     /// A writer of `T` on topic `name`.
     pub fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
-        let topic = self.topic::<T>(name, qos, "writer")?;
+        let topic = self.topic(name, T::TYPE_NAME, qos, "writer")?;
         let inner = self
             .publisher
             .create_datawriter_no_key::<T, CdrAdapter<T>>(&topic, Some(qos.policies()))
@@ -107,7 +107,22 @@ impl Participant {
 
     /// A reader of `T` on topic `name`. It yields samples from a tokio task (any executor).
     pub fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
-        let topic = self.topic::<T>(name, qos, "reader")?;
+        self.reader_of_type(name, T::TYPE_NAME, qos)
+    }
+
+    /// A reader of topic `name` whose samples are kept as bytes ([`RawSample`]), for a type known
+    /// only by the name other participants announce (an inspector).
+    pub fn raw_reader(&self, name: &str, type_name: &str, qos: Qos) -> Result<Reader<RawSample>, DdsError> {
+        self.reader_of_type(name, type_name, qos)
+    }
+
+    fn reader_of_type<T: CdrType + 'static>(
+        &self,
+        name: &str,
+        type_name: &str,
+        qos: Qos,
+    ) -> Result<Reader<T>, DdsError> {
+        let topic = self.topic(name, type_name, qos, "reader")?;
         let inner = self
             .subscriber
             .create_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))

@@ -195,3 +195,29 @@ impl<T: CdrType + 'static> Reader<T> {
         StatsHandle(self.counters.clone())
     }
 }
+
+/// A sample of a type robowire has no codec for: its representation and its CDR body.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RawSample {
+    /// The representation the writer used.
+    pub encoding: robowire_core::cdr::CdrEncoding,
+    /// The body (after the 4-byte encapsulation header).
+    pub body: Vec<u8>,
+}
+
+impl CdrType for RawSample {
+    /// Not used: a raw reader's topic takes the type name it is given.
+    const TYPE_NAME: &'static str = "";
+    type Error = core::convert::Infallible;
+    fn body_len(&self) -> usize {
+        self.body.len()
+    }
+    fn encode_body(&self, out: &mut [u8]) -> Result<usize, robowire_core::BufferTooSmall> {
+        let (needed, available) = (self.body.len(), out.len());
+        out.get_mut(..needed).ok_or(robowire_core::BufferTooSmall { needed, available })?.copy_from_slice(&self.body);
+        Ok(needed)
+    }
+    fn decode_body(encoding: robowire_core::cdr::CdrEncoding, body: &[u8]) -> Result<Self, Self::Error> {
+        Ok(Self { encoding, body: body.to_vec() })
+    }
+}

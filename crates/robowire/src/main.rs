@@ -27,6 +27,10 @@ enum Command {
     Kmc(cmd::kmc::KmcArgs),
     /// Drive a ZsiBot ZSL-1 / ZSL-1W over UDP (HighLevel: stand, walk, tricks, status).
     Dog(cmd::dog::DogArgs),
+    /// Drive a Unitree Go2's low-level interface over DDS (status, watch, release, stand, damp).
+    Go2(cmd::go2::Go2Args),
+    /// Inspect DDS: the topics on the network, the samples of one.
+    Dds(cmd::dds::DdsCommandArgs),
     /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
     #[command(subcommand)]
     Shm(cmd::shm::ShmCommand),
@@ -48,6 +52,8 @@ fn main() -> ExitCode {
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),
+        Command::Go2(args) => cmd::go2::run(args),
+        Command::Dds(args) => cmd::dds::run(args),
         Command::Shm(command) => cmd::shm::run(&command),
         Command::Decode(command) => cmd::decode::run(&command),
         Command::Encode(command) => cmd::encode::run(&command),

@@ -31,7 +31,6 @@ pub struct Go2Body {
     faulted: [bool; JOINTS],
     lost: [u32; JOINTS],
     tick_ms: u32,
-    elapsed_s: f64,
 }
 
 impl Default for Go2Body {
@@ -47,15 +46,7 @@ impl Go2Body {
         for (motor, q) in LYING_POSE_RAD.iter().enumerate() {
             joints.q_rad[motor / 3][motor % 3] = *q;
         }
-        Self {
-            joints,
-            command: None,
-            command_age_s: 0.0,
-            faulted: [false; JOINTS],
-            lost: [0; JOINTS],
-            tick_ms: 0,
-            elapsed_s: 0.0,
-        }
+        Self { joints, command: None, command_age_s: 0.0, faulted: [false; JOINTS], lost: [0; JOINTS], tick_ms: 0 }
     }
 
     /// A LowCmd the robot accepted: the motors follow it.
@@ -79,8 +70,8 @@ impl Go2Body {
     /// Advances the body by `dt_s` seconds.
     pub fn step(&mut self, dt_s: f32) {
         self.command_age_s += dt_s;
-        self.elapsed_s += f64::from(dt_s);
-        self.tick_ms = (self.elapsed_s * 1e3) as u32;
+        // The tick counts milliseconds of model time: 2 per state at 500 Hz, more after a stall.
+        self.tick_ms = self.tick_ms.wrapping_add((dt_s * 1e3).round() as u32);
         let active = self.command.filter(|_| self.command_age_s <= COMMAND_HOLD_S);
         let faulted = self.faulted;
         self.joints.step(dt_s, |leg, joint| {

@@ -16,6 +16,18 @@ pub(crate) enum SimCommand {
     Spline(SplineSimArgs),
     /// A ZSL-1 / ZSL-1W dog on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
     Dog(DogSimArgs),
+    /// A Unitree Go2 on DDS (rt/lowcmd, rt/lowstate at 500 Hz, motion_switcher and sport), booted
+    /// with its sport mode owning the motors, as Unitree's software expects.
+    Go2(Go2SimArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct Go2SimArgs {
+    #[command(flatten)]
+    dds: crate::cmd::go2::DdsArgs,
+    /// Print the simulator's state every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
 }
 
 #[derive(Debug, Args)]
@@ -78,6 +90,7 @@ pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
         SimCommand::Kmc(args) => run_kmc(&args),
         SimCommand::Spline(args) => run_spline(&args),
         SimCommand::Dog(args) => run_dog(&args),
+        SimCommand::Go2(args) => run_go2(&args),
     }
 }
 
@@ -204,5 +217,53 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
             s.low_level.states_sent
         );
     })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
+    use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+    let config = Go2SimConfig { participant: args.dds.participant(), ..Go2SimConfig::default() };
+    let sim = Go2Sim::spawn(config).context("starting the Go2 simulator")?;
+    let interface = args.dds.interface.as_deref().unwrap_or("the default interface");
+    // The first line, alone, for scripts.
+    println!("go2 domain {} {interface}", args.dds.domain);
+    eprintln!(
+        "Go2 simulator on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, motion_switcher and sport. \
+         Try: robowire go2 --domain {} status. Ctrl-C stops.",
+        args.dds.domain, args.dds.domain
+    );
+    let print_log = |sim: &Go2Sim| {
+        for line in sim.take_log() {
+            println!("{line}");
+        }
+    };
+    print_log(&sim);
+    let every_s = args.report_every_s;
+    let mut last_report = std::time::Instant::now();
+    until_ctrl_c(0.1, || {
+        print_log(&sim);
+        if every_s.is_finite() && every_s > 0.0 && last_report.elapsed().as_secs_f64() >= every_s {
+            last_report = std::time::Instant::now();
+            let s = sim.snapshot();
+            let q: Vec<String> = s.joints_rad.iter().map(|q| format!("{q:+.2}")).collect();
+            eprintln!(
+                "sport mode {:?} | q {} | lowcmd accepted {} ignored {} bad CRC {} bad head {} | lowstate {} | requests {}",
+                s.sport_mode,
+                q.join(" "),
+                s.lowcmd.accepted,
+                s.lowcmd.ignored_sport_mode,
+                s.lowcmd.bad_crc,
+                s.lowcmd.bad_head,
+                s.lowstate.samples,
+                s.requests
+            );
+        }
+    })?;
+    print_log(&sim);
+    let s = sim.snapshot();
+    println!(
+        "lowcmd accepted {} ignored {} bad CRC {} bad head {}; final q {:?}",
+        s.lowcmd.accepted, s.lowcmd.ignored_sport_mode, s.lowcmd.bad_crc, s.lowcmd.bad_head, s.joints_rad
+    );
     Ok(ExitCode::SUCCESS)
 }

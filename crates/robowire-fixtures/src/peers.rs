@@ -1,0 +1,124 @@
+//! The vendors' own software as the other end of the wire in interop tests
+//! (`../shared/peers/`, see its README): a CPython 3.10 environment with `cyclonedds` 0.10.2
+//! (Unitree's pin; its wheel bundles libddsc), numpy, and Unitree's Python SDK installed as its
+//! README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
+//! tree stays untouched).
+//!
+//! Made once per `target/` directory, under a file lock (tests run in parallel), and reused. A
+//! test that needs it fails with the reason when it cannot be made (no CPython 3.10, no
+//! network on the first run): an interop test that skips is a test that cannot fail.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// `cyclonedds` on PyPI: the version Unitree's SDK pins.
+pub const CYCLONEDDS_VERSION: &str = "0.10.2";
+
+/// The workspace root.
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The vendors' software: `$ROBOWIRE_PEERS`, else `../shared/peers` beside the workspace.
+pub fn peers_dir() -> PathBuf {
+    std::env::var_os("ROBOWIRE_PEERS").map_or_else(|| workspace().join("../shared/peers"), PathBuf::from)
+}
+
+/// Where the environment lives: `$CARGO_TARGET_DIR` (or `target/`)`/interop/py310`.
+fn env_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| workspace().join("target"), PathBuf::from);
+    target.join("interop")
+}
+
+/// A CPython 3.10 interpreter: `$ROBOWIRE_PYTHON310`, pyenv's newest 3.10, or `python3.10`.
+fn python310() -> Result<PathBuf, String> {
+    if let Some(path) = std::env::var_os("ROBOWIRE_PYTHON310") {
+        return Ok(path.into());
+    }
+    let pyenv_root = std::env::var_os("PYENV_ROOT")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".pyenv")));
+    if let Some(root) = pyenv_root
+        && let Ok(versions) = std::fs::read_dir(root.join("versions"))
+    {
+        let mut found: Vec<PathBuf> = versions
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("3.10.")))
+            .map(|p| p.join("bin/python3.10"))
+            .filter(|p| p.exists())
+            .collect();
+        found.sort();
+        if let Some(newest) = found.pop() {
+            return Ok(newest);
+        }
+    }
+    let on_path = Command::new("python3.10").arg("--version").output();
+    if on_path.is_ok_and(|o| o.status.success()) {
+        return Ok("python3.10".into());
+    }
+    Err("no CPython 3.10 (cyclonedds 0.10.2 has wheels for 3.10 only): install one with pyenv, or set \
+         ROBOWIRE_PYTHON310"
+        .into())
+}
+
+fn run(what: &str, command: &mut Command) -> Result<(), String> {
+    let out = command.output().map_err(|e| format!("{what}: {e}"))?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(format!("{what} failed ({}): {}", out.status, String::from_utf8_lossy(&out.stderr).trim()))
+    }
+}
+
+fn copy_tree(from: &Path, to: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let entry = entry?;
+        let target = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            copy_tree(&entry.path(), &target)?;
+        } else {
+            std::fs::copy(entry.path(), target)?;
+        }
+    }
+    Ok(())
+}
+
+/// The Python of the environment (made on first use); see the [module](self).
+pub fn unitree_python() -> Result<PathBuf, String> {
+    let dir = env_dir();
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let lock = std::fs::File::create(dir.join(".lock")).map_err(|e| e.to_string())?;
+    lock.lock().map_err(|e| format!("locking {}: {e}", dir.display()))?;
+    let venv = dir.join("py310");
+    let python = venv.join("bin/python");
+    let stamp = venv.join(".robowire-ready");
+    if stamp.exists() {
+        return Ok(python);
+    }
+    let sdk = peers_dir().join("unitree_sdk2_python");
+    if !sdk.join("setup.py").exists() {
+        return Err(format!("Unitree's Python SDK is not at {} (set ROBOWIRE_PEERS)", sdk.display()));
+    }
+    let _ = std::fs::remove_dir_all(&venv);
+    run("creating the venv", Command::new(python310()?).args(["-m", "venv"]).arg(&venv))?;
+    let pip = |args: &[&str]| {
+        let mut c = Command::new(&python);
+        c.args(["-m", "pip", "install", "-q", "--disable-pip-version-check"]).args(args);
+        c
+    };
+    run("pip install cyclonedds numpy", &mut pip(&[&format!("cyclonedds=={CYCLONEDDS_VERSION}"), "numpy"]))?;
+    let copy = dir.join("unitree_sdk2_python");
+    let _ = std::fs::remove_dir_all(&copy);
+    copy_tree(&sdk, &copy).map_err(|e| format!("copying the SDK: {e}"))?;
+    run("pip install the SDK", pip(&["--no-deps", "-e"]).arg(&copy))?;
+    std::fs::write(&stamp, b"").map_err(|e| e.to_string())?;
+    Ok(python)
+}
+
+/// Unitree's Go2 low-level examples (in the environment's copy of the SDK).
+pub fn unitree_go2_examples() -> Result<PathBuf, String> {
+    unitree_python()?;
+    Ok(env_dir().join("unitree_sdk2_python/example/go2/low_level"))
+}

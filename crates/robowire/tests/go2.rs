@@ -1,0 +1,137 @@
+//! `robowire sim go2` driven by Unitree's own software: the Go2 low-level stand example of
+//! `unitree_sdk2_python`, unchanged, on CycloneDDS (see `robowire_fixtures::peers`); and
+//! `robowire go2 …` against the same simulator. Each in a private network namespace (root).
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Child, Command, Stdio};
+
+use robowire_dds::netns::in_loopback_namespace;
+
+fn robowire() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+/// `robowire sim go2 --interface lo`, started and waited for.
+struct Sim(Child);
+
+impl Sim {
+    fn start() -> Self {
+        let mut child = robowire()
+            .args(["sim", "go2", "--interface", "lo", "--report-every-s", "0"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(child.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
+        assert!(first.starts_with("go2 domain 0 lo"), "{first}");
+        Self(child)
+    }
+
+    /// Ctrl-C, then everything it printed after its first line.
+    fn stop(mut self) -> String {
+        rustix::process::kill_process(rustix::process::Pid::from_child(&self.0), rustix::process::Signal::INT).unwrap();
+        let mut rest = String::new();
+        self.0.stdout.take().unwrap().read_to_string(&mut rest).unwrap();
+        assert!(self.0.wait().unwrap().success());
+        rest
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
+    let python = robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"));
+    let examples = robowire_fixtures::peers::unitree_go2_examples().unwrap();
+    in_loopback_namespace(|| {
+        let sim = Sim::start();
+        let mut example = Command::new(&python)
+            .arg("go2_stand_example.py")
+            .arg("lo")
+            .current_dir(&examples)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // "Press Enter to continue..."
+        example.stdin.take().unwrap().write_all(b"\n").unwrap();
+        let out = example.wait_with_output().unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        // The example ends with sys.exit(-1) after printing "Done!".
+        assert!(stdout.contains("Done!"), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+        let log = sim.stop();
+        assert!(log.contains("ReleaseMode: sport mode \"normal\" released"), "{log}");
+        let last = log.lines().last().unwrap_or_default();
+        let accepted: u64 = last.split_whitespace().nth(2).and_then(|n| n.parse().ok()).unwrap_or(0);
+        assert!(accepted > 2000, "the example's 500 Hz LowCmds were accepted: {last}");
+        assert!(last.contains("bad CRC 0 bad head 0"), "every LowCmd had Unitree's CRC: {last}");
+        // Its last phase moves the legs to the wide pose: hips ±0.35 front, ±0.5 rear.
+        let q: Vec<f32> = last
+            .split('[')
+            .nth(1)
+            .and_then(|s| s.split(']').next())
+            .map(|s| s.split(", ").filter_map(|v| v.parse().ok()).collect())
+            .unwrap_or_default();
+        let wide = [-0.35, 1.36, -2.65, 0.35, 1.36, -2.65, -0.5, 1.36, -2.65, 0.5, 1.36, -2.65];
+        assert_eq!(q.len(), 12, "{last}");
+        assert!(q.iter().zip(wide).all(|(q, w)| (q - w).abs() < 0.05), "final joints {q:?}");
+    })
+    .expect("a private network namespace (run as root)");
+}
+
+#[test]
+fn robowire_go2_status_release_stand_and_the_dds_inspector() {
+    in_loopback_namespace(|| {
+        let sim = Sim::start();
+        let go2 = |args: &[&str]| robowire().args(["go2", "--interface", "lo"]).args(args).output().unwrap();
+        let status = go2(&["status", "--json"]);
+        assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+        assert_eq!(json["motor_state"][2]["q"], -2.65, "lying: {json}");
+        assert_eq!(json["head"], serde_json::json!([254, 239]));
+
+        let stand = go2(&["stand", "--duration", "0.5", "--hold", "0.5"]);
+        let text = String::from_utf8_lossy(&stand.stdout);
+        assert!(stand.status.success(), "{text}{}", String::from_utf8_lossy(&stand.stderr));
+        assert!(text.contains("sport mode released (1 ReleaseMode call)"), "{text}");
+        assert!(text.contains("held the stand pose") && text.contains("damped; done"), "{text}");
+        let release = go2(&["release"]);
+        assert!(String::from_utf8_lossy(&release.stdout).contains("no sport mode owns the motors"));
+
+        let topics = robowire().args(["dds", "--interface", "lo", "topics", "--wait", "1"]).output().unwrap();
+        let topics = String::from_utf8_lossy(&topics.stdout);
+        assert!(topics.contains("rt/lowstate") && topics.contains("unitree_go::msg::dds_::LowState_"), "{topics}");
+        assert!(topics.contains("rt/api/motion_switcher/request"), "{topics}");
+        let echo =
+            robowire().args(["dds", "--interface", "lo", "echo", "rt/lowstate", "--count", "2"]).output().unwrap();
+        let echo = String::from_utf8_lossy(&echo.stdout);
+        assert_eq!(echo.lines().count(), 2, "{echo}");
+        assert!(echo.lines().all(|l| serde_json::from_str::<serde_json::Value>(l).is_ok_and(|v| v["tick"].is_u64())));
+
+        let log = sim.stop();
+        assert!(log.contains("sport StandDown") && log.contains("ReleaseMode"), "{log}");
+    })
+    .expect("a private network namespace (run as root)");
+}
+
+#[test]
+fn no_robot_on_the_network_is_a_clear_error() {
+    in_loopback_namespace(|| {
+        let out =
+            robowire().args(["go2", "--interface", "lo", "--connect-timeout-s", "0.5", "status"]).output().unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("no rt/lowstate within 0.5 s on domain 0 (interface lo)"), "{err}");
+        let bad = robowire().args(["go2", "--interface", "no-such-if0", "status"]).output().unwrap();
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert!(err.contains("no network interface \"no-such-if0\""), "{err}");
+    })
+    .expect("a private network namespace (run as root)");
+}
