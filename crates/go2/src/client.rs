@@ -364,11 +364,12 @@ async fn receive<R: Robot>(mut reader: Reader<R::State>, state: Arc<StateShared<
                 let (lost, late) = ticks.on(R::tick(&sample.value));
                 state.lost_by_tick.add(lost);
                 state.late_by_tick.add(late);
-                state.latest.send_replace(Some((Instant::now(), sample.value)));
+                // The connection first: whoever wakes on the state sees it connected.
                 if watchdog.feed(now).is_some() {
                     state.reconnects.set(watchdog.counters().reconnects);
                     state.connection.send_replace(watchdog.connection());
                 }
+                state.latest.send_replace(Some((Instant::now(), sample.value)));
             }
             () = timeout => {
                 if watchdog.poll_event(robowire_rt::now()).is_some() {

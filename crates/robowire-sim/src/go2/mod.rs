@@ -6,6 +6,8 @@
 //! 500 Hz on robowire's runner with a correct CRC; LowCmds with a bad CRC or a wrong head are
 //! dropped and counted; the 12 joints follow accepted LowCmds through the shared PD joint model
 //! ([`Go2Body`]), starting lying down. Faults: silence, a motor fault, bit flips on the wire.
+//! Unlike a real Go2, its LowState's `reserve` echoes the last accepted LowCmd's `reserve`, and
+//! it can answer each LowCmd at once ([`Go2SimConfig::answer_lowcmd`]): for round trips.
 //!
 //! Everything runs on `robowire-dds` (the transport), never on a facade. Create it inside a
 //! network namespace whose loopback has multicast when testing on one machine
@@ -45,11 +47,19 @@ pub struct Go2SimConfig {
     pub state_period: Duration,
     /// Pin the simulator's state stream to this CPU.
     pub cpu: Option<usize>,
+    /// Answer every accepted LowCmd with a LowState at once, besides the 500 Hz stream (for
+    /// round-trip measurements; a real Go2 only streams).
+    pub answer_lowcmd: bool,
 }
 
 impl Default for Go2SimConfig {
     fn default() -> Self {
-        Self { participant: ParticipantOptions::default(), state_period: Duration::from_millis(2), cpu: None }
+        Self {
+            participant: ParticipantOptions::default(),
+            state_period: Duration::from_millis(2),
+            cpu: None,
+            answer_lowcmd: false,
+        }
     }
 }
 
@@ -191,6 +201,8 @@ impl Go2Sim {
         let lowstate = writer.stats_handle();
         let reader = participant.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER)?;
         let lowcmd = reader.stats_handle();
+        let answers =
+            config.answer_lowcmd.then(|| participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)).transpose()?;
         let switcher = RpcServer::new(&participant, motion_switcher::SERVICE)?;
         let sport = RpcServer::new(&participant, sport::SERVICE)?;
         let (stop, stop_rx) = watch::channel(false);
@@ -198,7 +210,8 @@ impl Go2Sim {
             .name("go2-sim-services".into())
             .spawn({
                 let (shared, stats, period) = (shared.clone(), stats.clone(), config.state_period);
-                move || services::run(shared, stats, reader, switcher, sport, period, stop_rx)
+                let endpoints = services::Endpoints { lowcmd: reader, answers, switcher, sport };
+                move || services::run(shared, stats, endpoints, period, stop_rx)
             })
             .map_err(Go2SimError::Services)?;
         let job = StateStream {
@@ -207,6 +220,7 @@ impl Go2Sim {
             writer,
             corrupt,
             grid: Periodic::new(robowire_rt::now(), config.state_period),
+            period_ms: u32::try_from(config.state_period.as_millis()).unwrap_or(u32::MAX).max(1),
             last_step: None,
             sent: AtomicU32::new(0),
         };
@@ -301,8 +315,10 @@ impl CdrType for BitFlipped {
     }
     fn encode_body(&self, out: &mut [u8]) -> Result<usize, robowire_core::BufferTooSmall> {
         let n = self.state.encode_body(out)?;
-        // A bit among the motor states (body 80..1036), never the header.
-        let bit = 80 * 8 + self.bit % ((1036 - 80) * 8);
+        // A bit of one of the 12 joints' `q` (XCDR1 body offset 80 + 48·i, spec §6.3): data,
+        // never alignment padding (which a decoder rightly ignores).
+        let motor = self.bit % 12;
+        let bit = (80 + 48 * motor) * 8 + (self.bit / 12) % 32;
         out[bit / 8] ^= 1 << (bit % 8);
         Ok(n)
     }
@@ -318,6 +334,8 @@ struct StateStream {
     writer: Writer<LowState>,
     corrupt: Writer<BitFlipped>,
     grid: Periodic,
+    /// The tick's step per slot, ms.
+    period_ms: u32,
     last_step: Option<Time>,
     sent: AtomicU32,
 }
@@ -337,6 +355,8 @@ impl Job for StateStream {
         let (state, silent, flip_every) = {
             let mut s = lock(&self.shared);
             s.body.step(dt.min(MAX_STEP_S));
+            let slots = u32::try_from(tick.skipped + 1).unwrap_or(u32::MAX);
+            s.body.advance_tick(self.period_ms.saturating_mul(slots));
             (s.body.low_state(), s.silent, s.bit_flip_every)
         };
         if silent {
@@ -358,12 +378,12 @@ fn head_ok(cmd: &LowCmd) -> bool {
     cmd.head == go2::HEAD && cmd.level_flag == go2::LEVEL_LOW
 }
 
-/// Applies one decoded LowCmd (arrived at `now`).
-fn on_lowcmd(shared: &Mutex<Shared>, stats: &Stats, period: Duration, cmd: &LowCmd, now: Time) {
+/// Applies one decoded LowCmd (arrived at `now`); the state right after it, if accepted.
+fn on_lowcmd(shared: &Mutex<Shared>, stats: &Stats, period: Duration, cmd: &LowCmd, now: Time) -> Option<LowState> {
     let mut s = lock(shared);
     if !head_ok(cmd) {
         stats.bad_head.add(1);
-        return;
+        return None;
     }
     if !s.sport_mode.is_empty() {
         stats.ignored.add(1);
@@ -375,13 +395,14 @@ fn on_lowcmd(shared: &Mutex<Shared>, stats: &Stats, period: Duration, cmd: &LowC
                  further ones are counted"
             ));
         }
-        return;
+        return None;
     }
     stats.accepted.add(1);
     if let Some(last) = s.last_command.replace(now) {
         stats.jitter.record(micros(now.saturating_duration_since(last).abs_diff(period)));
     }
     s.body.command(cmd);
+    Some(s.body.low_state())
 }
 
 /// `Reader<LowCmd>` for the services module.

@@ -67,11 +67,15 @@ impl Go2Body {
         core::array::from_fn(|m| self.joints.q_rad[m / 3][m % 3])
     }
 
+    /// Advances the `tick` counter by `ms` (the state stream: its period per slot, skipped slots
+    /// included, so that a receiver sees a fixed step and counts what it missed).
+    pub fn advance_tick(&mut self, ms: u32) {
+        self.tick_ms = self.tick_ms.wrapping_add(ms);
+    }
+
     /// Advances the body by `dt_s` seconds.
     pub fn step(&mut self, dt_s: f32) {
         self.command_age_s += dt_s;
-        // The tick counts milliseconds of model time: 2 per state at 500 Hz, more after a stall.
-        self.tick_ms = self.tick_ms.wrapping_add((dt_s * 1e3).round() as u32);
         let active = self.command.filter(|_| self.command_age_s <= COMMAND_HOLD_S);
         let faulted = self.faulted;
         self.joints.step(dt_s, |leg, joint| {
@@ -134,6 +138,9 @@ impl Go2Body {
         state.power_v = 28.8.into();
         state.power_a = (2.0 + total_torque * 0.05).into();
         state.tick = self.tick_ms.into();
+        // robowire's simulator only: the last accepted LowCmd's `reserve` word, echoed, so that a
+        // client can match a state to a command (round trips). A real Go2 leaves it 0.
+        state.reserve = self.command.map_or(0, |c| c.reserve.get()).into();
         state
     }
 }
@@ -158,6 +165,7 @@ mod tests {
         for _ in 0..1000 {
             body.command(&stand());
             body.step(0.002);
+            body.advance_tick(2);
         }
         let q = body.joint_positions();
         assert!(q.iter().enumerate().all(|(m, q)| (q - STAND_POSE_RAD[m % 3]).abs() < 0.01), "{q:?}");

@@ -4,22 +4,32 @@
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use lowcmd_proto::LowState;
 use lowcmd_proto::api::{self, ApiRequest, motion_switcher, sport, status};
+use robowire_dds::Writer;
 use robowire_dds::rpc::RpcServer;
 use tokio::sync::watch;
 
 use super::{LowCmdReader, Shared, Stats, lock, on_lowcmd};
 
+/// The simulator's DDS endpoints the services thread owns.
+pub(super) struct Endpoints {
+    pub(super) lowcmd: LowCmdReader,
+    /// Immediate answers to LowCmds, if asked for.
+    pub(super) answers: Option<Writer<LowState>>,
+    pub(super) switcher: RpcServer,
+    pub(super) sport: RpcServer,
+}
+
 /// Runs until `stop` says so.
 pub(super) fn run(
     shared: Arc<Mutex<Shared>>,
     stats: Arc<Stats>,
-    mut reader: LowCmdReader,
-    switcher: RpcServer,
-    sport: RpcServer,
+    endpoints: Endpoints,
     period: Duration,
     mut stop: watch::Receiver<bool>,
 ) {
+    let Endpoints { lowcmd: mut reader, answers, switcher, sport } = endpoints;
     let Ok(runtime) = tokio::runtime::Builder::new_current_thread().enable_all().build() else {
         lock(&shared).say("cannot start the services' runtime; the simulator answers nothing");
         return;
@@ -27,7 +37,11 @@ pub(super) fn run(
     runtime.block_on(async {
         let commands = async {
             while let Ok(sample) = reader.recv().await {
-                on_lowcmd(&shared, &stats, period, &sample.value, robowire_rt::now());
+                let state = on_lowcmd(&shared, &stats, period, &sample.value, robowire_rt::now());
+                if let (Some(answers), Some(state)) = (&answers, state) {
+                    // A failed write is counted by the writer.
+                    let _ = answers.write(state);
+                }
             }
         };
         tokio::select! {

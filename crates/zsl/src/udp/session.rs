@@ -291,10 +291,11 @@ async fn receive<I: Wire>(session: Arc<Session<I>>, mut receiver: UdpReceiver<Co
                     if let Some(last) = last_state.replace(now) {
                         session.counters.gaps.record(micros(now.saturating_duration_since(last)));
                     }
-                    on_state(&session, &received, now);
+                    // The connection first: whoever wakes on the state sees it connected.
                     if event.is_some() {
                         on_connected(&session, &watchdog);
                     }
+                    on_state(&session, &received, now);
                 }
                 // Counted by the link; a datagram that does not decode does not feed the watchdog.
                 Err(UdpError::Decode(_)) => {}

@@ -1,132 +1,212 @@
-//! The LowCmd/LowState scenario: a 500 Hz loop on absolute deadlines (robowire's schedule, each
-//! wait finished the runner's way) that does what a Unitree
-//! low-level controller does each cycle: build a `LowCmd`, encode it (struct image with CRC, and
-//! the XCDR1 payload published on `rt/lowcmd`), decode and verify it as the robot would, answer
-//! with a `LowState` and verify that too. Every 50th image gets a flipped bit, which must be
-//! caught by the CRC.
+//! The Unitree scenario: a Go2 on DDS. The simulated Go2 and the `go2` client in one process,
+//! over real DDS participants on loopback (in a private network namespace when the loopback has
+//! no multicast): release the sport mode, stand up from lying, hold, with bit flips injected on
+//! `rt/lowstate` and caught by the CRC.
 
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::{CdrEncoding, DecodeError, LowCmd, LowState, Message, MotorCmd};
-use robowire_core::schedule::Periodic;
+use anyhow::Context;
+use go2::{Go2, LowCmd, LowLevel, LowLevelOptions, MotorCmd, STAND_POSE_RAD};
 use robowire_core::timing::LatenessRing;
-use robowire_rt::runner::{DEFAULT_SPIN, sleep_until};
-use robowire_rt::stats::micros;
+use robowire_dds::ParticipantOptions;
+use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
 
-const PERIOD: Duration = Duration::from_millis(2);
-const STAND_RAD: [f32; 3] = [0.0, 0.67, -1.3];
+const KP: f32 = 60.0;
+const KD: f32 = 5.0;
+/// Every this many LowStates one goes out with a flipped bit, during the fault phase.
+const FLIP_EVERY: u32 = 25;
 
 pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
-    out.line(format_args!("== Unitree LowCmd / LowState (encode, CDR, decode, verify at 500 Hz) =="));
-    let run_for = Duration::from_secs_f64(duration_s.max(1.0));
-    let mut lateness: LatenessRing<4096> = LatenessRing::new();
-    let mut work: LatenessRing<4096> = LatenessRing::new();
-    let (mut cycles, mut mismatches, mut corrupted, mut caught) = (0u64, 0u64, 0u64, 0u64);
-    let mut cdr = [0u8; 1200];
-    let mut progress = Progress::new("lowcmd", out);
-    let mut window_late_us = 0u32;
-    let start = Instant::now();
-    robowire_rt::set_fine_timer_slack();
-    let mut grid = Periodic::new(robowire_rt::now() + PERIOD, PERIOD);
-    while start.elapsed() < run_for {
-        sleep_until(grid.deadline(), DEFAULT_SPIN);
-        let woke = Instant::now();
-        let Some(tick) = grid.poll(robowire_rt::now()) else { continue };
-        let late_us = micros(tick.lateness);
-        lateness.record(late_us);
-        window_late_us = window_late_us.max(late_us);
+    out.line(format_args!("== Unitree Go2 over DDS (rt/lowcmd, rt/lowstate, motion_switcher; simulated Go2) =="));
+    if robowire_dds::netns::loopback_has_multicast() {
+        return scenario(duration_s, out);
+    }
+    out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace");
+    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out)).context(
+        "DDS on one machine needs multicast on lo: run the demo as root (it makes a private network namespace), \
+         or enable multicast on lo",
+    )?
+}
 
-        // The controller: a slow sway of the calves around the stand pose.
-        let t = start.elapsed().as_secs_f32();
-        let mut cmd = LowCmd::default();
-        for (i, motor) in cmd.motor_cmd.iter_mut().take(12).enumerate() {
-            let sway = if i % 3 == 2 { 0.1 * (t * std::f32::consts::TAU).sin() } else { 0.0 };
-            *motor = MotorCmd::servo(STAND_RAD[i % 3] + sway, 0.0, 60.0, 5.0, 0.0);
+/// A command for the 12 joints at `pose`, tagged with `tag` (the simulator echoes it).
+fn command(pose: &[f32; 12], tag: u32) -> LowCmd {
+    let mut cmd = LowCmd::default();
+    for (m, q) in cmd.motor_cmd.iter_mut().zip(pose) {
+        *m = MotorCmd::servo(*q, 0.0, KP, KD, 0.0);
+    }
+    cmd.reserve = tag.into();
+    cmd
+}
+
+fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+    runtime.block_on(async {
+        let lo = ParticipantOptions::new(0, Some("lo"));
+        let sim = Go2Sim::spawn(Go2SimConfig { participant: lo.clone(), ..Go2SimConfig::default() })
+            .context("starting the Go2 simulator")?;
+        let robot = LowLevel::<Go2>::connect(LowLevelOptions { participant: lo, ..LowLevelOptions::default() })
+            .await
+            .context("the Go2 client")?;
+        let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
+        out.line(format_args!("simulator and client on DDS domain 0, interface lo; LowState tick {}", first.tick.get()));
+
+        // Before the release the robot ignores LowCmds.
+        let start: [f32; 12] = std::array::from_fn(|i| first.motor_state[i].q.get());
+        robot.set_command(command(&start, 0))?;
+        let began = Instant::now();
+        while sim.snapshot().lowcmd.ignored_sport_mode == 0 && began.elapsed() < Duration::from_secs(5) {
+            tokio::time::sleep(Duration::from_millis(2)).await;
         }
-        let image = cmd.to_image();
-        let n = cmd.encode_cdr(CdrEncoding::Xcdr1, &mut cdr)?;
-        // The robot's side: the payload decodes and verifies to the same command.
-        let received = LowCmd::decode_cdr(&cdr[..n]).map(|(c, _)| c);
-        let from_image = LowCmd::decode_image(&image);
-        let same = |c: &LowCmd| c.motor_cmd.iter().zip(&cmd.motor_cmd).all(|(a, b)| a.q == b.q && a.kp == b.kp);
-        if !(received.as_ref().is_ok_and(same) && from_image.as_ref().is_ok_and(same)) {
-            mismatches += 1;
-        }
-        // Its answer: the joints where they were told to be.
-        let mut state = LowState::default();
-        for (s, c) in state.motor_state.iter_mut().zip(&cmd.motor_cmd) {
-            s.q = c.q;
-        }
-        state.tick = u32::try_from(cycles).unwrap_or(u32::MAX).into();
-        let state_image = state.to_image();
-        if !LowState::decode_image(&state_image)
-            .is_ok_and(|s| s.tick == state.tick && s.motor_state[2].q == state.motor_state[2].q)
-        {
-            mismatches += 1;
-        }
-        // Fault: a flipped bit on the way.
-        if cycles % 50 == 49 {
-            let mut bad = image;
-            bad[100 + (cycles as usize / 50) % 600] ^= 0x04;
-            corrupted += 1;
-            if matches!(LowCmd::decode_image(&bad), Err(DecodeError::CrcMismatch { .. })) {
-                caught += 1;
+        let ignored = sim.snapshot().lowcmd.ignored_sport_mode;
+        let released = robot.release_sport_mode().await.context("releasing the sport mode")?;
+        let mode_after = robot.sport_mode().await?;
+        out.line(format_args!(
+            "  release  {ignored} LowCmds ignored while sport mode \"normal\" owned the motors; ReleaseMode × {released} -> {:?}",
+            mode_after
+        ));
+
+        // Stand up, then hold with bit flips on the wire for a while.
+        let move_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
+        let hold_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
+        let target: [f32; 12] = std::array::from_fn(|i| STAND_POSE_RAD[i % 3]);
+        let mut echo: LatenessRing<4096> = LatenessRing::new();
+        let mut pending: VecDeque<(u32, Instant)> = VecDeque::new();
+        let mut progress = Progress::new("lowcmd", out);
+        let mut ticker = tokio::time::interval(Duration::from_millis(2));
+        let (mut tag, mut flips_on, mut flips_off) = (0u32, false, false);
+        let started = Instant::now();
+        loop {
+            ticker.tick().await;
+            let elapsed = started.elapsed();
+            if elapsed >= move_time + hold_time {
+                break;
+            }
+            let fraction = (elapsed.as_secs_f32() / move_time.as_secs_f32()).min(1.0);
+            let pose: [f32; 12] = std::array::from_fn(|i| start[i] + (target[i] - start[i]) * fraction);
+            tag += 1;
+            robot.set_command(command(&pose, tag))?;
+            pending.push_back((tag, Instant::now()));
+            if let Some(state) = robot.state() {
+                let seen = state.state.reserve.get();
+                while pending.front().is_some_and(|(t, _)| *t <= seen) {
+                    if let Some((t, at)) = pending.pop_front()
+                        && t == seen
+                    {
+                        echo.record(u32::try_from(at.elapsed().as_micros()).unwrap_or(u32::MAX));
+                    }
+                }
+            }
+            if !flips_on && elapsed >= move_time {
+                sim.inject(Go2Fault::BitFlips { every: FLIP_EVERY });
+                flips_on = true;
+            }
+            if !flips_off && elapsed >= move_time + hold_time / 2 {
+                sim.clear_faults();
+                flips_off = true;
+            }
+            if progress.due() {
+                let knee = robot.joint_positions().map_or(f32::NAN, |q| q[2]);
+                progress.show(&Status {
+                    mode: if elapsed < move_time { "stand-up" } else { "hold" },
+                    motion: format!("FR calf {knee:+.3} rad"),
+                    loop_count: u64::from(tag),
+                    lateness_us: (robot.stats().send_lateness.p99_us, "p99"),
+                });
             }
         }
-        work.record(u32::try_from(woke.elapsed().as_micros()).unwrap_or(u32::MAX));
-        cycles += 1;
-        if progress.due() {
-            progress.show(&Status {
-                mode: "servo sway",
-                motion: format!("calf {:+.3} rad", cmd.motor_cmd[2].q),
-                loop_count: cycles,
-                lateness_us: (std::mem::take(&mut window_late_us), "max"),
-            });
-        }
-    }
-    let elapsed = start.elapsed().as_secs_f64();
-    let rate_hz = cycles as f64 / elapsed;
-    let (late, busy) = (lateness.summary(), work.summary());
-    out.line(format_args!(
-        "  loop     {cycles} cycles in {elapsed:.1} s = {rate_hz:.0} Hz · lateness p50 {} µs p99 {} µs · work per cycle p50 {} µs p99 {} µs",
-        late.p50_us,
-        late.p99_us,
-        busy.p50_us,
-        busy.p99_us
-    ));
-    out.line(format_args!("  verify   {} round trips (image + XCDR1 + LowState), {mismatches} mismatches", cycles));
-    out.line(format_args!("  fault    {corrupted} images with a flipped bit, {caught} caught by the CRC"));
-    let mut report = DeviceReport::new("lowcmd");
-    report.commanded = vec!["12 motors, sway ±0.1 rad".into(), "image, XCDR1, LowState".into()];
-    report.observed = vec![format!("{cycles} round trips"), format!("{mismatches} mismatches")];
-    report.rates_hz = vec![("loop", rate_hz)];
-    report.timings = vec![("lateness", late), ("work per cycle", busy)];
-    report.counters = vec![
-        ("images decoded", 2 * cycles + corrupted),
-        ("CDR decoded", cycles),
-        ("mismatches", mismatches),
-        ("CRC rejects", caught),
-    ];
-    report.faults = vec![InjectedFault::new(
-        format!("{corrupted} bit flips"),
-        corrupted > 0 && caught == corrupted,
-        format!("{caught} caught"),
-    )];
-    report.checks = vec![
-        Check::new(
-            "lowcmd: 500 Hz encode/decode/verify loop",
-            (rate_hz - 500.0).abs() < 25.0 && mismatches == 0,
-            format!("{rate_hz:.0} Hz, {mismatches} mismatches, work p99 {} µs", busy.p99_us),
-        ),
-        Check::new(
-            "lowcmd: every corrupted image caught by the CRC",
-            corrupted > 0 && caught == corrupted,
-            format!("{caught} of {corrupted}"),
-        ),
-        Check::on_time("lowcmd: 500 Hz loop", &late),
-    ];
-    Ok(report)
+        let reached = robot.joint_positions().context("no state")?;
+        let worst = reached.iter().zip(target).map(|(q, t)| (q - t).abs()).fold(0.0f32, f32::max);
+        robot.damp();
+        tokio::time::sleep(Duration::from_millis(100)).await;
+        let (stats, snapshot) = (robot.stats(), sim.snapshot());
+        let elapsed = started.elapsed().as_secs_f64();
+        out.line(format_args!(
+            "  stand    lying -> stand pose over {:.1} s, held {:.1} s: largest joint error {worst:.4} rad",
+            move_time.as_secs_f64(),
+            hold_time.as_secs_f64()
+        ));
+        let (injected, caught) = (snapshot.corrupted_states, stats.lowstate.checksum_errors);
+        out.line(format_args!(
+            "  fault    {injected} LowStates with a flipped bit on the wire, {caught} caught by the CRC, {} decoded as garbage",
+            stats.lowstate.decode_errors
+        ));
+        let echo = echo.summary();
+        out.line(format_args!(
+            "  loop     LowCmd sent {} ({} damping), accepted {}; LowState in {}; send lateness p50 {} µs p99 {} µs; \
+             command -> state p50 {} µs p99 {} µs",
+            stats.commands_sent,
+            stats.damping_sent,
+            snapshot.lowcmd.accepted,
+            stats.lowstate.samples,
+            stats.send_lateness.p50_us,
+            stats.send_lateness.p99_us,
+            echo.p50_us,
+            echo.p99_us
+        ));
+
+        let mut report = DeviceReport::new("lowcmd");
+        report.commanded = vec![
+            "ReleaseMode (motion_switcher)".into(),
+            format!("12 joints up, {:.1} s, kp {KP} kd {KD}", move_time.as_secs_f64()),
+            format!("hold {:.1} s, then damp", hold_time.as_secs_f64()),
+        ];
+        report.observed = vec![
+            format!("{ignored} LowCmds ignored before release"),
+            format!("max error {worst:.4} rad"),
+            format!("{caught} of {injected} flips caught"),
+        ];
+        report.rates_hz = vec![
+            ("LowCmd", stats.commands_sent as f64 / elapsed),
+            ("LowState", stats.lowstate.samples as f64 / elapsed),
+        ];
+        report.timings = vec![
+            ("send lateness", stats.send_lateness),
+            ("sim send lateness", snapshot.state_lateness),
+            ("cmd -> state echo", echo),
+            ("state gap", stats.state_gap),
+        ];
+        report.counters = vec![
+            ("LowCmd sent", stats.commands_sent),
+            ("LowCmd accepted", snapshot.lowcmd.accepted),
+            ("LowCmd ignored", snapshot.lowcmd.ignored_sport_mode),
+            ("LowState in", stats.lowstate.samples),
+            ("CRC errors", caught),
+            ("lost by tick", stats.lost_by_tick),
+            ("requests", snapshot.requests),
+        ];
+        report.faults =
+            vec![InjectedFault::new(format!("{injected} bit flips"), injected > 0 && caught > 0, format!("{caught} caught"))];
+        report.checks = vec![
+            Check::new(
+                "go2: LowCmds ignored until the sport mode is released",
+                ignored > 0 && released >= 1 && mode_after.is_empty(),
+                format!("{ignored} ignored, {released} ReleaseMode, mode now {mode_after:?}"),
+            ),
+            Check::new("go2: legs reach the stand pose", worst < 0.02, format!("largest error {worst:.4} rad")),
+            Check::new(
+                "go2: every LowCmd after the release accepted",
+                snapshot.lowcmd.accepted > 0 && snapshot.lowcmd.bad_crc == 0 && snapshot.lowcmd.bad_head == 0,
+                format!(
+                    "{} accepted, {} bad CRC, {} bad head",
+                    snapshot.lowcmd.accepted, snapshot.lowcmd.bad_crc, snapshot.lowcmd.bad_head
+                ),
+            ),
+            Check::new(
+                "go2: bit flips on the wire caught by the CRC",
+                caught > 0 && caught <= injected && stats.lowstate.decode_errors == 0,
+                if caught == injected {
+                    format!("all {injected} caught")
+                } else {
+                    format!("{caught} of {injected} caught (the rest overwritten in the 1-deep reader history)")
+                },
+            ),
+            Check::on_time("go2: client LowCmd stream", &stats.send_lateness),
+            Check::on_time("go2: simulator LowState stream", &snapshot.state_lateness),
+        ];
+        Ok(report)
+    })
 }

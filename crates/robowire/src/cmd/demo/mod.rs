@@ -41,7 +41,8 @@ enum Device {
     Dog,
     /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).
     Spline,
-    /// Unitree LowCmd/LowState encode, decode and verify at 500 Hz.
+    /// A Unitree Go2 on DDS (simulated): sport mode release, stand-up, CRC faults on the wire.
+    #[value(alias = "go2")]
     Lowcmd,
 }
 
