@@ -20,6 +20,7 @@ const BENCHES: &[(&str, &str)] = &[
     ("zsl", "spline"),
     ("zsl", "udp"),
     ("robowire", "streams"),
+    ("robowire", "dds"),
 ];
 
 /// One row of the table.
@@ -61,6 +62,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let udp_meta_path = target.join("bench-meta-zsl-udp.json");
     let kmc_meta_path = target.join("bench-meta-kmc.json");
     let streams_meta_path = target.join("bench-meta-streams.json");
+    let dds_meta_path = target.join("bench-meta-dds.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -75,6 +77,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META_ZSL_UDP", &udp_meta_path)
             .env("ROBOWIRE_BENCH_META_KMC", &kmc_meta_path)
             .env("ROBOWIRE_BENCH_META_STREAMS", &streams_meta_path)
+            .env("ROBOWIRE_BENCH_META_DDS", &dds_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -134,6 +137,8 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let streams: Value =
         serde_json::from_str(&std::fs::read_to_string(&streams_meta_path).context("streams bench metadata")?)?;
     rows.extend(stream_rows(&streams)?);
+    let dds: Value = serde_json::from_str(&std::fs::read_to_string(&dds_meta_path).context("DDS bench metadata")?)?;
+    rows.extend(dds_rows(&dds)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
@@ -212,8 +217,6 @@ fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
     for (bench, label, copy, copy_label) in [
         ("lowcmd_encode_image", "LowCmd encode (zero padding, CRC)", copy_cmd, "memcpy 812 B"),
         ("lowcmd_decode_verify_image", "LowCmd decode + verify", copy_cmd, "memcpy 812 B"),
-        ("lowcmd_encode_xcdr1", "LowCmd encode XCDR1", copy_cmd, "memcpy 812 B"),
-        ("lowcmd_decode_verify_xcdr1", "LowCmd decode XCDR1 + verify", copy_cmd, "memcpy 812 B"),
         ("lowstate_encode_image", "LowState encode (zero padding, CRC)", copy_state, "memcpy 1180 B"),
         ("lowstate_decode_verify_image", "LowState decode + verify", copy_state, "memcpy 1180 B"),
     ] {
@@ -225,6 +228,33 @@ fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
             ratio: format!("{:.1}×", ns / copy),
             target: "–".into(),
             met: None,
+        });
+    }
+    // The CDR paths run on precomputed copy plans: within 2× of the struct-image paths (issue 14).
+    for (bench, label, image, image_label) in [
+        ("lowcmd_encode_xcdr1", "LowCmd encode XCDR1 (copy plan)", "lowcmd_encode_image", "image encode"),
+        (
+            "lowcmd_decode_verify_xcdr1",
+            "LowCmd decode XCDR1 + verify",
+            "lowcmd_decode_verify_image",
+            "image decode + verify",
+        ),
+        ("lowstate_encode_xcdr1", "LowState encode XCDR1 (copy plan)", "lowstate_encode_image", "image encode"),
+        (
+            "lowstate_decode_verify_xcdr1",
+            "LowState decode XCDR1 + verify",
+            "lowstate_decode_verify_image",
+            "image decode + verify",
+        ),
+    ] {
+        let (ns, base) = (mean_ns(criterion, codec, bench)?, mean_ns(criterion, codec, image)?);
+        rows.push(Row {
+            path: label.into(),
+            figure: format!("{ns:.0} ns"),
+            baseline: format!("struct {image_label}: {base:.0} ns"),
+            ratio: format!("{:.2}×", ns / base),
+            target: "≤ 2× the struct image".into(),
+            met: Some(ns <= 2.0 * base),
         });
     }
     Ok(rows)
@@ -356,6 +386,39 @@ fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             met: None,
         });
     }
+    Ok(rows)
+}
+
+/// The Go2's round trip over DDS against twice `ddsperf`'s figure: ≤ 1.5× (issue 14).
+const DDS_ROUND_TRIP_RATIO: f64 = 1.5;
+
+/// Rows of the DDS bench: round trip and one way, beside `ddsperf` with the same payload.
+fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let us = |path: [&str; 2]| meta[path[0]][path[1]].as_f64().with_context(|| format!("dds meta {path:?}"));
+    let seconds = meta["seconds"].as_f64().context("dds meta seconds")?;
+    let (half50, half99) = (us(["ddsperf_half_round_trip_us", "p50"])?, us(["ddsperf_half_round_trip_us", "p99"])?);
+    let mut rows = Vec::new();
+    for pct in ["p50", "p99"] {
+        let (trip, half) = (us(["round_trip_us", pct])?, if pct == "p50" { half50 } else { half99 });
+        let ratio = trip / (2.0 * half);
+        rows.push(Row {
+            path: format!("Go2 LowCmd → LowState answer via the simulator, DDS on loopback, {pct} ({seconds:.0} s)"),
+            figure: format!("{trip:.1} µs"),
+            baseline: format!("CycloneDDS ddsperf ping/pong, 812 B, round trip: {:.1} µs", 2.0 * half),
+            ratio: format!("{ratio:.2}×"),
+            target: format!("≤ {DDS_ROUND_TRIP_RATIO}× ddsperf"),
+            met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
+        });
+    }
+    let (w50, w99) = (us(["one_way_us", "p50"])?, us(["one_way_us", "p99"])?);
+    rows.push(Row {
+        path: "Go2 LowCmd write (encode, CRC, rustdds) → verified at a reader, one way".into(),
+        figure: format!("p50 {w50:.1} µs, p99 {w99:.1} µs"),
+        baseline: format!("ddsperf half round trip: p50 {half50:.1} µs, p99 {half99:.1} µs"),
+        ratio: format!("{:.2}× (p50)", w50 / half50),
+        target: "–".into(),
+        met: None,
+    });
     Ok(rows)
 }
 

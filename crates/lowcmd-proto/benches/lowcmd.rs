@@ -63,6 +63,15 @@ fn benches(c: &mut Criterion) {
     let mut cdr = [0u8; 812];
     cmd.encode_cdr(CdrEncoding::Xcdr1, &mut cdr).unwrap();
     codec.bench_function("lowcmd_decode_verify_xcdr1", |b| b.iter(|| LowCmd::decode_cdr(black_box(&cdr)).is_ok()));
+    let state = LowState::decode_image(&state_image).unwrap();
+    codec.bench_function("lowstate_encode_xcdr1", |b| {
+        b.iter(|| black_box(&state).encode_cdr(CdrEncoding::Xcdr1, &mut out))
+    });
+    let mut state_cdr = [0u8; 1180];
+    state.encode_cdr(CdrEncoding::Xcdr1, &mut state_cdr).unwrap();
+    codec.bench_function("lowstate_decode_verify_xcdr1", |b| {
+        b.iter(|| LowState::decode_cdr(black_box(&state_cdr)).is_ok())
+    });
     codec.bench_function("memcpy_812B", |b| {
         b.iter(|| {
             out[..812].copy_from_slice(black_box(&image));

@@ -202,15 +202,42 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         Ok((Unverified { message, crc, padding: None }, encoding))
     }
 
-    /// Decodes a CDR body in `encoding` and verifies the CRC over the rebuilt image.
+    /// Decodes a CDR body in `encoding` and verifies the CRC over the rebuilt image. (The
+    /// verified path builds the message in place, without the [`Unverified`] detour.)
+    #[inline]
     fn decode_cdr_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<Self>> {
-        Self::decode_cdr_body_unverified(encoding, body)?.0.verify()
+        let plan = Self::cdr_plan(encoding);
+        if body.len() != plan.body_len {
+            return Err(DecodeError::CdrLength { encoding, expected: plan.body_len, found: body.len() });
+        }
+        let mut message = Self::new_zeroed();
+        plan.decode(body, message.as_mut_bytes()).map_err(|e| match e {
+            PlanError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
+        })?;
+        message.zero_padding();
+        let (computed, received) = (message.computed_crc(), message.crc());
+        if computed != received && !cfg!(fuzzing) {
+            return Err(DecodeError::CrcMismatch { expected: computed, found: received, message });
+        }
+        Ok(message)
     }
 
     /// Decodes a CDR payload (XCDR1 or XCDR2) and verifies the CRC over the rebuilt image.
+    #[inline]
     fn decode_cdr(bytes: &[u8]) -> Result<(Self, CdrEncoding), DecodeError<Self>> {
-        let (unverified, encoding) = Self::decode_cdr_unverified(bytes)?;
-        Ok((unverified.verify()?, encoding))
+        let header: [u8; 4] = bytes
+            .get(..4)
+            .and_then(|h| h.try_into().ok())
+            .ok_or(DecodeError::NoEncapsulation { found: bytes.len() })?;
+        let encoding = CdrEncoding::from_header(header).ok_or(DecodeError::Encapsulation { found: header })?;
+        match Self::decode_cdr_body(encoding, &bytes[4..]) {
+            Ok(message) => Ok((message, encoding)),
+            // The length in the error counts the header, as the caller's bytes do.
+            Err(DecodeError::CdrLength { encoding, expected, found }) => {
+                Err(DecodeError::CdrLength { encoding, expected: expected + 4, found: found + 4 })
+            }
+            Err(e) => Err(e),
+        }
     }
 }
 

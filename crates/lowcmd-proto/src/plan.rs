@@ -1,4 +1,4 @@
-//! Precomputed CDR copy plans: the field-table walk of [`cdr`](crate::cdr) done once, at compile
+//! Precomputed CDR copy plans: the walk of the field tables by the CDR rules done once, at compile
 //! time, and flattened into a few block copies between the struct image and the CDR body.
 //!
 //! Two scalars whose body offset and image offset differ by the same amount belong to one
@@ -173,6 +173,7 @@ pub(crate) enum PlanError {
 
 impl CdrPlan {
     /// Image → body. `body` is exactly `body_len` long; `image` is a sealed image.
+    #[inline]
     pub(crate) fn encode(&self, image: &[u8], body: &mut [u8]) {
         // Bytes between runs are CDR alignment padding or DHEADERs: zero, then headers.
         let mut end = 0;
@@ -188,6 +189,7 @@ impl CdrPlan {
     }
 
     /// Body → image (then zero the image's padding). `body` is exactly `body_len` long.
+    #[inline]
     pub(crate) fn decode(&self, body: &[u8], image: &mut [u8]) -> Result<(), PlanError> {
         for header in self.headers {
             let bytes = &body[header.at..header.at + 4];

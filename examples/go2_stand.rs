@@ -1,0 +1,85 @@
+//! Unitree's Go2 low-level stand example with robowire: release the sport mode, move the twelve
+//! joints from where they are to the stand pose, hold it, damp. Against a simulated Go2 on DDS by
+//! default (in a private network namespace when the loopback has no multicast, as root);
+//! `--interface eth0` for a robot on its 192.168.123.x network.
+//!
+//! ```sh
+//! cargo run --example go2_stand
+//! ```
+
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, ensure};
+use clap::Parser;
+use go2::{Go2, JointCommand, LowLevel, LowLevelOptions, ParticipantOptions, STAND_POSE_RAD};
+use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+
+/// Unitree Go2 low-level stand.
+#[derive(Debug, Parser)]
+struct Args {
+    /// The network interface of the robot's network; without it, a simulated Go2 on loopback.
+    #[arg(long)]
+    interface: Option<String>,
+    /// Seconds to move to the stand pose.
+    #[arg(long, default_value_t = 2.0)]
+    duration: f64,
+    /// Seconds to hold it.
+    #[arg(long, default_value_t = 2.0)]
+    hold: f64,
+}
+
+/// Unitree's stand gains.
+const KP: f32 = 60.0;
+const KD: f32 = 5.0;
+
+fn main() -> anyhow::Result<()> {
+    let args = Args::parse();
+    ensure!(args.duration.is_finite() && args.duration >= 0.1, "--duration must be at least 0.1 s");
+    ensure!(args.hold.is_finite() && args.hold >= 0.0, "--hold must not be negative");
+    match &args.interface {
+        Some(interface) => stand(&args, ParticipantOptions::new(0, Some(interface)), None),
+        None if robowire_dds::netns::loopback_has_multicast() => simulated(&args),
+        None => robowire_dds::netns::in_loopback_namespace(|| simulated(&args))
+            .context("a simulated Go2 on loopback needs multicast on lo: run as root (a private network namespace)")?,
+    }
+}
+
+fn simulated(args: &Args) -> anyhow::Result<()> {
+    let lo = ParticipantOptions::new(0, Some("lo"));
+    let sim = Go2Sim::spawn(Go2SimConfig { participant: lo.clone(), ..Go2SimConfig::default() })
+        .context("starting the simulated Go2")?;
+    println!("simulated Go2 on DDS, interface lo");
+    stand(args, lo, Some(&sim))
+}
+
+fn stand(args: &Args, participant: ParticipantOptions, sim: Option<&Go2Sim>) -> anyhow::Result<()> {
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+    runtime.block_on(async {
+        let robot = LowLevel::<Go2>::connect(LowLevelOptions { participant, ..LowLevelOptions::default() }).await?;
+        let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
+        let start: [f32; 12] = std::array::from_fn(|i| first.motor_state[i].q.get());
+        let calls = robot.release_sport_mode().await?;
+        println!("sport mode released ({calls} ReleaseMode)");
+        let (duration, hold) = (Duration::from_secs_f64(args.duration), Duration::from_secs_f64(args.hold));
+        let began = Instant::now();
+        let mut ticker = tokio::time::interval(Duration::from_millis(2));
+        while began.elapsed() < duration + hold {
+            ticker.tick().await;
+            let s = (began.elapsed().as_secs_f32() / duration.as_secs_f32()).min(1.0);
+            let joints: [JointCommand; 12] =
+                std::array::from_fn(|i| JointCommand::hold(start[i] + (STAND_POSE_RAD[i % 3] - start[i]) * s, KP, KD));
+            robot.set_joints(&joints)?;
+        }
+        let q = robot.joint_positions().context("no state")?;
+        let worst = q.iter().enumerate().map(|(i, q)| (q - STAND_POSE_RAD[i % 3]).abs()).fold(0.0f32, f32::max);
+        println!("standing: largest joint error {worst:.3} rad");
+        robot.damp();
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        if let Some(sim) = sim {
+            ensure!(worst < 0.05, "the simulated Go2 did not reach the stand pose ({worst:.3} rad)");
+            println!("simulator: {} LowCmds accepted", sim.snapshot().lowcmd.accepted);
+        }
+        println!("damped; done");
+        Ok(())
+    })
+}
