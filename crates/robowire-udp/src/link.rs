@@ -267,24 +267,88 @@ impl<C: DatagramCodec> UdpReceiver<C> {
                     return Err(e.into());
                 }
             };
-            if !self.peer.accepts(from) {
-                Counters::bump(&self.counters.foreign_dropped);
-                continue;
+            if let Some(result) = self.accept(len, from) {
+                return result.map(|message| (message, from));
             }
-            Counters::bump(&self.counters.received);
-            return match self.codec.decode(&self.buf[..len]) {
-                Ok(message) => {
-                    if self.peer.learns() {
-                        *self.destination.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(from);
-                    }
-                    Ok((message, from))
-                }
+        }
+    }
+
+    /// Asks the kernel to stamp each datagram with its arrival time (`SO_TIMESTAMPNS`), for
+    /// [`recv_stamped`](Self::recv_stamped): arrival as the network stack saw it, whatever the
+    /// receiving thread's scheduling.
+    pub fn enable_arrival_stamps(&self) -> io::Result<()> {
+        nix::sys::socket::setsockopt(&*self.socket, nix::sys::socket::sockopt::ReceiveTimestampns, &true)
+            .map_err(io::Error::from)
+    }
+
+    /// [`recv_from`](Self::recv_from) with the kernel's arrival stamp (`CLOCK_REALTIME`, since the
+    /// Unix epoch), if [`enable_arrival_stamps`](Self::enable_arrival_stamps) was called.
+    pub async fn recv_stamped(
+        &mut self,
+    ) -> Result<(C::Incoming, SocketAddr, Option<std::time::Duration>), UdpError<C::Error>> {
+        use nix::sys::socket::{ControlMessageOwned, MsgFlags, SockaddrStorage, recvmsg};
+        use std::os::fd::AsRawFd;
+        loop {
+            let socket = self.socket.clone();
+            let buf = &mut self.buf;
+            let received = socket
+                .async_io(tokio::io::Interest::READABLE, || {
+                    let mut cmsg = nix::cmsg_space!(nix::sys::time::TimeSpec);
+                    let mut iov = [io::IoSliceMut::new(buf)];
+                    let msg =
+                        recvmsg::<SockaddrStorage>(socket.as_raw_fd(), &mut iov, Some(&mut cmsg), MsgFlags::empty())
+                            .map_err(io::Error::from)?;
+                    let stamp = msg.cmsgs().ok().and_then(|mut c| {
+                        c.find_map(|m| match m {
+                            ControlMessageOwned::ScmTimestampns(ts) => Some(std::time::Duration::new(
+                                u64::try_from(ts.tv_sec()).unwrap_or(0),
+                                u32::try_from(ts.tv_nsec()).unwrap_or(0),
+                            )),
+                            _ => None,
+                        })
+                    });
+                    let from = msg.address.and_then(|a: SockaddrStorage| {
+                        a.as_sockaddr_in()
+                            .map(|v4| SocketAddr::from((v4.ip(), v4.port())))
+                            .or_else(|| a.as_sockaddr_in6().map(|v6| SocketAddr::from((v6.ip(), v6.port()))))
+                    });
+                    Ok((msg.bytes, from, stamp))
+                })
+                .await;
+            let (len, from, stamp) = match received {
+                Ok((len, Some(from), stamp)) => (len, from, stamp),
+                Ok((_, None, _)) => continue,
                 Err(e) => {
-                    Counters::bump(&self.counters.decode_errors);
-                    Err(UdpError::Decode(e))
+                    Counters::bump(&self.counters.receive_errors);
+                    return Err(e.into());
                 }
             };
+            if let Some(result) = self.accept(len, from) {
+                return result.map(|message| (message, from, stamp));
+            }
         }
+    }
+
+    /// A datagram of `len` bytes (in `buf`) from `from`: `None` if the peer filter drops it (counted),
+    /// else the decoded message or the decode error (counted).
+    fn accept(&mut self, len: usize, from: SocketAddr) -> Option<Result<C::Incoming, UdpError<C::Error>>> {
+        if !self.peer.accepts(from) {
+            Counters::bump(&self.counters.foreign_dropped);
+            return None;
+        }
+        Counters::bump(&self.counters.received);
+        Some(match self.codec.decode(&self.buf[..len]) {
+            Ok(message) => {
+                if self.peer.learns() {
+                    *self.destination.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(from);
+                }
+                Ok(message)
+            }
+            Err(e) => {
+                Counters::bump(&self.counters.decode_errors);
+                Err(UdpError::Decode(e))
+            }
+        })
     }
 
     /// The address the socket is bound to.

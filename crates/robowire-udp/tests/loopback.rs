@@ -151,3 +151,21 @@ async fn a_bind_failure_names_the_address_and_lists_the_hosts_ipv4_addresses() {
     let err = UdpLink::bind(foreign, Peer::Exact(addr), Word).await.unwrap_err();
     assert!(err.to_string().starts_with("cannot bind UDP 192.0.2.1:43988"), "{err}");
 }
+
+#[tokio::test]
+async fn arrival_stamps_are_the_network_stacks_times() {
+    let peer = peer();
+    let (_sender, mut receiver) = link_to(&peer).await.into_split();
+    receiver.enable_arrival_stamps().unwrap();
+    let to = receiver.local_addr().unwrap();
+    peer.send_to(&7u32.to_le_bytes(), to).unwrap();
+    std::thread::sleep(Duration::from_millis(20));
+    peer.send_to(&8u32.to_le_bytes(), to).unwrap();
+    // Both are queued before the first is read: their stamps are still 20 ms apart.
+    let (a, from, first) = receiver.recv_stamped().await.unwrap();
+    let (b, _, second) = receiver.recv_stamped().await.unwrap();
+    assert_eq!((a, b, from), (7, 8, peer.local_addr().unwrap()));
+    let gap = second.unwrap().saturating_sub(first.unwrap());
+    assert!(gap >= Duration::from_millis(19), "stamped when they arrived, not when read: {gap:?}");
+    assert_eq!(receiver.stats().received, 2);
+}

@@ -2,13 +2,15 @@
 //! measured in the same run with a payload of the same size (812 bytes):
 //!
 //! - round trip: a LowCmd published → the LowState answer received, through the simulated Go2
-//!   (which answers each accepted LowCmd at once), one at a time; beside `ddsperf ping size 812`
+//!   (which answers each accepted LowCmd at once; its periodic stream slowed to 1 Hz, as ddsperf's
+//!   pong has none), one at a time; beside `ddsperf ping size 812`
 //!   against `ddsperf pong`, whose printed latency is half the round trip (it divides by 2), so
 //!   it is doubled here;
 //! - one way: a LowCmd written (encode, CRC, rustdds) → decoded and verified at a reader in
 //!   another participant, beside `ddsperf`'s half round trip.
 //!
-//! Figures to `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Needs root (the namespace) and
+//! Each side has a CPU of its own (client CPU 0, peer CPU 1), ddsperf's as ours. Figures to
+//! `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Needs root (the namespace) and
 //! `ddsperf` (Debian's cyclonedds-tools).
 
 use std::process::Command;
@@ -22,6 +24,23 @@ use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use serde_json::json;
 
+/// Both sides get a CPU of their own, ddsperf's and ours alike: the client side on CPU 0, the
+/// peer (pong, the simulator, the second participant) on CPU 1.
+const CLIENT_CPU: usize = 0;
+const PEER_CPU: usize = 1;
+
+/// Runs `f` on a thread pinned to `cpu`; threads it starts (DDS's, a simulator's) stay there.
+fn on_cpu<T: Send>(cpu: usize, f: impl FnOnce() -> T + Send) -> T {
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            robowire_rt::pin_current_thread(cpu).expect("pinning (needs 2 CPUs)");
+            f()
+        })
+        .join()
+        .expect("the pinned thread")
+    })
+}
+
 /// p50 and p99 of `samples`, µs.
 fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
     samples.sort_by(f64::total_cmp);
@@ -32,8 +51,8 @@ fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
 /// `ddsperf ping size 812` against `ddsperf pong` for `seconds`: the medians of its per-second
 /// p50 and p99 lines, µs (its figures: half the round trip).
 fn ddsperf(seconds: u32) -> (f64, f64) {
-    let mut pong = Command::new("ddsperf")
-        .args(["-D", &(seconds + 3).to_string(), "pong"])
+    let mut pong = Command::new("taskset")
+        .args(["-c", &PEER_CPU.to_string(), "ddsperf", "-D", &(seconds + 3).to_string(), "pong"])
         .stdout(std::process::Stdio::null())
         .spawn()
         .expect("ddsperf (apt install cyclonedds-tools)");
@@ -66,8 +85,15 @@ fn tagged(tag: u32) -> LowCmd {
 
 async fn round_trips(seconds: u32) -> Vec<f64> {
     let lo = ParticipantOptions::new(0, Some("lo"));
-    let _sim = Go2Sim::spawn(Go2SimConfig { participant: lo.clone(), answer_lowcmd: true, ..Go2SimConfig::default() })
-        .expect("simulator");
+    // The simulator answers each LowCmd at once; its 500 Hz stream is slowed to 1 Hz so that the
+    // round trip is the answer alone, as ddsperf's pong is.
+    let config = Go2SimConfig {
+        participant: lo.clone(),
+        answer_lowcmd: true,
+        state_period: Duration::from_secs(1),
+        ..Go2SimConfig::default()
+    };
+    let _sim = on_cpu(PEER_CPU, || Go2Sim::spawn(config).expect("simulator"));
     let us = Participant::new(lo).expect("participant");
     let switcher = RpcClient::new(&us, motion_switcher::SERVICE).unwrap();
     let released = switcher.call(motion_switcher::RELEASE_MODE, "{}", Duration::from_secs(20)).await.unwrap();
@@ -101,7 +127,8 @@ async fn round_trips(seconds: u32) -> Vec<f64> {
 
 async fn one_way(seconds: u32) -> Vec<f64> {
     let lo = ParticipantOptions::new(0, Some("lo"));
-    let (a, b) = (Participant::new(lo.clone()).unwrap(), Participant::new(lo).unwrap());
+    let a = Participant::new(lo.clone()).unwrap();
+    let b = on_cpu(PEER_CPU, || Participant::new(lo).unwrap());
     let writer = a.writer::<LowCmd>(LowCmd::TOPIC, Qos::WRITER).unwrap();
     let mut reader = b.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER).unwrap();
     let mut samples = Vec::new();
@@ -131,6 +158,7 @@ fn main() {
     let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
     let meta = robowire_dds::netns::in_loopback_namespace(|| {
         let (half50, half99) = ddsperf(seconds);
+        robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         let trips = runtime.block_on(round_trips(seconds));
         let ways = runtime.block_on(one_way(seconds));

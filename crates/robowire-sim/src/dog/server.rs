@@ -76,8 +76,8 @@ pub struct PortStats {
     pub garbage_sent: u64,
     /// Where state goes (learned or configured).
     pub client: Option<SocketAddr>,
-    /// |interval − `state_period`| between consecutive valid commands as they arrive, µs: how
-    /// evenly the client streams (calls between refreshes show as outliers).
+    /// |interval − `state_period`| between consecutive valid commands, by the kernel's arrival
+    /// stamps, µs: how evenly the client streams (calls between refreshes show as outliers).
     pub command_jitter: LatenessSummary,
 }
 
@@ -102,7 +102,8 @@ pub struct DogSnapshot {
 struct Port<C> {
     sender: UdpSender<C>,
     stats: PortStats,
-    last_command: Option<Time>,
+    /// When the last valid command arrived (the kernel's stamp, or the monotonic clock).
+    last_command: Option<Duration>,
 }
 
 impl<C: DatagramCodec> Port<C> {
@@ -110,12 +111,14 @@ impl<C: DatagramCodec> Port<C> {
         Self { sender, stats: PortStats { client, ..PortStats::default() }, last_command: None }
     }
 
-    /// A valid command arrived now; records |interval − `period`| in `jitter`.
-    fn on_command(&mut self, period: Duration, jitter: &SharedLateness<4096>) {
-        let now = robowire_rt::now();
+    /// A valid command arrived at `stamp` (the kernel's arrival stamp: the interval on the wire,
+    /// whatever the receiving thread's scheduling; without one, now); records |interval −
+    /// `period`| in `jitter`.
+    fn on_command(&mut self, period: Duration, jitter: &SharedLateness<4096>, stamp: Option<Duration>) {
+        let at = stamp.unwrap_or_else(|| Duration::from_nanos(robowire_rt::monotonic_ns()));
         self.stats.commands += 1;
-        if let Some(last) = self.last_command.replace(now) {
-            jitter.record(micros(now.saturating_duration_since(last).abs_diff(period)));
+        if let Some(last) = self.last_command.replace(at) {
+            jitter.record(micros(at.saturating_sub(last).abs_diff(period)));
         }
     }
 
@@ -354,15 +357,18 @@ async fn receive(
     mut low: UdpReceiver<LowLevelDogCodec>,
     stop: &mut watch::Receiver<bool>,
 ) {
+    // Arrival as the network stack saw it: without the stamps, the intervals are the receiving
+    // thread's wake-ups. Best effort.
+    let _ = (high.enable_arrival_stamps(), low.enable_arrival_stamps());
     loop {
         tokio::select! {
             _ = stop.changed() => return,
-            received = high.recv() => {
+            received = high.recv_stamped() => {
                 let mut s = lock(&shared);
                 match received {
-                    Ok((command, model)) => {
+                    Ok(((command, model), _, stamp)) => {
                         let period = s.period;
-                        s.high.on_command(period, &timing.high_level_jitter);
+                        s.high.on_command(period, &timing.high_level_jitter, stamp);
                         if s.dog.on_high_level(&command, model) {
                             s.send_high_level();
                         }
@@ -372,12 +378,12 @@ async fn receive(
                     Err(_) => {}
                 }
             }
-            received = low.recv() => {
+            received = low.recv_stamped() => {
                 let mut s = lock(&shared);
                 match received {
-                    Ok((command, _)) => {
+                    Ok(((command, _), _, stamp)) => {
                         let period = s.period;
-                        s.low.on_command(period, &timing.low_level_jitter);
+                        s.low.on_command(period, &timing.low_level_jitter, stamp);
                         if s.dog.on_low_level(&command) {
                             s.send_low_level();
                         }

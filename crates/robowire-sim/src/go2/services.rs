@@ -30,7 +30,7 @@ pub(super) fn run(
     mut stop: watch::Receiver<bool>,
 ) {
     let Endpoints { lowcmd: mut reader, answers, switcher, sport } = endpoints;
-    let Ok(runtime) = tokio::runtime::Builder::new_current_thread().enable_all().build() else {
+    let Ok(runtime) = tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build() else {
         lock(&shared).say("cannot start the services' runtime; the simulator answers nothing");
         return;
     };
