@@ -474,33 +474,27 @@ mod owned {
         }
     }
 
-    impl CdrType for ApiRequest {
-        const TYPE_NAME: &'static str = REQUEST_TYPE_NAME;
-        type Error = ApiError;
-        fn body_len(&self) -> usize {
-            self.view().body_len()
-        }
-        fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
-            self.view().encode_body(out)
-        }
-        fn decode_body(_: CdrEncoding, body: &[u8]) -> Result<Self, ApiError> {
-            Request::decode_body(body).map(Self::from)
-        }
+    /// `CdrType` for an owned message through its borrowed view.
+    macro_rules! cdr_type {
+        ($owned:ty, $view:ident, $name:expr) => {
+            impl CdrType for $owned {
+                const TYPE_NAME: &'static str = $name;
+                type Error = ApiError;
+                fn body_len(&self) -> usize {
+                    self.view().body_len()
+                }
+                fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+                    self.view().encode_body(out)
+                }
+                fn decode_body(_: CdrEncoding, body: &[u8]) -> Result<Self, ApiError> {
+                    $view::decode_body(body).map(Self::from)
+                }
+            }
+        };
     }
 
-    impl CdrType for ApiResponse {
-        const TYPE_NAME: &'static str = RESPONSE_TYPE_NAME;
-        type Error = ApiError;
-        fn body_len(&self) -> usize {
-            self.view().body_len()
-        }
-        fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
-            self.view().encode_body(out)
-        }
-        fn decode_body(_: CdrEncoding, body: &[u8]) -> Result<Self, ApiError> {
-            Response::decode_body(body).map(Self::from)
-        }
-    }
+    cdr_type!(ApiRequest, Request, REQUEST_TYPE_NAME);
+    cdr_type!(ApiResponse, Response, RESPONSE_TYPE_NAME);
 }
 
 #[cfg(feature = "alloc")]

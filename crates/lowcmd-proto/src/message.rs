@@ -182,12 +182,9 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         Ok((unverified, encoding))
     }
 
-    /// Decodes a CDR body in `encoding` (no encapsulation header: a DDS library read it) without
-    /// verifying the CRC.
-    fn decode_cdr_body_unverified(
-        encoding: CdrEncoding,
-        body: &[u8],
-    ) -> Result<(Unverified<Self>, CdrEncoding), DecodeError<Self>> {
+    /// The zero-padded image a CDR body in `encoding` describes, CRC not checked.
+    #[inline]
+    fn image_of_cdr_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<Self>> {
         let plan = Self::cdr_plan(encoding);
         if body.len() != plan.body_len {
             return Err(DecodeError::CdrLength { encoding, expected: plan.body_len, found: body.len() });
@@ -198,23 +195,25 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         })?;
         // Alignment bytes of the body landed on the image's padding: zero it.
         message.zero_padding();
+        Ok(message)
+    }
+
+    /// Decodes a CDR body in `encoding` (no encapsulation header: a DDS library read it) without
+    /// verifying the CRC.
+    fn decode_cdr_body_unverified(
+        encoding: CdrEncoding,
+        body: &[u8],
+    ) -> Result<(Unverified<Self>, CdrEncoding), DecodeError<Self>> {
+        let message = Self::image_of_cdr_body(encoding, body)?;
         let crc = CrcCheck { computed: message.computed_crc(), received: message.crc() };
         Ok((Unverified { message, crc, padding: None }, encoding))
     }
 
-    /// Decodes a CDR body in `encoding` and verifies the CRC over the rebuilt image. (The
-    /// verified path builds the message in place, without the [`Unverified`] detour.)
+    /// Decodes a CDR body in `encoding` and verifies the CRC over the rebuilt image (without the
+    /// [`Unverified`] detour: the hot path of a DDS reader).
     #[inline]
     fn decode_cdr_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<Self>> {
-        let plan = Self::cdr_plan(encoding);
-        if body.len() != plan.body_len {
-            return Err(DecodeError::CdrLength { encoding, expected: plan.body_len, found: body.len() });
-        }
-        let mut message = Self::new_zeroed();
-        plan.decode(body, message.as_mut_bytes()).map_err(|e| match e {
-            PlanError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
-        })?;
-        message.zero_padding();
+        let message = Self::image_of_cdr_body(encoding, body)?;
         let (computed, received) = (message.computed_crc(), message.crc());
         if computed != received && !cfg!(fuzzing) {
             return Err(DecodeError::CrcMismatch { expected: computed, found: received, message });

@@ -208,7 +208,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             true
         }
         DogCommand::Watch => {
-            watch_until_ctrl_c(&dog).await?;
+            crate::cmd::live::watch_until_ctrl_c(dog.connection_events(), || dog.state().map(|s| line(&s))).await?;
             true
         }
     };
@@ -287,25 +287,6 @@ async fn watch_for(dog: &HighLevel, how_long: Duration) {
         match dog.state() {
             Some(s) => println!("  {}", line(&s)),
             None => println!("  (no state: {:?})", dog.connection()),
-        }
-    }
-}
-
-async fn watch_until_ctrl_c(dog: &HighLevel) -> anyhow::Result<()> {
-    let mut ticker = tokio::time::interval(Duration::from_millis(100));
-    let mut events = dog.connection_events();
-    loop {
-        tokio::select! {
-            signal = tokio::signal::ctrl_c() => return signal.context("waiting for Ctrl-C"),
-            changed = events.changed() => {
-                changed.context("client stopped")?;
-                println!("connection: {:?}", *events.borrow_and_update());
-            }
-            _ = ticker.tick() => {
-                if let Some(s) = dog.state() {
-                    println!("{}", line(&s));
-                }
-            }
         }
     }
 }

@@ -214,20 +214,8 @@ fn print_status(state: &LowState) {
 }
 
 async fn watch(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
-    let mut ticker = tokio::time::interval(Duration::from_millis(100));
-    let mut events = robot.connection_events();
-    loop {
-        tokio::select! {
-            signal = tokio::signal::ctrl_c() => return signal.context("waiting for Ctrl-C"),
-            changed = events.changed() => {
-                changed.context("client stopped")?;
-                println!("connection: {:?}", *events.borrow_and_update());
-            }
-            _ = ticker.tick() => {
-                if let Some(s) = robot.state() {
-                    println!("{} | age {} ms", line(&s.state), s.age.as_millis());
-                }
-            }
-        }
-    }
+    crate::cmd::live::watch_until_ctrl_c(robot.connection_events(), || {
+        robot.state().map(|s| format!("{} | age {} ms", line(&s.state), s.age.as_millis()))
+    })
+    .await
 }

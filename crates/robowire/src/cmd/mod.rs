@@ -7,5 +7,6 @@ pub(crate) mod dog;
 pub(crate) mod encode;
 pub(crate) mod go2;
 pub(crate) mod kmc;
+pub(crate) mod live;
 pub(crate) mod shm;
 pub(crate) mod sim;
