@@ -134,6 +134,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let udp: Value =
         serde_json::from_str(&std::fs::read_to_string(&udp_meta_path).context("ZSL-1 UDP bench metadata")?)?;
     rows.extend(zsl_udp_rows(&criterion, &udp)?);
+    rows.extend(crate::python::bench_rows(quick, &udp)?);
     let streams: Value =
         serde_json::from_str(&std::fs::read_to_string(&streams_meta_path).context("streams bench metadata")?)?;
     rows.extend(stream_rows(&streams)?);

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod fuzz;
 pub mod golden;
+pub mod python;
 
 use std::path::PathBuf;
 

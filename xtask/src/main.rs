@@ -28,6 +28,13 @@ enum Task {
         #[arg(long, default_value_t = 20)]
         time: u64,
     },
+    /// Run every test of the project: `cargo test --workspace`, then the Python suite on the
+    /// wheel built as users build it, on CPython 3.10 and 3.12 (or 3.13).
+    Test {
+        /// Only the Python suite (the wheel, both CPythons).
+        #[arg(long)]
+        python_only: bool,
+    },
     /// Run the benchmarks and print the performance table.
     Bench {
         /// Shorter measurements (a smoke run).
@@ -40,6 +47,8 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Task::Golden { bless } => golden(bless),
         Task::Fuzz { target, time } => xtask::fuzz::run(target.as_deref(), time),
+        Task::Test { python_only: false } => xtask::python::test_all(),
+        Task::Test { python_only: true } => xtask::python::test_python(),
         Task::Bench { quick } => xtask::bench::run(quick).and_then(|rows| {
             anyhow::ensure!(rows.iter().all(|r| r.met != Some(false)), "a benchmark missed its target");
             Ok(())

@@ -35,31 +35,41 @@ fn python310() -> Result<PathBuf, String> {
     if let Some(path) = std::env::var_os("ROBOWIRE_PYTHON310") {
         return Ok(path.into());
     }
+    cpython("3.10").ok_or_else(|| {
+        "no CPython 3.10 (cyclonedds 0.10.2 has wheels for 3.10 only): install one with pyenv, or set \
+         ROBOWIRE_PYTHON310"
+            .into()
+    })
+}
+
+/// A CPython `version` (`"3.12"`) interpreter: pyenv's newest of that version, or `python3.12`
+/// on the `PATH`.
+pub fn cpython(version: &str) -> Option<PathBuf> {
     let pyenv_root = std::env::var_os("PYENV_ROOT")
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".pyenv")));
+    let executable = format!("python{version}");
     if let Some(root) = pyenv_root
         && let Ok(versions) = std::fs::read_dir(root.join("versions"))
     {
-        let mut found: Vec<PathBuf> = versions
+        let prefix = format!("{version}.");
+        let mut found: Vec<(u32, PathBuf)> = versions
             .flatten()
             .map(|e| e.path())
-            .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("3.10.")))
-            .map(|p| p.join("bin/python3.10"))
-            .filter(|p| p.exists())
+            .filter_map(|p| {
+                let name = p.file_name()?.to_str()?;
+                let patch = name.strip_prefix(&prefix)?.parse().ok()?;
+                Some((patch, p.join("bin").join(&executable)))
+            })
+            .filter(|(_, p)| p.exists())
             .collect();
         found.sort();
-        if let Some(newest) = found.pop() {
-            return Ok(newest);
+        if let Some((_, newest)) = found.pop() {
+            return Some(newest);
         }
     }
-    let on_path = Command::new("python3.10").arg("--version").output();
-    if on_path.is_ok_and(|o| o.status.success()) {
-        return Ok("python3.10".into());
-    }
-    Err("no CPython 3.10 (cyclonedds 0.10.2 has wheels for 3.10 only): install one with pyenv, or set \
-         ROBOWIRE_PYTHON310"
-        .into())
+    let on_path = Command::new(&executable).arg("--version").output();
+    on_path.is_ok_and(|o| o.status.success()).then(|| executable.into())
 }
 
 fn run(what: &str, command: &mut Command) -> Result<(), String> {

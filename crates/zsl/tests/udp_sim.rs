@@ -337,3 +337,24 @@ async fn bad_options_and_placement_are_typed_errors() {
         other => panic!("{other:?}"),
     }
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn close_frees_the_local_port_at_once() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let high = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
+    let port = high.local_addr().port();
+    assert!(high.wait_connected(WAIT).await);
+    high.close().await;
+    let again = ClientOptions {
+        dog: sim.high_level_addr(),
+        ..ClientOptions::high_level([127, 0, 0, 1].into(), port, [127, 0, 0, 1].into())
+    };
+    let high = HighLevel::connect(again).await.expect("the port of a closed client binds again");
+    assert!(high.wait_connected(WAIT).await);
+
+    let low_options = ClientOptions { dog: sim.low_level_addr(), ..options_to(sim.low_level_addr()) };
+    let low = LowLevel::connect(low_options).await.unwrap();
+    let port = low.local_addr().port();
+    low.close().await;
+    UdpSocket::bind(("127.0.0.1", port)).expect("the port of a closed LowLevel client binds again");
+}

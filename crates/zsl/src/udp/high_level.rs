@@ -111,6 +111,13 @@ impl HighLevel {
         Ok(Self { running: Running::start(options).await?, acks: Mutex::new([AckCounter::default(); Call::COUNT]) })
     }
 
+    /// Stops streaming and closes the socket: when this returns, the local port can be bound
+    /// again. (Dropping the client stops it too, but its socket closes a moment later, on the
+    /// runtime's thread.)
+    pub async fn close(self) {
+        self.running.shut_down().await;
+    }
+
     fn session(&self) -> &Session<HighLevelInterface> {
         &self.running.session
     }

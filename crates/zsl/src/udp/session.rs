@@ -145,6 +145,15 @@ impl<I: Wire> Drop for Running<I> {
 }
 
 impl<I: Wire> Running<I> {
+    /// Stops the receive task and the stream and waits until both have let go of the socket.
+    pub(super) async fn shut_down(mut self) {
+        self.receive.abort();
+        let _ = (&mut self.receive).await;
+        if let Some(stream) = self.stream.take() {
+            drop(stream.stop());
+        }
+    }
+
     /// Binds, starts the stream (idle command at once, like the vendor) and the receive task.
     pub(super) async fn start(options: ClientOptions) -> Result<Self, ConnectError> {
         options.validate()?;

@@ -1,0 +1,39 @@
+"""robowire: low-level robot protocols from Python, byte-exact, safe by default.
+
+- :mod:`robowire.zsl1`, :mod:`robowire.zsl1w`: drop-ins for ZsiBot's ``mc_sdk_zsl_1_py`` and
+  ``mc_sdk_zsl_1w_py`` (``import robowire.zsl1 as mc_sdk_zsl_1_py``).
+- :mod:`robowire.kmc`: the KMC UART chassis.
+- :mod:`robowire.unitree`: Unitree LowCmd/LowState (Go2 and HG), struct image and CDR.
+- :mod:`robowire.go2`: the Go2's low-level interface over DDS.
+- :mod:`robowire.sim`: every simulator, in-process, as a context manager.
+
+Importing robowire starts no thread and opens nothing.
+"""
+
+from ._native import __version__
+from .errors import (
+    ArgumentError,
+    BindError,
+    ClosedError,
+    CrcError,
+    DecodeError,
+    Error,
+    NoStateError,
+    PortError,
+    ServiceError,
+    TimeoutError,
+)
+
+__all__ = [
+    "__version__",
+    "Error",
+    "ArgumentError",
+    "ClosedError",
+    "BindError",
+    "PortError",
+    "NoStateError",
+    "TimeoutError",
+    "DecodeError",
+    "CrcError",
+    "ServiceError",
+]

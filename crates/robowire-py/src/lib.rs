@@ -1,0 +1,29 @@
+//! robowire for Python: the `robowire._native` extension behind the `robowire` package
+//! (`python/robowire`). Importing it starts no thread and opens nothing: the runtime starts
+//! with the first client or simulator.
+
+mod errors;
+mod go2;
+mod kmc;
+mod owned;
+mod pyjson;
+mod runtime;
+mod sim;
+mod spline;
+mod stats;
+mod unitree;
+mod zsl;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    zsl::register(m)?;
+    sim::register(m)?;
+    kmc::register(m)?;
+    unitree::register(m)?;
+    go2::register(m)?;
+    spline::register(m)?;
+    Ok(())
+}

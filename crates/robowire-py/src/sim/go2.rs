@@ -1,0 +1,132 @@
+//! `robowire.sim.Go2`: a Unitree Go2 on DDS.
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use robowire_dds::{ParticipantOptions, TopicStats};
+use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
+
+use crate::errors::{Kind, chain, error};
+use crate::owned::{Owned, closeable};
+use crate::runtime::seconds;
+use crate::stats::{dict, lateness};
+
+/// A simulated Unitree Go2 on DDS: `rt/lowstate` at 500 Hz, `rt/lowcmd` obeyed once the sport
+/// mode is released, the motion_switcher and sport services. Unitree's own SDK and
+/// `robowire.go2.LowLevel` both drive it. DDS discovery needs multicast: on a machine whose
+/// loopback has none, call `robowire.sim.enter_loopback_namespace()` first (root).
+#[pyclass(module = "robowire.sim", frozen)]
+pub(crate) struct Go2 {
+    sim: Owned<Go2Sim>,
+    domain: u16,
+}
+
+pub(crate) fn topic<'py>(py: Python<'py>, t: &TopicStats) -> PyResult<Bound<'py, PyDict>> {
+    Ok(dict!(py, {
+        "samples" => t.samples,
+        "write_errors" => t.write_errors,
+        "decode_errors" => t.decode_errors,
+        "checksum_errors" => t.checksum_errors,
+    }))
+}
+
+#[pymethods]
+impl Go2 {
+    /// Joins DDS domain `domain` on `interface` (`None`: the library's choice) and boots lying
+    /// down with its sport mode owning the motors.
+    #[new]
+    #[pyo3(signature = (*, domain = 0, interface = None, state_period_s = 0.002))]
+    fn new(py: Python<'_>, domain: u16, interface: Option<&str>, state_period_s: f64) -> PyResult<Self> {
+        let state_period = seconds("state_period_s", state_period_s)?;
+        if state_period.as_micros() < 100 {
+            return Err(error(Kind::Argument, "state_period_s must be at least 0.0001"));
+        }
+        let config = Go2SimConfig {
+            participant: ParticipantOptions::new(domain, interface),
+            state_period,
+            ..Go2SimConfig::default()
+        };
+        let sim = py.detach(|| Go2Sim::spawn(config)).map_err(|e| error(Kind::Error, chain(&e)))?;
+        Ok(Self { sim: Owned::new("Go2 simulator", sim), domain })
+    }
+
+    /// The DDS domain.
+    #[getter]
+    fn domain(&self) -> u16 {
+        self.domain
+    }
+
+    /// Stop `rt/lowstate` (a client's watchdog reports the robot lost).
+    fn inject_silence(&self) -> PyResult<()> {
+        self.sim.with(|s| s.inject(Go2Fault::Silence))
+    }
+
+    /// Motor `motor` (0..12) fails: it reports mode 0 and exerts no torque.
+    fn inject_motor_fault(&self, motor: usize) -> PyResult<()> {
+        if motor >= 12 {
+            return Err(error(Kind::Argument, format!("motor {motor}: the Go2 has motors 0..12")));
+        }
+        self.sim.with(|s| s.inject(Go2Fault::MotorFault { motor }))
+    }
+
+    /// Every `every`-th LowState goes out with one bit flipped after its CRC (a client counts
+    /// and drops it).
+    fn inject_bit_flips(&self, every: u32) -> PyResult<()> {
+        if every == 0 {
+            return Err(error(Kind::Argument, "every must be at least 1"));
+        }
+        self.sim.with(|s| s.inject(Go2Fault::BitFlips { every }))
+    }
+
+    /// Clear every fault.
+    fn clear_faults(&self) -> PyResult<()> {
+        self.sim.with(|s| s.clear_faults())
+    }
+
+    /// What the robot did that a user should know, since the last call.
+    fn take_log(&self) -> PyResult<Vec<String>> {
+        self.sim.with(|s| s.take_log())
+    }
+
+    /// Sport mode, joint positions, LowCmd and LowState counters, timing.
+    fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.sim.with(|s| s.snapshot())?;
+        let c = &s.lowcmd;
+        Ok(dict!(py, {
+            "sport_mode" => s.sport_mode,
+            "joints_rad" => s.joints_rad.to_vec(),
+            "lowcmd" => dict!(py, {
+                "accepted" => c.accepted,
+                "ignored_sport_mode" => c.ignored_sport_mode,
+                "bad_head" => c.bad_head,
+                "bad_crc" => c.bad_crc,
+                "malformed" => c.malformed,
+            }),
+            "lowstate" => topic(py, &s.lowstate)?,
+            "corrupted_states" => s.corrupted_states,
+            "requests" => s.requests,
+            "state_lateness_us" => lateness(py, &s.state_lateness)?,
+            "command_jitter_us" => lateness(py, &s.command_jitter)?,
+        }))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Go2(domain={})", self.domain)
+    }
+}
+
+closeable!(Go2, sim, "Leaves the domain and stops the robot. Idempotent.");
+
+/// Whether loopback carries multicast here (DDS discovery on one machine needs it).
+#[pyfunction]
+pub(crate) fn loopback_has_multicast() -> bool {
+    robowire_dds::netns::loopback_has_multicast()
+}
+
+/// Moves this thread (and every thread and process it starts later) into a private network
+/// namespace whose loopback carries multicast, so DDS participants on this machine find each
+/// other and nothing leaves it. Call it before anything starts robowire's threads. Needs root
+/// and iproute2.
+#[pyfunction]
+pub(crate) fn enter_loopback_namespace() -> PyResult<()> {
+    robowire_dds::netns::enter_loopback_namespace().map_err(|e| error(Kind::Error, chain(&e)))
+}

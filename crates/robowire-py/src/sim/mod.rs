@@ -1,0 +1,23 @@
+//! `robowire.sim`: every simulator in-process, as a context manager, with its faults.
+
+mod chassis;
+mod dog;
+mod go2;
+
+pub(crate) use go2::topic;
+pub(crate) use spline::state_dict;
+mod spline;
+
+use pyo3::prelude::*;
+
+/// Adds the classes to the extension module.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("SimDog", py.get_type::<dog::Dog>())?;
+    m.add("SimChassis", py.get_type::<chassis::Chassis>())?;
+    m.add("SimSpline", py.get_type::<spline::Spline>())?;
+    m.add("SimGo2", py.get_type::<go2::Go2>())?;
+    m.add_function(wrap_pyfunction!(go2::loopback_has_multicast, m)?)?;
+    m.add_function(wrap_pyfunction!(go2::enter_loopback_namespace, m)?)?;
+    Ok(())
+}

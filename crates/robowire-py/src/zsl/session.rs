@@ -1,0 +1,230 @@
+//! What the drop-in `HighLevel` and `LowLevel` share: the client behind `initRobot`, replaced
+//! by a second `initRobot` and dropped by `close()`; the vendor's return codes with robowire's
+//! reason kept in `last_error`; "no state" as an exception instead of the vendor's zeros.
+
+use std::net::{IpAddr, SocketAddr};
+use std::sync::{Arc, Mutex, PoisonError, RwLock};
+use std::time::Duration;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use zsl::udp::{self as facade, CallError, ClientOptions, ClientStats, ConnectError, Connection, Model};
+
+use crate::errors::{Kind, chain, error};
+use crate::runtime;
+use crate::stats::{dict, lateness};
+
+/// A ZSL-1 UDP client of the `zsl` facade.
+pub(crate) trait Facade: Send + Sync + Sized + 'static {
+    /// The vendor's name, for messages.
+    const NAME: &'static str;
+    /// Options for `initRobot(local_ip, local_port, dog_ip)`.
+    fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions;
+    /// Binds and starts streaming.
+    fn connect(options: ClientOptions) -> impl Future<Output = Result<Self, ConnectError>> + Send;
+    /// Stops streaming and closes the socket.
+    fn close(self) -> impl Future<Output = ()> + Send;
+    /// Waits for the first state.
+    fn wait_connected(&self, timeout: Duration) -> impl Future<Output = bool> + Send;
+    /// The connection now.
+    fn connection(&self) -> Connection;
+    /// The bound address.
+    fn local_addr(&self) -> SocketAddr;
+    /// Counters.
+    fn stats(&self) -> ClientStats;
+}
+
+macro_rules! facade {
+    ($t:ty, $name:literal, $options:path) => {
+        impl Facade for $t {
+            const NAME: &'static str = $name;
+            fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions {
+                $options(local, port, dog)
+            }
+            fn connect(options: ClientOptions) -> impl Future<Output = Result<Self, ConnectError>> + Send {
+                <$t>::connect(options)
+            }
+            fn close(self) -> impl Future<Output = ()> + Send {
+                <$t>::close(self)
+            }
+            fn wait_connected(&self, timeout: Duration) -> impl Future<Output = bool> + Send {
+                <$t>::wait_connected(self, timeout)
+            }
+            fn connection(&self) -> Connection {
+                <$t>::connection(self)
+            }
+            fn local_addr(&self) -> SocketAddr {
+                <$t>::local_addr(self)
+            }
+            fn stats(&self) -> ClientStats {
+                <$t>::stats(self)
+            }
+        }
+    };
+}
+
+facade!(facade::HighLevel, "HighLevel", ClientOptions::high_level);
+facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level);
+
+/// A running client and whom it talks to.
+pub(crate) struct Running<T> {
+    pub(crate) client: Arc<T>,
+    pub(crate) dog: SocketAddr,
+}
+
+impl<T> Clone for Running<T> {
+    fn clone(&self) -> Self {
+        Self { client: self.client.clone(), dog: self.dog }
+    }
+}
+
+/// The client behind a drop-in object.
+pub(crate) struct Session<T> {
+    model: Model,
+    running: RwLock<Option<Running<T>>>,
+    last_error: Mutex<Option<String>>,
+}
+
+fn parse_ip(name: &str, text: &str) -> PyResult<IpAddr> {
+    text.parse().map_err(|_| error(Kind::Argument, format!("{name} = {text:?} is not an IP address")))
+}
+
+impl<T: Facade> Session<T> {
+    pub(crate) fn new(model: Model) -> Self {
+        Self { model, running: RwLock::new(None), last_error: Mutex::new(None) }
+    }
+
+    /// `initRobot`: binds `local_ip:local_port`, streams to `dog_ip`. A second call replaces
+    /// the first client (closed first, so the same port can be bound again).
+    pub(crate) fn init(&self, py: Python<'_>, local_ip: &str, local_port: i64, dog_ip: &str) -> PyResult<()> {
+        let local = parse_ip("local_ip", local_ip)?;
+        let dog = parse_ip("dog_ip", dog_ip)?;
+        let port = u16::try_from(local_port)
+            .map_err(|_| error(Kind::Argument, format!("local_port = {local_port} is outside 0..=65535")))?;
+        self.close(py)?;
+        let options = T::options(local, port, dog).with_model(self.model);
+        let dog = options.dog;
+        let client = runtime::block_on(py, T::connect(options))?.map_err(|e| match &e {
+            ConnectError::Link(_) => error(Kind::Bind, format!("{}.initRobot: {}", T::NAME, chain(&e))),
+            ConnectError::Option { .. } => error(Kind::Argument, chain(&e)),
+            _ => error(Kind::Error, format!("{}.initRobot: {}", T::NAME, chain(&e))),
+        })?;
+        *self.running.write().unwrap_or_else(PoisonError::into_inner) = Some(Running { client: Arc::new(client), dog });
+        Ok(())
+    }
+
+    /// Stops streaming and frees the port (bound again at once if no other thread is inside a
+    /// call on this client). Idempotent.
+    pub(crate) fn close(&self, py: Python<'_>) -> PyResult<()> {
+        let old = self.running.write().unwrap_or_else(PoisonError::into_inner).take();
+        if let Some(Running { client, .. }) = old {
+            match Arc::try_unwrap(client) {
+                Ok(client) => runtime::block_on(py, client.close())?,
+                Err(shared) => py.detach(move || drop(shared)),
+            }
+        }
+        Ok(())
+    }
+
+    /// The running client, or `ClosedError`.
+    pub(crate) fn running(&self) -> PyResult<Running<T>> {
+        self.running.read().unwrap_or_else(PoisonError::into_inner).clone().ok_or_else(|| {
+            error(
+                Kind::Closed,
+                format!("this {} is not connected: call initRobot(local_ip, local_port, dog_ip) first", T::NAME),
+            )
+        })
+    }
+
+    /// The client, if running.
+    pub(crate) fn client(&self) -> Option<Arc<T>> {
+        self.running.read().unwrap_or_else(PoisonError::into_inner).as_ref().map(|r| r.client.clone())
+    }
+
+    /// A getter: the value, or `NoStateError` saying why there is none.
+    pub(crate) fn read<R>(&self, get: impl FnOnce(&T) -> Option<R>) -> PyResult<R> {
+        let running = self.running()?;
+        get(&running.client).ok_or_else(|| no_state(&*running.client, running.dog))
+    }
+
+    /// A call's outcome as the vendor's return code; the reason of a refusal is kept for
+    /// `last_error`.
+    pub(crate) fn code(&self, outcome: Result<(), CallError>) -> u32 {
+        let code = outcome.as_ref().map_or_else(|e| e.return_code().raw(), |()| 0);
+        self.remember(outcome.err().map(|e| e.to_string()));
+        code
+    }
+
+    /// Keeps (or clears) the reason of the last refused call.
+    pub(crate) fn remember(&self, reason: Option<String>) {
+        *self.last_error.lock().unwrap_or_else(PoisonError::into_inner) = reason;
+    }
+
+    /// Why the last call returned a non-zero code, if it did.
+    pub(crate) fn last_error(&self) -> Option<String> {
+        self.last_error.lock().unwrap_or_else(PoisonError::into_inner).clone()
+    }
+
+    /// `checkConnect()`: state within the watchdog's 3 s. False before `initRobot`.
+    pub(crate) fn is_connected(&self) -> bool {
+        self.client().is_some_and(|c| c.connection() == Connection::Connected)
+    }
+
+    /// Waits up to `timeout_s` for the first state (Ctrl-C interrupts).
+    pub(crate) fn wait_connected(&self, py: Python<'_>, timeout_s: f64) -> PyResult<bool> {
+        let timeout = runtime::seconds("timeout_s", timeout_s)?;
+        let client = self.running()?.client;
+        Ok(runtime::wait(py, Some(timeout), async move { client.wait_connected(timeout).await })?.unwrap_or(false))
+    }
+
+    /// `"waiting"`, `"connected"`, `"disconnected"`, or `"closed"`.
+    pub(crate) fn connection(&self) -> &'static str {
+        match self.client().map(|c| c.connection()) {
+            None => "closed",
+            Some(Connection::Waiting) => "waiting",
+            Some(Connection::Connected) => "connected",
+            Some(Connection::Disconnected) => "disconnected",
+        }
+    }
+
+    /// The bound address as `(ip, port)`.
+    pub(crate) fn local_addr(&self) -> PyResult<(String, u16)> {
+        let addr = self.running()?.client.local_addr();
+        Ok((addr.ip().to_string(), addr.port()))
+    }
+
+    /// The client's counters as a dict.
+    pub(crate) fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.running()?.client.stats();
+        Ok(dict!(py, {
+            "commands_sent" => s.link.sent,
+            "send_errors" => s.link.send_errors,
+            "states_received" => s.link.received,
+            "decode_errors" => s.link.decode_errors,
+            "foreign_dropped" => s.link.foreign_dropped,
+            "receive_errors" => s.link.receive_errors,
+            "calls_sent" => s.calls_sent,
+            "refreshes_sent" => s.refreshes_sent,
+            "missed_ticks" => s.missed_ticks,
+            "states" => s.states,
+            "short_states" => s.short_states,
+            "header_anomalies" => s.header_anomalies,
+            "disconnects" => s.disconnects,
+            "reconnects" => s.reconnects,
+            "stream_lateness_us" => lateness(py, &s.stream_lateness)?,
+            "state_gap_us" => lateness(py, &s.state_gap)?,
+        }))
+    }
+}
+
+fn no_state<T: Facade>(client: &T, dog: SocketAddr) -> PyErr {
+    let local = client.local_addr();
+    let why = match client.connection() {
+        Connection::Disconnected => format!("the robot at {} has been silent for 3 s or more", dog.ip()),
+        _ => format!(
+            "no state from the robot at {} yet (commands go to {dog}; its state must come to {local})",
+            dog.ip()
+        ),
+    };
+    error(Kind::NoState, format!("{}: {why}", T::NAME))
+}
