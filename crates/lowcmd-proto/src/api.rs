@@ -26,6 +26,7 @@
 //! ```
 
 use robowire_core::BufferTooSmall;
+use robowire_core::cdr::{CdrEncoding, CdrError, CdrReader, CdrWriter};
 
 /// Service names and API ids of `motion_switcher` (API version "1.0.0.1").
 pub mod motion_switcher {
@@ -186,155 +187,17 @@ pub struct Response<'a> {
 }
 
 /// Why a body is not a `Request_` or `Response_`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
-pub enum ApiError {
-    /// The body ends before field `field`.
-    #[error("the body ends in field {field}: {needed} bytes needed, {found} given")]
-    Truncated {
-        /// The field.
-        field: &'static str,
-        /// Bytes the field needs from the start of the body.
-        needed: usize,
-        /// The body's length.
-        found: usize,
-    },
-    /// A string without its terminating NUL (or with a length of 0).
-    #[error("string {field} is not NUL-terminated")]
-    NoNul {
-        /// The field.
-        field: &'static str,
-    },
-    /// A string that is not UTF-8.
-    #[error("string {field} is not UTF-8")]
-    NotUtf8 {
-        /// The field.
-        field: &'static str,
-    },
-    /// A boolean byte other than 0 or 1.
-    #[error("boolean {field} is {value}, not 0 or 1")]
-    Bool {
-        /// The field.
-        field: &'static str,
-        /// The byte.
-        value: u8,
-    },
-    /// Bytes left after the last field beyond alignment padding.
-    #[error("{extra} bytes after the last field")]
-    Trailing {
-        /// Bytes left.
-        extra: usize,
-    },
-}
-
-/// Bytes after the last field that are taken as padding (a writer may pad the body to 4 or 8).
-const MAX_TRAILING_PADDING: usize = 7;
-
-/// A cursor writing CDR little-endian with alignment counted from the body's start.
-struct Writer<'a> {
-    out: &'a mut [u8],
-    pos: usize,
-    needed: usize,
-}
-
-impl Writer<'_> {
-    fn bytes(&mut self, align: usize, bytes: &[u8]) {
-        let start = self.pos.next_multiple_of(align);
-        let end = start + bytes.len();
-        self.needed = self.needed.max(end);
-        if let Some(dst) = self.out.get_mut(self.pos..end) {
-            dst[..start - self.pos].fill(0);
-            dst[start - self.pos..].copy_from_slice(bytes);
-        }
-        self.pos = end;
-    }
-
-    fn string(&mut self, s: &str) {
-        self.bytes(4, &(s.len() as u32 + 1).to_le_bytes());
-        self.bytes(1, s.as_bytes());
-        self.bytes(1, &[0]);
-    }
-
-    fn sequence(&mut self, bytes: &[u8]) {
-        self.bytes(4, &(bytes.len() as u32).to_le_bytes());
-        self.bytes(1, bytes);
-    }
-
-    fn finish(self) -> Result<usize, BufferTooSmall> {
-        let available = self.out.len();
-        if self.needed <= available { Ok(self.pos) } else { Err(BufferTooSmall { needed: self.needed, available }) }
-    }
-}
-
-/// A cursor reading CDR little-endian.
-struct Reader<'a> {
-    body: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, field: &'static str, align: usize, len: usize) -> Result<&'a [u8], ApiError> {
-        let start = self.pos.next_multiple_of(align);
-        let end = start + len;
-        let bytes =
-            self.body.get(start..end).ok_or(ApiError::Truncated { field, needed: end, found: self.body.len() })?;
-        self.pos = end;
-        Ok(bytes)
-    }
-
-    fn array<const N: usize>(&mut self, field: &'static str) -> Result<[u8; N], ApiError> {
-        let bytes = self.take(field, N, N)?;
-        let mut out = [0u8; N];
-        out.copy_from_slice(bytes);
-        Ok(out)
-    }
-
-    fn i64(&mut self, field: &'static str) -> Result<i64, ApiError> {
-        self.array(field).map(i64::from_le_bytes)
-    }
-
-    fn i32(&mut self, field: &'static str) -> Result<i32, ApiError> {
-        self.array(field).map(i32::from_le_bytes)
-    }
-
-    fn bool(&mut self, field: &'static str) -> Result<bool, ApiError> {
-        match self.take(field, 1, 1)?[0] {
-            0 => Ok(false),
-            1 => Ok(true),
-            value => Err(ApiError::Bool { field, value }),
-        }
-    }
-
-    fn string(&mut self, field: &'static str) -> Result<&'a str, ApiError> {
-        let len = u32::from_le_bytes(self.array(field)?) as usize;
-        let bytes = self.take(field, 1, len)?;
-        let (&nul, text) = bytes.split_last().ok_or(ApiError::NoNul { field })?;
-        if nul != 0 {
-            return Err(ApiError::NoNul { field });
-        }
-        core::str::from_utf8(text).map_err(|_| ApiError::NotUtf8 { field })
-    }
-
-    fn sequence(&mut self, field: &'static str) -> Result<&'a [u8], ApiError> {
-        let len = u32::from_le_bytes(self.array(field)?) as usize;
-        self.take(field, 1, len)
-    }
-
-    fn finish(self) -> Result<(), ApiError> {
-        let extra = self.body.len() - self.pos.min(self.body.len());
-        if extra <= MAX_TRAILING_PADDING { Ok(()) } else { Err(ApiError::Trailing { extra }) }
-    }
-}
+pub type ApiError = CdrError;
 
 impl<'a> Request<'a> {
     /// Body length, bytes.
     pub fn body_len(&self) -> usize {
-        let mut w = Writer { out: &mut [], pos: 0, needed: 0 };
+        let mut w = CdrWriter::measure(CdrEncoding::Xcdr1);
         self.write(&mut w);
-        w.pos
+        w.position()
     }
 
-    fn write(&self, w: &mut Writer<'_>) {
+    fn write(&self, w: &mut CdrWriter<'_>) {
         let h = &self.header;
         w.bytes(8, &h.id.to_le_bytes());
         w.bytes(8, &h.api_id.to_le_bytes());
@@ -342,19 +205,19 @@ impl<'a> Request<'a> {
         w.bytes(4, &h.priority.to_le_bytes());
         w.bytes(1, &[u8::from(h.noreply)]);
         w.string(self.parameter);
-        w.sequence(self.binary);
+        w.octets(self.binary);
     }
 
     /// Writes the body into `out`; its length.
     pub fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
-        let mut w = Writer { out, pos: 0, needed: 0 };
+        let mut w = CdrWriter::new(CdrEncoding::Xcdr1, out);
         self.write(&mut w);
         w.finish()
     }
 
     /// Reads a body (XCDR1 or XCDR2: the same bytes).
     pub fn decode_body(body: &'a [u8]) -> Result<Self, ApiError> {
-        let mut r = Reader { body, pos: 0 };
+        let mut r = CdrReader::new(CdrEncoding::Xcdr1, body);
         let header = RequestHeader {
             id: r.i64("header.identity.id")?,
             api_id: r.i64("header.identity.api_id")?,
@@ -362,7 +225,7 @@ impl<'a> Request<'a> {
             priority: r.i32("header.policy.priority")?,
             noreply: r.bool("header.policy.noreply")?,
         };
-        let request = Self { header, parameter: r.string("parameter")?, binary: r.sequence("binary")? };
+        let request = Self { header, parameter: r.string("parameter")?, binary: r.octets("binary")? };
         r.finish()?;
         Ok(request)
     }
@@ -376,35 +239,35 @@ impl<'a> Response<'a> {
 
     /// Body length, bytes.
     pub fn body_len(&self) -> usize {
-        let mut w = Writer { out: &mut [], pos: 0, needed: 0 };
+        let mut w = CdrWriter::measure(CdrEncoding::Xcdr1);
         self.write(&mut w);
-        w.pos
+        w.position()
     }
 
-    fn write(&self, w: &mut Writer<'_>) {
+    fn write(&self, w: &mut CdrWriter<'_>) {
         w.bytes(8, &self.id.to_le_bytes());
         w.bytes(8, &self.api_id.to_le_bytes());
         w.bytes(4, &self.code.to_le_bytes());
         w.string(self.data);
-        w.sequence(self.binary);
+        w.octets(self.binary);
     }
 
     /// Writes the body into `out`; its length.
     pub fn encode_body(&self, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
-        let mut w = Writer { out, pos: 0, needed: 0 };
+        let mut w = CdrWriter::new(CdrEncoding::Xcdr1, out);
         self.write(&mut w);
         w.finish()
     }
 
     /// Reads a body (XCDR1 or XCDR2: the same bytes).
     pub fn decode_body(body: &'a [u8]) -> Result<Self, ApiError> {
-        let mut r = Reader { body, pos: 0 };
+        let mut r = CdrReader::new(CdrEncoding::Xcdr1, body);
         let response = Self {
             id: r.i64("header.identity.id")?,
             api_id: r.i64("header.identity.api_id")?,
             code: r.i32("header.status.code")?,
             data: r.string("data")?,
-            binary: r.sequence("binary")?,
+            binary: r.octets("binary")?,
         };
         r.finish()?;
         Ok(response)

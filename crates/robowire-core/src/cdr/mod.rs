@@ -94,3 +94,6 @@ pub trait CdrType: Sized {
         false
     }
 }
+
+mod cursor;
+pub use cursor::{CdrError, CdrReader, CdrWriter};

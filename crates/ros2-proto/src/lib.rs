@@ -1,0 +1,153 @@
+//! ROS 2 messages on the wire, without a ROS installation.
+//!
+//! ROS 2 over DDS (rmw_cyclonedds, rmw_fastrtps) maps a ROS topic `/ns/name` to the DDS topic
+//! `rt/ns/name` ([`topic`]) and a type `pkg/msg/Type` to the DDS type `pkg::msg::dds_::Type_`;
+//! samples are XCDR1 little endian in the ROS 2 IDL layouts. A service `name` is two topics,
+//! `rq/nameRequest` and `rr/nameReply` ([`request_topic`], [`reply_topic`]), each sample prefixed
+//! by rmw_cyclonedds' [`RequestId`] (client GUID, sequence number).
+//!
+//! Every message here is a [`CdrType`](robowire_core::cdr::CdrType) a DDS transport publishes
+//! as is. Decoding reads XCDR1 (what every ROS 2 middleware writes) and refuses XCDR2.
+//!
+//! ```
+//! use robowire_core::cdr::{CdrEncoding, CdrType};
+//! use ros2_proto::geometry::{Twist, Vector3};
+//!
+//! let twist = Twist { linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: 0.3 } };
+//! let mut body = [0u8; 48];
+//! assert_eq!(twist.encode_body(&mut body), Ok(48));
+//! assert_eq!(Twist::decode_body(CdrEncoding::Xcdr1, &body).unwrap(), twist);
+//! assert_eq!(Twist::TYPE_NAME, "geometry_msgs::msg::dds_::Twist_");
+//! ```
+
+#![no_std]
+
+extern crate alloc;
+
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use robowire_core::cdr::{CdrError, CdrReader, CdrWriter};
+
+#[macro_use]
+mod macros;
+
+pub mod builtin;
+pub mod diagnostic;
+pub mod geometry;
+pub mod nav;
+pub mod sensor;
+pub mod srv;
+pub mod tf;
+
+pub use robowire_core::cdr::CdrError as Error;
+pub use srv::RequestId;
+
+/// A value in a CDR body: how it is written and read, and the fewest bytes it takes (so that a
+/// sequence's count is checked against the body before anything is allocated).
+pub trait CdrValue: Sized {
+    /// The fewest bytes a value takes, padding aside.
+    const MIN_LEN: usize;
+    /// Writes the value at the cursor.
+    fn write(&self, w: &mut CdrWriter<'_>);
+    /// Reads a value at the cursor; `field` names it in errors.
+    fn read(r: &mut CdrReader<'_>, field: &'static str) -> Result<Self, CdrError>;
+}
+
+macro_rules! primitive {
+    ($($ty:ty => $write:ident, $read:ident, $len:expr;)*) => {$(
+        impl CdrValue for $ty {
+            const MIN_LEN: usize = $len;
+            fn write(&self, w: &mut CdrWriter<'_>) {
+                w.$write(*self);
+            }
+            fn read(r: &mut CdrReader<'_>, field: &'static str) -> Result<Self, CdrError> {
+                r.$read(field)
+            }
+        }
+    )*};
+}
+
+primitive! {
+    u8 => u8, u8, 1;
+    bool => bool, bool, 1;
+    i32 => i32, i32, 4;
+    u32 => u32, u32, 4;
+    i64 => i64, i64, 8;
+    u64 => u64, u64, 8;
+    f32 => f32, f32, 4;
+    f64 => f64, f64, 8;
+}
+
+impl CdrValue for String {
+    /// The length word and the NUL.
+    const MIN_LEN: usize = 5;
+    fn write(&self, w: &mut CdrWriter<'_>) {
+        w.string(self);
+    }
+    fn read(r: &mut CdrReader<'_>, field: &'static str) -> Result<Self, CdrError> {
+        r.string(field).map(String::from)
+    }
+}
+
+impl<T: CdrValue> CdrValue for Vec<T> {
+    const MIN_LEN: usize = 4;
+    fn write(&self, w: &mut CdrWriter<'_>) {
+        w.count(self.len());
+        self.iter().for_each(|v| v.write(w));
+    }
+    fn read(r: &mut CdrReader<'_>, field: &'static str) -> Result<Self, CdrError> {
+        let count = r.count(field, T::MIN_LEN)?;
+        (0..count).map(|_| T::read(r, field)).collect()
+    }
+}
+
+impl<T: CdrValue + Copy + Default, const N: usize> CdrValue for [T; N] {
+    const MIN_LEN: usize = N * T::MIN_LEN;
+    fn write(&self, w: &mut CdrWriter<'_>) {
+        self.iter().for_each(|v| v.write(w));
+    }
+    fn read(r: &mut CdrReader<'_>, field: &'static str) -> Result<Self, CdrError> {
+        let mut out = [T::default(); N];
+        for v in &mut out {
+            *v = T::read(r, field)?;
+        }
+        Ok(out)
+    }
+}
+
+/// The DDS topic of the ROS topic `name` in `namespace` (`""` or `/` for the root):
+/// `topic("/kmc0", "cmd_vel")` is `rt/kmc0/cmd_vel`.
+pub fn topic(namespace: &str, name: &str) -> String {
+    alloc::format!("rt{}/{name}", normalize(namespace))
+}
+
+/// The request topic of the service `name` in `namespace`: `rq/kmc0/stand_upRequest`.
+pub fn request_topic(namespace: &str, name: &str) -> String {
+    alloc::format!("rq{}/{name}Request", normalize(namespace))
+}
+
+/// The reply topic of the service `name` in `namespace`: `rr/kmc0/stand_upReply`.
+pub fn reply_topic(namespace: &str, name: &str) -> String {
+    alloc::format!("rr{}/{name}Reply", normalize(namespace))
+}
+
+/// `""`, `"/"` → `""`; `"ns"`, `"/ns/"` → `"/ns"`.
+fn normalize(namespace: &str) -> String {
+    let trimmed = namespace.trim_matches('/');
+    if trimmed.is_empty() { String::new() } else { alloc::format!("/{trimmed}") }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topic_names_follow_the_ros2_mapping() {
+        assert_eq!(topic("", "cmd_vel"), "rt/cmd_vel");
+        assert_eq!(topic("/", "odom"), "rt/odom");
+        assert_eq!(topic("/zsl1_0/", "joint_states"), "rt/zsl1_0/joint_states");
+        assert_eq!(request_topic("kmc0", "stand_up"), "rq/kmc0/stand_upRequest");
+        assert_eq!(reply_topic("", "stand_up"), "rr/stand_upReply");
+    }
+}
