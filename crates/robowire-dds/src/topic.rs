@@ -124,6 +124,8 @@ impl<T: CdrType + 'static> Writer<T> {
 pub struct Sample<T> {
     /// The message.
     pub value: T,
+    /// The GUID of the writer that sent it (tells two publishers on one topic apart).
+    pub writer: [u8; 16],
 }
 
 /// Reads `T` from one topic, asynchronously (any executor). Samples whose body does not decode
@@ -150,12 +152,12 @@ impl<T: CdrType + 'static> Reader<T> {
     pub async fn recv(&mut self) -> Result<Sample<T>, DdsError> {
         loop {
             match self.stream.next().await {
-                Some(Ok(sample)) => match sample.into_value() {
-                    Ok(value) => {
+                Some(Ok(sample)) => match (sample.sample_info().writer_guid().to_bytes(), sample.into_value()) {
+                    (writer, Ok(value)) => {
                         Counters::bump(&self.counters.samples);
-                        return Ok(Sample { value });
+                        return Ok(Sample { value, writer });
                     }
-                    Err(failure) => {
+                    (_, Err(failure)) => {
                         let counter = if failure.checksum {
                             &self.counters.checksum_errors
                         } else {

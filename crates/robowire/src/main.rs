@@ -31,6 +31,8 @@ enum Command {
     Go2(cmd::go2::Go2Args),
     /// Inspect DDS: the topics on the network, the samples of one.
     Dds(cmd::dds::DdsCommandArgs),
+    /// Every device as a ROS 2 node on the wire (cmd_vel, odom, tf, imu, joint_states, …), no ROS install needed.
+    Ros2(cmd::ros2::Ros2Args),
     /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
     #[command(subcommand)]
     Shm(cmd::shm::ShmCommand),
@@ -54,6 +56,7 @@ fn main() -> ExitCode {
         Command::Dog(args) => cmd::dog::run(args),
         Command::Go2(args) => cmd::go2::run(args),
         Command::Dds(args) => cmd::dds::run(args),
+        Command::Ros2(args) => cmd::ros2::run(args),
         Command::Shm(command) => cmd::shm::run(&command),
         Command::Decode(command) => cmd::decode::run(&command),
         Command::Encode(command) => cmd::encode::run(&command),

@@ -266,6 +266,10 @@ impl<I: Wire> Session<I> {
     }
 
     /// Waits until a state satisfies `accept`, up to `timeout`.
+    pub(super) fn state_updates(&self) -> watch::Receiver<Option<I::State>> {
+        self.state.subscribe()
+    }
+
     pub(super) async fn wait_for(&self, timeout: Duration, accept: impl Fn(&I::State) -> bool) -> Option<I::State> {
         let mut rx = self.state.subscribe();
         let wait = rx.wait_for(|s| s.as_ref().is_some_and(&accept));
@@ -395,6 +399,12 @@ macro_rules! client_accessors {
         ) -> Option<$state> {
             let state = self.session().wait_for(timeout, |s| accept(&s.into())).await?;
             Some((&state).into())
+        }
+
+        /// Every state as it arrives: `changed()` resolves at each state datagram (and with
+        /// `None` at a watchdog timeout); read it with `borrow_and_update()`.
+        pub fn state_updates(&self) -> tokio::sync::watch::Receiver<Option<$wire_state>> {
+            self.session().state_updates()
         }
 
         /// Waits for state, up to `timeout`; whether the client is connected.

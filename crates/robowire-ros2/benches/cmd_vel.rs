@@ -1,0 +1,171 @@
+//! `cmd_vel` → the command on the device's wire, through `robowire ros2`'s bridge, in a private
+//! network namespace (root): a Twist written by a ROS 2 publisher (robowire-dds, another
+//! participant) → the HighLevel datagram carrying its vx at a socket standing in for a ZSL-1;
+//! beside, in the same run, the two legs it is made of: the Twist's DDS delivery alone (writer →
+//! reader in another participant) and the facade's `move_velocity()` call → wire. Figures to
+//! `ROBOWIRE_BENCH_META_ROS2` for `cargo xtask bench`.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::time::{Duration, Instant};
+
+use robowire_dds::netns::in_loopback_namespace;
+use robowire_dds::qos::Qos;
+use robowire_dds::{Participant, ParticipantOptions};
+use robowire_ros2::{BridgeOptions, DeviceAddress};
+use ros2_proto::geometry::{Twist, Vector3};
+use serde_json::json;
+use zsl::udp::{ClientOptions, HighLevel};
+use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
+
+/// p50 and p99 of `samples`, µs.
+fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
+    samples.sort_by(f64::total_cmp);
+    let at = |p: usize| samples[((p * samples.len()).div_ceil(100)).saturating_sub(1).min(samples.len() - 1)];
+    (at(50), at(99))
+}
+
+/// A socket on the ZSL-1's HighLevel port, answering as a walking dog (mode 18).
+struct Dog {
+    socket: UdpSocket,
+    walking: Vec<u8>,
+}
+
+impl Dog {
+    fn bind() -> Self {
+        let socket = UdpSocket::bind("127.0.0.1:43997").unwrap();
+        socket.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
+        let walking = HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() };
+        Self { socket, walking: walking.encode().to_vec() }
+    }
+
+    /// Waits for the client's first datagram, then tells it the dog walks.
+    fn greet(&self) -> SocketAddr {
+        let mut buf = [0u8; 64];
+        let (_, client) = self.socket.recv_from(&mut buf).expect("the client streams");
+        for _ in 0..5 {
+            self.socket.send_to(&self.walking, client).unwrap();
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        client
+    }
+
+    /// Reads until a command datagram carries `vx`.
+    fn wait_for_vx(&self, vx: f32) {
+        let mut buf = [0u8; 64];
+        loop {
+            let len = self.socket.recv(&mut buf).expect("a datagram with the new vx within 2 s");
+            if len == 40 && buf[4..8] == vx.to_le_bytes() {
+                return;
+            }
+        }
+    }
+
+    fn keep_alive(&self, client: SocketAddr) {
+        self.socket.send_to(&self.walking, client).unwrap();
+    }
+}
+
+fn twist(vx: f32) -> Twist {
+    Twist { linear: Vector3 { x: vx.into(), y: 0.0, z: 0.0 }, angular: Vector3::default() }
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return; // `cargo test --benches` lists; there is nothing to list
+    }
+    let quick = std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some();
+    let n = if quick { 300 } else { 2000 };
+    let meta = in_loopback_namespace(|| {
+        let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+        let lo = ParticipantOptions::new(0, Some("lo"));
+        let dog = Dog::bind();
+        let speeds = [0.5f32, 0.6];
+
+        // 1. Through the bridge: Twist written → datagram at the dog.
+        let (stop_tx, stop) = tokio::sync::watch::channel(false);
+        let options = BridgeOptions {
+            armed: true,
+            interface: Some("lo".into()),
+            ..BridgeOptions::new(vec!["zsl1:127.0.0.1".parse::<DeviceAddress>().unwrap()])
+        };
+        let bridge = runtime.spawn(robowire_ros2::run(options, stop, |_| {}));
+        let client = dog.greet();
+        let publisher = Participant::new(lo.clone()).unwrap();
+        let writer = publisher.writer::<Twist>("rt/cmd_vel", Qos::ROS_DEFAULT).unwrap();
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while writer.matched_readers() == 0 {
+            assert!(Instant::now() < deadline, "the bridge's cmd_vel reader was not discovered");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let mut bridged = Vec::with_capacity(n);
+        for i in 0..n + 50 {
+            let vx = speeds[i % 2];
+            let start = Instant::now();
+            writer.write(twist(vx)).unwrap();
+            dog.wait_for_vx(vx);
+            if i >= 50 {
+                bridged.push(start.elapsed().as_secs_f64() * 1e6);
+            }
+            if i % 100 == 0 {
+                dog.keep_alive(client);
+            }
+        }
+        stop_tx.send(true).unwrap();
+        runtime.block_on(bridge).unwrap().unwrap();
+
+        // 2. The DDS leg alone: Twist written → read in another participant.
+        let subscriber = Participant::new(lo).unwrap();
+        let mut reader = subscriber.reader::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
+        let writer = publisher.writer::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
+        while writer.matched_readers() == 0 {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let mut dds = Vec::with_capacity(n);
+        runtime.block_on(async {
+            for i in 0..n + 50 {
+                let start = Instant::now();
+                writer.write(twist(speeds[i % 2])).unwrap();
+                reader.recv().await.unwrap();
+                if i >= 50 {
+                    dds.push(start.elapsed().as_secs_f64() * 1e6);
+                }
+            }
+        });
+
+        // 3. The device leg alone: move_velocity() → datagram at the dog.
+        let mut direct = Vec::with_capacity(n);
+        runtime.block_on(async {
+            let options = ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
+            let robot = HighLevel::connect(options).await.unwrap();
+            let client = dog.greet();
+            assert!(robot.wait_connected(Duration::from_secs(2)).await);
+            for i in 0..n + 50 {
+                let vx = speeds[i % 2];
+                let start = Instant::now();
+                robot.move_velocity(vx, 0.0, 0.0).await.unwrap();
+                dog.wait_for_vx(vx);
+                if i >= 50 {
+                    direct.push(start.elapsed().as_secs_f64() * 1e6);
+                }
+                if i % 100 == 0 {
+                    dog.keep_alive(client);
+                }
+            }
+            robot.close().await;
+        });
+        let (b50, b99) = percentiles(bridged);
+        let (d50, d99) = percentiles(dds);
+        let (c50, c99) = percentiles(direct);
+        json!({
+            "cmd_vel_to_wire_p50_us": b50, "cmd_vel_to_wire_p99_us": b99,
+            "dds_twist_p50_us": d50, "dds_twist_p99_us": d99,
+            "call_to_wire_p50_us": c50, "call_to_wire_p99_us": c99,
+            "samples": n,
+        })
+    })
+    .expect("a private network namespace (run as root)");
+    println!("ros2 cmd_vel: {meta}");
+    if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_ROS2") {
+        std::fs::write(path, meta.to_string()).unwrap();
+    }
+}

@@ -1,0 +1,119 @@
+//! What every device's bridge shares: its namespace, frame ids, stamps, the rate cap, the
+//! `cmd_vel` guard's options, and typed writers under ROS 2 names and QoS.
+
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use robowire_core::cdr::CdrType;
+use robowire_dds::qos::Qos;
+use robowire_dds::{DdsError, Participant, Reader, Writer};
+use ros2_proto::builtin::{Header, Time};
+
+/// How a device is bridged.
+#[derive(Debug, Clone)]
+pub(crate) struct NodeOptions {
+    /// The device's namespace (`""` for the root, else `/ns`).
+    pub namespace: String,
+    /// `cmd_vel` moves the robot; without it the bridge only publishes.
+    pub armed: bool,
+    /// A `cmd_vel` older than this stops the robot.
+    pub deadman: Duration,
+    /// Publish at most this often per topic, Hz (`None`: the device's native rate).
+    pub rate_cap_hz: Option<f64>,
+}
+
+/// One device's node: topics in its namespace on the shared participant.
+pub(crate) struct Node<'a> {
+    pub(crate) participant: &'a Participant,
+    pub(crate) options: NodeOptions,
+}
+
+impl Node<'_> {
+    /// A writer of the ROS topic `name` in the namespace.
+    pub(crate) fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
+        self.participant.writer(&ros2_proto::topic(&self.options.namespace, name), qos)
+    }
+
+    /// A reader of the ROS topic `name` in the namespace.
+    pub(crate) fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
+        self.participant.reader(&ros2_proto::topic(&self.options.namespace, name), qos)
+    }
+
+    /// The frame id `name` in the namespace: `odom`, or `kmc0/odom`.
+    pub(crate) fn frame(&self, name: &str) -> String {
+        let ns = self.options.namespace.trim_matches('/');
+        if ns.is_empty() { name.into() } else { format!("{ns}/{name}") }
+    }
+
+    /// A header at `stamp` in the frame `name`.
+    pub(crate) fn header(&self, stamp: Time, name: &str) -> Header {
+        Header { stamp, frame_id: self.frame(name) }
+    }
+
+    /// A rate limiter for one topic group.
+    pub(crate) fn limiter(&self) -> RateLimiter {
+        RateLimiter { period: self.options.rate_cap_hz.map(|hz| Duration::from_secs_f64(1.0 / hz)), last: None }
+    }
+}
+
+/// Now as a ROS time (wall clock, what ROS 2 nodes stamp with by default).
+pub(crate) fn stamp_now() -> Time {
+    let since = SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default();
+    Time::from_nanos(u64::try_from(since.as_nanos()).unwrap_or(u64::MAX))
+}
+
+/// Lets a publish through at most once per period.
+#[derive(Debug)]
+pub(crate) struct RateLimiter {
+    period: Option<Duration>,
+    last: Option<Instant>,
+}
+
+impl RateLimiter {
+    /// Whether to publish at `now` (and if so, counts it as published).
+    pub(crate) fn ready(&mut self, now: Instant) -> bool {
+        let due = match (self.period, self.last) {
+            (Some(period), Some(last)) => now.saturating_duration_since(last) >= period,
+            _ => true,
+        };
+        if due {
+            self.last = Some(now);
+        }
+        due
+    }
+}
+
+/// Logs at most once per second per call site's limiter; the rest are counted in `suppressed`.
+#[derive(Debug, Default)]
+pub(crate) struct LogLimiter {
+    last: Option<Instant>,
+    suppressed: u64,
+}
+
+impl LogLimiter {
+    pub(crate) fn log(&mut self, now: Instant, message: impl FnOnce() -> String) {
+        if self.last.is_some_and(|last| now.saturating_duration_since(last) < Duration::from_secs(1)) {
+            self.suppressed += 1;
+            return;
+        }
+        let more = std::mem::take(&mut self.suppressed);
+        let suffix = if more > 0 { format!(" ({more} more since the last report)") } else { String::new() };
+        eprintln!("{}{suffix}", message());
+        self.last = Some(now);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rate_cap_lets_one_through_per_period() {
+        let mut limiter = RateLimiter { period: Some(Duration::from_millis(100)), last: None };
+        let t0 = Instant::now();
+        assert!(limiter.ready(t0));
+        assert!(!limiter.ready(t0 + Duration::from_millis(99)));
+        assert!(limiter.ready(t0 + Duration::from_millis(100)));
+        let mut native = RateLimiter { period: None, last: None };
+        assert!(native.ready(t0) && native.ready(t0));
+    }
+}

@@ -1,0 +1,131 @@
+//! `robowire ros2`: every device as a ROS 2 node, on the wire, without a ROS installation.
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::Args;
+use robowire_ros2::{BridgeOptions, DeviceAddress};
+use serde::Serialize;
+
+#[derive(Debug, Args)]
+pub(crate) struct Ros2Args {
+    /// A device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, or sim:kmc|zsl1|zsl1w|go2
+    /// for a simulator. Repeat for several devices.
+    #[arg(long = "device", required = true, value_name = "ADDRESS")]
+    devices: Vec<DeviceAddress>,
+    /// Namespace of the topics (several devices: NS/KIND INDEX each).
+    #[arg(long)]
+    namespace: Option<String>,
+    /// DDS domain (ROS_DOMAIN_ID).
+    #[arg(long, default_value_t = 0)]
+    domain: u16,
+    /// Network interface for DDS (e.g. eth0).
+    #[arg(long)]
+    interface: Option<String>,
+    /// Let cmd_vel move the robots. Without it the bridge only publishes.
+    #[arg(long)]
+    arm: bool,
+    /// Seconds after the last cmd_vel at which the robot is stopped.
+    #[arg(long, default_value_t = 0.5)]
+    deadman: f64,
+    /// Publish each topic at most this often, Hz (default: the device's native rate).
+    #[arg(long)]
+    rate: Option<f64>,
+    /// Stop after this many seconds (default: at Ctrl-C or SIGTERM).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// At the end, print each device's counters as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct DeviceJson {
+    device: String,
+    namespace: String,
+    #[serde(flatten)]
+    counters: robowire_ros2::DeviceCounters,
+}
+
+pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.deadman.is_finite() && args.deadman > 0.0 && args.deadman <= 60.0,
+        "--deadman must be in (0, 60] s, got {}",
+        args.deadman
+    );
+    let duration = match args.duration {
+        Some(s) if s.is_finite() && (0.0..=1e6).contains(&s) => Some(Duration::from_secs_f64(s)),
+        Some(s) => anyhow::bail!("--duration must be 0–1e6 s, got {s}"),
+        None => None,
+    };
+    let options = BridgeOptions {
+        namespace: args.namespace.clone(),
+        domain: args.domain,
+        interface: args.interface.clone(),
+        armed: args.arm,
+        deadman: Duration::from_secs_f64(args.deadman),
+        rate_cap_hz: args.rate,
+        ..BridgeOptions::new(args.devices.clone())
+    };
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+    let devices = runtime.block_on(async {
+        let (stop_tx, stop) = tokio::sync::watch::channel(false);
+        let stopper = tokio::spawn(async move {
+            let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+            let timeout = async {
+                match duration {
+                    Some(d) => tokio::time::sleep(d).await,
+                    None => std::future::pending().await,
+                }
+            };
+            tokio::select! {
+                signal = tokio::signal::ctrl_c() => signal?,
+                _ = term.recv() => {}
+                () = timeout => {}
+            }
+            let _ = stop_tx.send(true);
+            anyhow::Ok(())
+        });
+        let armed = if args.arm { "armed: cmd_vel moves the robots" } else { "not armed: publishing only" };
+        let devices = robowire_ros2::run(options, stop, |devices| {
+            for d in devices {
+                let ns = if d.namespace.is_empty() { "/" } else { &d.namespace };
+                eprintln!("ros2: {:?} as {ns} on domain {}", d.address, args.domain);
+            }
+            eprintln!("ros2: ready ({armed})");
+        })
+        .await
+        .context("the ROS 2 bridge")?;
+        stopper.abort();
+        anyhow::Ok(devices)
+    })?;
+    let report: Vec<DeviceJson> = devices
+        .iter()
+        .map(|d| DeviceJson {
+            device: format!("{:?}", d.address),
+            namespace: d.namespace.clone(),
+            counters: d.counters(),
+        })
+        .collect();
+    for d in &report {
+        let c = &d.counters;
+        eprintln!(
+            "ros2: {} published {} samples, answered {} service calls; cmd_vel: {} received, {} applied, {} unarmed, {} invalid, {} refused, {} deadman stops, {} publishers",
+            d.device,
+            c.published,
+            c.service_calls,
+            c.cmd_vel.received,
+            c.cmd_vel.applied,
+            c.cmd_vel.unarmed,
+            c.cmd_vel.invalid,
+            c.cmd_vel.refused,
+            c.cmd_vel.deadman_stops,
+            c.cmd_vel.publishers
+        );
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    }
+    Ok(ExitCode::SUCCESS)
+}

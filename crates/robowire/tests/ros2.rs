@@ -1,0 +1,189 @@
+//! `robowire ros2` against a ROS 2 peer on CycloneDDS (the `cyclonedds` Python binding 0.10.2
+//! with the ROS 2 message types declared under their ROS 2 DDS names, `tests/ros2_interop/`),
+//! in a private network namespace (root): the peer drives a simulated chassis and dog through
+//! `cmd_vel`, sees them move on `odom` and stop after the deadman time, reads `joint_states`,
+//! `imu`, `battery_state` and `tf` field for field, calls `stand_up` in rmw_cyclonedds'
+//! request/reply format; unarmed, the same `cmd_vel` moves nothing.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use robowire_dds::netns::in_loopback_namespace;
+use serde_json::Value;
+
+/// `robowire ros2 ARGS`, started and waited for (its "ready" line).
+struct Bridge(Child);
+
+impl Bridge {
+    fn start(args: &[&str]) -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_robowire"))
+            .arg("ros2")
+            .args(args)
+            .arg("--json")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stderr = BufReader::new(child.stderr.take().unwrap());
+        let mut line = String::new();
+        loop {
+            line.clear();
+            assert!(stderr.read_line(&mut line).unwrap() > 0, "robowire ros2 ended before it was ready");
+            if line.starts_with("ros2: ready") {
+                break;
+            }
+        }
+        // Keep draining its log so that it never blocks on a full pipe.
+        std::thread::spawn(move || std::io::copy(&mut stderr, &mut std::io::sink()));
+        Self(child)
+    }
+
+    /// Ctrl-C, then its counters (the `--json` line): one object per device.
+    fn stop(mut self) -> Vec<Value> {
+        rustix::process::kill_process(rustix::process::Pid::from_child(&self.0), rustix::process::Signal::INT).unwrap();
+        let mut out = String::new();
+        self.0.stdout.take().unwrap().read_to_string(&mut out).unwrap();
+        assert!(self.0.wait().unwrap().success());
+        serde_json::from_str(out.trim()).unwrap_or_else(|e| panic!("{e}: {out}"))
+    }
+}
+
+impl Drop for Bridge {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn interop_python() -> PathBuf {
+    robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"))
+}
+
+/// Runs the ROS 2 peer's `scenario` on `namespace`; its JSON.
+fn peer(python: &Path, scenario: &str, namespace: &str) -> Value {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/ros2_interop");
+    let out = Command::new(python).arg("ros2_peer.py").args([scenario, namespace]).current_dir(dir).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{scenario}: {}\n{stdout}\n{}", out.status, String::from_utf8_lossy(&out.stderr));
+    serde_json::from_str(stdout.lines().last().unwrap_or_default()).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// The deadman time given to the bridge, and the time a robot needs to coast to a stop.
+const DEADMAN_S: f64 = 0.5;
+const SETTLE_S: f64 = 1.0;
+
+#[test]
+fn a_cyclonedds_peer_drives_senses_and_calls_services_on_two_devices() {
+    let python = interop_python();
+    in_loopback_namespace(|| {
+        let bridge = Bridge::start(&["--device", "sim:kmc", "--device", "sim:zsl1", "--arm", "--deadman", "0.5"]);
+
+        let kmc = peer(&python, "drive", "/kmc0");
+        assert!(f(&kmc["max_speed"]) > 0.4, "the chassis reached the commanded 0.5 m/s: {kmc}");
+        assert!(f(&kmc["moved_m"]) > 0.3, "and moved forward in odom: {kmc}");
+        let still = f(&kmc["still_after_s"]);
+        assert!(still <= DEADMAN_S + SETTLE_S, "stopped within the deadman time and the coast: {kmc}");
+        assert_eq!(kmc["frame_id"], "kmc0/odom");
+        assert_eq!(kmc["child_frame_id"], "kmc0/base_link");
+
+        let chassis = peer(&python, "sense_chassis", "/kmc0");
+        let volts = f(&chassis["battery"]["voltage"]);
+        assert!((20.0..=26.0).contains(&volts), "the simulated pack: {chassis}");
+        assert!(chassis["battery"]["percentage"].is_null(), "not reported by the chassis: {chassis}");
+        let status = &chassis["diagnostics"]["status"][0];
+        assert_eq!(status["level"], 0, "{chassis}");
+        assert!(status["name"].as_str().unwrap().starts_with("kmc0/motor "), "{chassis}");
+        let keys: Vec<&str> =
+            status["values"].as_array().unwrap().iter().map(|kv| kv["key"].as_str().unwrap()).collect();
+        assert_eq!(keys, ["position_deg", "speed_rpm", "current_a", "temperature_c", "error_code"]);
+
+        let dog = peer(&python, "stand_and_drive", "/zsl1_0");
+        assert_eq!(dog["stand_up"]["success"], true, "{dog}");
+        assert_eq!(dog["stand_up"]["guid_matches"], true, "the reply carries the request's header: {dog}");
+        assert_eq!(dog["stand_up"]["seq"], 1);
+        assert!(f(&dog["max_speed"]) > 0.4, "the dog walked: {dog}");
+        assert!(f(&dog["still_after_s"]) <= DEADMAN_S + SETTLE_S, "and stopped: {dog}");
+
+        let seen = peer(&python, "sense", "/zsl1_0");
+        let joints = &seen["joint_states"];
+        let names: Vec<&str> = joints["name"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+        assert_eq!(names.len(), 12);
+        assert_eq!(names[..3], ["FR_abad", "FR_hip", "FR_knee"]);
+        assert_eq!(names[9..], ["RL_abad", "RL_hip", "RL_knee"]);
+        let position: Vec<f64> = joints["position"].as_array().unwrap().iter().map(f).collect();
+        assert_eq!(position.len(), 12);
+        assert!(position.chunks(3).all(|leg| leg == &position[..3]), "four legs in one pose: {position:?}");
+        assert!(position[2] < -0.5, "a folded knee: {position:?}");
+        assert_eq!(joints["header"]["frame_id"], "zsl1_0/base_link");
+        let imu = &seen["imu"];
+        assert_eq!(f(&imu["linear_acceleration"]["z"]), f64::from(9.81f32), "gravity, the f32 the dog sent");
+        assert_eq!(f(&imu["orientation"]["w"]), 1.0);
+        assert_eq!(imu["header"]["frame_id"], "zsl1_0/imu_link");
+        assert!(imu["header"]["stamp"]["sec"].as_i64().unwrap() > 1_600_000_000, "wall-clock stamps");
+        let battery = &seen["battery_state"];
+        assert!((0.0..=1.0).contains(&f(&battery["percentage"])), "{battery}");
+        assert!(battery["voltage"].is_null(), "not measured by the dog: NaN, as ROS specifies: {battery}");
+        let tf = &seen["tf"]["transforms"][0];
+        assert_eq!(
+            (&tf["header"]["frame_id"], &tf["child_frame_id"]),
+            (&"zsl1_0/odom".into(), &"zsl1_0/base_link".into())
+        );
+
+        let counters = bridge.stop();
+        let (kmc, dog) = (&counters[0], &counters[1]);
+        assert_eq!((kmc["namespace"].as_str(), dog["namespace"].as_str()), (Some("/kmc0"), Some("/zsl1_0")));
+        for device in [kmc, dog] {
+            let cmd_vel = &device["cmd_vel"];
+            assert!(cmd_vel["applied"].as_u64().unwrap() > 10, "{device}");
+            assert_eq!(cmd_vel["deadman_stops"], 1, "{device}");
+            assert_eq!(cmd_vel["unarmed"], 0);
+        }
+        assert_eq!(dog["service_calls"], 1, "the one stand_up");
+    })
+    .expect("a private network namespace (run as root)");
+}
+
+#[test]
+fn unarmed_the_same_cmd_vel_moves_nothing() {
+    let python = interop_python();
+    in_loopback_namespace(|| {
+        let bridge = Bridge::start(&["--device", "sim:kmc"]);
+        let seen = peer(&python, "drive", "");
+        assert_eq!(f(&seen["max_speed"]), 0.0, "{seen}");
+        assert_eq!(f(&seen["moved_m"]), 0.0, "{seen}");
+        let counters = bridge.stop();
+        let cmd_vel = &counters[0]["cmd_vel"];
+        assert!(cmd_vel["received"].as_u64().unwrap() > 10, "the twists arrived: {cmd_vel}");
+        assert_eq!(cmd_vel["unarmed"], cmd_vel["received"]);
+        assert_eq!(cmd_vel["applied"], 0);
+    })
+    .expect("a private network namespace (run as root)");
+}
+
+#[test]
+fn a_go2_publishes_joint_states_and_passes_lowstate_through() {
+    let python = interop_python();
+    in_loopback_namespace(|| {
+        let bridge = Bridge::start(&["--device", "sim:go2", "--interface", "lo", "--namespace", "dog"]);
+        let seen = peer(&python, "sense_go2", "/dog");
+        let names: Vec<&str> = seen["names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+        assert_eq!(names[..3], ["FR_hip_joint", "FR_thigh_joint", "FR_calf_joint"]);
+        assert_eq!(names.len(), 12);
+        assert_eq!(seen["crc_ok"], true, "Unitree's CRC accepts the passed-through LowState: {seen}");
+        // The same LowState's joints (f32) on both topics, as f64 on joint_states.
+        let q =
+            |key: &str| seen[key].as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect::<Vec<_>>();
+        assert_eq!(q("position").len(), 12);
+        assert!(q("position").iter().zip(q("lowstate_q")).all(|(a, b)| (a - b).abs() < 0.05), "{seen}");
+        assert_eq!(seen["imu_w"].as_f64().unwrap() as f32, seen["lowstate_quaternion_w"].as_f64().unwrap() as f32);
+        let counters = bridge.stop();
+        assert!(counters[0]["published"].as_u64().unwrap() > 100);
+        assert_eq!(counters[0]["namespace"], "/dog");
+    })
+    .expect("a private network namespace (run as root)");
+}

@@ -1,0 +1,170 @@
+"""A ROS 2 peer on CycloneDDS (no ROS install): drives `robowire ros2` the way a ROS 2 node on
+rmw_cyclonedds would, and prints what it saw as one JSON line.
+
+    python ros2_peer.py SCENARIO NAMESPACE
+
+Scenarios:
+- drive: publishes geometry_msgs/Twist on rt/NS/cmd_vel at 20 Hz for 2 s, then nothing; reads
+  rt/NS/odom throughout (speeds while driving, after the deadman, the last pose).
+- sense: reads one sample of each of rt/NS/joint_states, rt/NS/imu, rt/NS/battery_state,
+  rt/NS/tf, rt/NS/odom, field for field.
+- stand_up: calls the std_srvs/Trigger service NS/stand_up (rq/…Request, rr/…Reply).
+- stand_and_drive: stand_up, then drive (a dog must stand before it walks).
+- sense_chassis: rt/NS/battery_state and rt/NS/diagnostics of a KMC chassis.
+- sense_go2: rt/NS/joint_states and rt/NS/imu of a Go2, and rt/NS/lowstate with Unitree's class.
+"""
+
+import json
+import sys
+import time
+from dataclasses import asdict
+
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+from ros2_types import BatteryState, DiagnosticArray, Imu, JointState, Odometry, TFMessage, TriggerRequest, TriggerResponse, Twist, Vector3
+
+RELIABLE = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.History.KeepLast(10))
+SENSOR = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(5))
+
+
+def topic(ns, name):
+    return f"rt{ns}/{name}"
+
+
+def take_one(reader, timeout_s=10.0):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        for sample in reader.take(N=1):
+            return sample
+        time.sleep(0.005)
+    raise SystemExit(f"nothing on {reader.topic.name} within {timeout_s} s")
+
+
+def latest(reader):
+    samples = reader.take(N=100)
+    return samples[-1] if samples else None
+
+
+def stand_and_drive(dp, ns):
+    stood = stand_up(dp, ns)
+    time.sleep(2.0)  # standing up takes the dog about 1.2 s
+    return {"stand_up": stood, **drive(dp, ns)}
+
+
+def drive(dp, ns):
+    writer = DataWriter(dp, Topic(dp, topic(ns, "cmd_vel"), Twist), qos=RELIABLE)
+    odom = DataReader(dp, Topic(dp, topic(ns, "odom"), Odometry), qos=RELIABLE)
+    first = take_one(odom)
+    start_x = first.pose.pose.position.x
+    twist = Twist(linear=Vector3(x=0.5), angular=Vector3(z=0.0))
+    speeds = []
+    last = first
+    end = time.monotonic() + 2.0
+    while time.monotonic() < end:
+        writer.write(twist)
+        time.sleep(0.05)
+        sample = latest(odom)
+        if sample:
+            speeds.append(sample.twist.twist.linear.x)
+            last = sample
+    stopped_at = time.monotonic()
+    after = []
+    while time.monotonic() < stopped_at + 2.0:
+        time.sleep(0.05)
+        sample = latest(odom)
+        if sample:
+            after.append((time.monotonic() - stopped_at, sample.twist.twist.linear.x))
+            last = sample
+    return {
+        "max_speed": max(speeds, default=0.0),
+        "speed_after_2s": after[-1][1] if after else None,
+        "still_after_s": next((t for t, v in after if abs(v) < 0.02), None),
+        "moved_m": last.pose.pose.position.x - start_x,
+        "frame_id": first.header.frame_id,
+        "child_frame_id": first.child_frame_id,
+    }
+
+
+def sense_chassis(dp, ns):
+    """The chassis's battery_state and per-motor diagnostics."""
+    battery = take_one(DataReader(dp, Topic(dp, topic(ns, "battery_state"), BatteryState), qos=SENSOR))
+    diagnostics = take_one(DataReader(dp, Topic(dp, topic(ns, "diagnostics"), DiagnosticArray), qos=RELIABLE))
+    return {"battery": asdict(battery), "diagnostics": asdict(diagnostics)}
+
+
+def sense(dp, ns):
+    readers = {
+        "joint_states": DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR),
+        "imu": DataReader(dp, Topic(dp, topic(ns, "imu"), Imu), qos=SENSOR),
+        "battery_state": DataReader(dp, Topic(dp, topic(ns, "battery_state"), BatteryState), qos=SENSOR),
+        "tf": DataReader(dp, Topic(dp, topic(ns, "tf"), TFMessage), qos=RELIABLE),
+        "odom": DataReader(dp, Topic(dp, topic(ns, "odom"), Odometry), qos=RELIABLE),
+    }
+    out = {}
+    for name, reader in readers.items():
+        out[name] = asdict(take_one(reader))
+    return out
+
+
+def sense_go2(dp, ns):
+    """joint_states and imu from the Go2's LowState, and the LowState itself passed through as
+    unitree_go/msg/LowState (read with Unitree's own IDL class, its CRC checked by Unitree's code)."""
+    from unitree_sdk2py.idl.unitree_go.msg.dds_ import LowState_
+    from unitree_sdk2py.utils.crc import CRC
+
+    joints = take_one(DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR))
+    imu = take_one(DataReader(dp, Topic(dp, topic(ns, "imu"), Imu), qos=SENSOR))
+    low = take_one(DataReader(dp, Topic(dp, topic(ns, "lowstate"), LowState_), qos=SENSOR))
+    return {
+        "names": joints.name,
+        "position": joints.position,
+        "lowstate_q": [m.q for m in low.motor_state[:12]],
+        "crc_ok": CRC().Crc(low) == low.crc,
+        "imu_w": imu.orientation.w,
+        "lowstate_quaternion_w": low.imu_state.quaternion[0],
+    }
+
+
+def stand_up(dp, ns):
+    requests = DataWriter(dp, Topic(dp, f"rq{ns}/stand_upRequest", TriggerRequest), qos=RELIABLE)
+    replies = DataReader(dp, Topic(dp, f"rr{ns}/stand_upReply", TriggerResponse), qos=RELIABLE)
+    time.sleep(1.0)  # discovery both ways before the request
+    guid = 0x1234_5678_9ABC_DEF0
+    requests.write(TriggerRequest(guid=guid, seq=1))
+    reply = take_one(replies)
+    return {"guid_matches": reply.guid == guid, "seq": reply.seq, "success": reply.success, "message": reply.message}
+
+
+def no_nan(value):
+    """JSON has no NaN: ROS's "not measured" becomes null."""
+    if isinstance(value, float) and value != value:
+        return None
+    if isinstance(value, dict):
+        return {k: no_nan(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [no_nan(v) for v in value]
+    return value
+
+
+def main():
+    scenario, ns = sys.argv[1], sys.argv[2]
+    dp = DomainParticipant(0)
+    scenarios = {
+        "drive": drive,
+        "stand_and_drive": stand_and_drive,
+        "sense": sense,
+        "sense_go2": sense_go2,
+        "sense_chassis": sense_chassis,
+        "stand_up": stand_up,
+    }
+    result = scenarios[scenario](dp, ns)
+    print(json.dumps(no_nan(result), allow_nan=False))
+
+
+if __name__ == "__main__":
+    main()
