@@ -47,13 +47,20 @@ fn device(
     std::thread::spawn(move || {
         let mut got = Vec::new();
         let mut noise = 0;
-        loop {
+        // Every pending order; `true` on Stop. Called again after a receive: an order sent before
+        // the host wrote its request is then in the channel, so noise ordered first goes out first.
+        let take_orders = |device: &mut PtyDevice<HostFrameDecoder>, noise: &mut usize| loop {
             match orders.try_recv() {
-                Ok(Do::Noise(n)) => noise += n,
+                Ok(Do::Noise(n)) => *noise += n,
                 Ok(Do::HangUp) => device.hang_up(),
                 Ok(Do::PlugIn(pty)) => device.plug_in(pty).unwrap(),
-                Ok(Do::Stop) | Err(mpsc::TryRecvError::Disconnected) => return (got, device.counters()),
-                Err(mpsc::TryRecvError::Empty) => {}
+                Ok(Do::Stop) | Err(mpsc::TryRecvError::Disconnected) => return true,
+                Err(mpsc::TryRecvError::Empty) => return false,
+            }
+        };
+        loop {
+            if take_orders(&mut device, &mut noise) {
+                return (got, device.counters());
             }
             let mut answers = Vec::new();
             device
@@ -72,6 +79,9 @@ fn device(
                 })
                 .unwrap();
             if !answers.is_empty() {
+                if take_orders(&mut device, &mut noise) {
+                    return (got, device.counters());
+                }
                 let mut out = vec![0x11; std::mem::take(&mut noise)];
                 out.extend(answers);
                 device.send(&out, WATCHDOG).unwrap();
