@@ -45,7 +45,44 @@ pub const TARGETS: &[Target] = &[
         check: lowcmd_proto::decode_roundtrip::cdr_decode,
     },
     Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::decode_roundtrip::datagram_decode },
+    Target { name: "mcap_replay_read", seeds: capture_seeds, check: robowire_record::fuzz_read },
 ];
+
+/// Which datagrams a capture seed keeps.
+type Keep = fn(&[u8]) -> bool;
+
+/// Capture seeds: recorded exchanges of the captured ZSL-1 datagrams (all of them both ways,
+/// HighLevel only, LowLevel only) and an empty capture.
+fn capture_seeds() -> Seeds {
+    let datagrams = zsl1_seeds()?;
+    let low_level = |d: &[u8]| matches!(d.len(), 248 | 272);
+    // Which datagrams each seed keeps: all, HighLevel, LowLevel, none.
+    let variants: [(&str, Keep); 4] = [
+        ("seed-all", |_| true),
+        ("seed-high-level", |d| !matches!(d.len(), 248 | 272)),
+        ("seed-low-level", |d| matches!(d.len(), 248 | 272)),
+        ("seed-empty", |_| false),
+    ];
+    variants
+        .into_iter()
+        .map(|(name, keep)| {
+            let path = std::env::temp_dir().join(format!("robowire-fuzz-{name}-{}.mcap", std::process::id()));
+            let recorder = robowire_record::Recorder::create(&path, "cargo xtask fuzz (seed)")?;
+            let high = recorder.link("dog/high_level", robowire_record::Protocol::ZslHighLevel);
+            let low = recorder.link("dog/low_level", robowire_record::Protocol::ZslLowLevel);
+            for (i, (_, bytes)) in datagrams.iter().enumerate().filter(|(_, (_, d))| keep(d)) {
+                let tap = if low_level(bytes) { &low } else { &high };
+                let direction =
+                    if i % 2 == 0 { robowire_record::Direction::Sent } else { robowire_record::Direction::Received };
+                tap.record(direction, bytes);
+            }
+            recorder.finish()?;
+            let capture = std::fs::read(&path)?;
+            let _ = std::fs::remove_file(&path);
+            Ok((name.to_string(), capture))
+        })
+        .collect()
+}
 
 /// ZSL-1 seeds: every captured datagram.
 fn zsl1_seeds() -> Seeds {

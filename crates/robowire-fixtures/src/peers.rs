@@ -1,6 +1,6 @@
 //! The vendors' own software as the other end of the wire in interop tests
 //! (`../shared/peers/`, see its README): a CPython 3.10 environment with `cyclonedds` 0.10.2
-//! (Unitree's pin; its wheel bundles libddsc), numpy, and Unitree's Python SDK installed as its
+//! (Unitree's pin; its wheel bundles libddsc), numpy, mcap (the capture reader) and Unitree's Python SDK installed as its
 //! README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
 //! tree stays untouched).
 //!
@@ -13,6 +13,8 @@ use std::process::Command;
 
 /// `cyclonedds` on PyPI: the version Unitree's SDK pins.
 pub const CYCLONEDDS_VERSION: &str = "0.10.2";
+/// The `mcap` Python package: the independent reader of robowire's captures.
+pub const MCAP_PY_VERSION: &str = "1.6.0";
 
 /// The workspace root.
 fn workspace() -> PathBuf {
@@ -103,7 +105,8 @@ pub fn unitree_python() -> Result<PathBuf, String> {
     lock.lock().map_err(|e| format!("locking {}: {e}", dir.display()))?;
     let venv = dir.join("py310");
     let python = venv.join("bin/python");
-    let stamp = venv.join(".robowire-ready");
+    // Versioned: an environment made before a package was added is made again.
+    let stamp = venv.join(".robowire-ready-2");
     if stamp.exists() {
         return Ok(python);
     }
@@ -118,7 +121,10 @@ pub fn unitree_python() -> Result<PathBuf, String> {
         c.args(["-m", "pip", "install", "-q", "--disable-pip-version-check"]).args(args);
         c
     };
-    run("pip install cyclonedds numpy", &mut pip(&[&format!("cyclonedds=={CYCLONEDDS_VERSION}"), "numpy"]))?;
+    run(
+        "pip install cyclonedds numpy mcap",
+        &mut pip(&[&format!("cyclonedds=={CYCLONEDDS_VERSION}"), "numpy", &format!("mcap=={MCAP_PY_VERSION}")]),
+    )?;
     let copy = dir.join("unitree_sdk2_python");
     let _ = std::fs::remove_dir_all(&copy);
     copy_tree(&sdk, &copy).map_err(|e| format!("copying the SDK: {e}"))?;

@@ -6,6 +6,7 @@ use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 
 use robowire_core::DatagramCodec;
+use robowire_tap::{Direction, Tap};
 use tokio::net::UdpSocket;
 
 use crate::stats::{Counters, StatsHandle};
@@ -93,6 +94,7 @@ impl<C: DatagramCodec + Clone> UdpLink<C> {
             codec: codec.clone(),
             buf: vec![0; C::MAX_DATAGRAM_LEN].into_boxed_slice(),
             counters: counters.clone(),
+            tap: None,
         };
         // One byte more than the longest datagram, so that an over-long one is seen as such
         // by the codec instead of being silently truncated by the kernel.
@@ -103,6 +105,7 @@ impl<C: DatagramCodec + Clone> UdpLink<C> {
             codec,
             buf: vec![0; C::MAX_DATAGRAM_LEN + 1].into_boxed_slice(),
             counters,
+            tap: None,
         };
         Ok(Self { sender, receiver })
     }
@@ -134,6 +137,13 @@ impl<C: DatagramCodec> UdpLink<C> {
         self.sender.counters.snapshot()
     }
 
+    /// Hands every datagram sent and accepted from now on to `tap` (`None`: stop); the frames
+    /// carry their direction.
+    pub fn set_tap(&mut self, tap: Option<Tap>) {
+        self.sender.set_tap(tap.clone());
+        self.receiver.set_tap(tap);
+    }
+
     /// A handle to the counters that outlives the link's halves.
     pub fn stats_handle(&self) -> StatsHandle {
         StatsHandle(self.sender.counters.clone())
@@ -154,6 +164,7 @@ pub struct UdpSender<C> {
     codec: C,
     buf: Box<[u8]>,
     counters: Arc<Counters>,
+    tap: Option<Tap>,
 }
 
 impl<C> fmt::Debug for UdpSender<C> {
@@ -177,10 +188,14 @@ impl<C: DatagramCodec> UdpSender<C> {
         }
     }
 
-    fn count(&self, result: io::Result<usize>) -> Result<(), UdpError<C::Error>> {
+    /// Counts a send of `len` bytes of `buf` (or of `bytes`), and hands them to the tap.
+    fn count(&self, result: io::Result<usize>, sent: &[u8]) -> Result<(), UdpError<C::Error>> {
         match result {
             Ok(_) => {
                 Counters::bump(&self.counters.sent);
+                if let Some(tap) = &self.tap {
+                    tap.record(Direction::Sent, sent);
+                }
                 Ok(())
             }
             Err(e) => {
@@ -194,7 +209,7 @@ impl<C: DatagramCodec> UdpSender<C> {
     pub async fn send(&mut self, message: &C::Outgoing) -> Result<(), UdpError<C::Error>> {
         let (len, to) = self.encode(message)?;
         let result = self.socket.send_to(&self.buf[..len], to).await;
-        self.count(result)
+        self.count(result, &self.buf[..len])
     }
 
     /// Encodes `message` and sends it now, from any thread, without a runtime: one
@@ -203,7 +218,7 @@ impl<C: DatagramCodec> UdpSender<C> {
     pub fn send_now(&mut self, message: &C::Outgoing) -> Result<(), UdpError<C::Error>> {
         let (len, to) = self.encode(message)?;
         let result = self.sync_socket.send_to(&self.buf[..len], to);
-        self.count(result)
+        self.count(result, &self.buf[..len])
     }
 
     /// The address the socket is bound to.
@@ -216,12 +231,17 @@ impl<C: DatagramCodec> UdpSender<C> {
     pub fn send_bytes_now(&mut self, bytes: &[u8]) -> Result<(), UdpError<C::Error>> {
         let to = self.destination().ok_or_else(|| self.refused(UdpError::NoPeer))?;
         let result = self.sync_socket.send_to(bytes, to);
-        self.count(result)
+        self.count(result, bytes)
     }
 
     /// Where messages go now (`None` on a [`Peer::Any`] link that has heard nobody yet).
     pub fn destination(&self) -> Option<SocketAddr> {
         destination(&self.destination)
+    }
+
+    /// Hands every datagram sent from now on to `tap` (`None`: stop).
+    pub fn set_tap(&mut self, tap: Option<Tap>) {
+        self.tap = tap;
     }
 
     /// The counters now.
@@ -238,6 +258,7 @@ pub struct UdpReceiver<C> {
     codec: C,
     buf: Box<[u8]>,
     counters: Arc<Counters>,
+    tap: Option<Tap>,
 }
 
 impl<C> fmt::Debug for UdpReceiver<C> {
@@ -337,6 +358,9 @@ impl<C: DatagramCodec> UdpReceiver<C> {
             return None;
         }
         Counters::bump(&self.counters.received);
+        if let Some(tap) = &self.tap {
+            tap.record(Direction::Received, &self.buf[..len]);
+        }
         Some(match self.codec.decode(&self.buf[..len]) {
             Ok(message) => {
                 if self.peer.learns() {
@@ -364,6 +388,11 @@ impl<C: DatagramCodec> UdpReceiver<C> {
     /// The counters now.
     pub fn stats(&self) -> LinkStats {
         self.counters.snapshot()
+    }
+
+    /// Hands every datagram accepted from the peer from now on to `tap` (`None`: stop).
+    pub fn set_tap(&mut self, tap: Option<Tap>) {
+        self.tap = tap;
     }
 
     /// The codec, for codecs that keep state (to reset it after a timeout, say).

@@ -36,9 +36,10 @@ enum Command {
     /// Look at the ZSL-1 spline daemon's shared memory (/spline_shm, /imu_shm).
     #[command(subcommand)]
     Shm(cmd::shm::ShmCommand),
-    /// Decode frames or messages from hex and print them.
-    #[command(subcommand)]
-    Decode(cmd::decode::DecodeCommand),
+    /// Decode frames or messages from hex and print them, or summarize a capture (--mcap).
+    Decode(cmd::decode::DecodeArgs),
+    /// Replay an MCAP capture into the decoders, at the recorded pace.
+    Replay(cmd::record::ReplayArgs),
     /// Encode a message from JSON and print its bytes in hex.
     #[command(subcommand)]
     Encode(cmd::encode::EncodeCommand),
@@ -58,7 +59,8 @@ fn main() -> ExitCode {
         Command::Dds(args) => cmd::dds::run(args),
         Command::Ros2(args) => cmd::ros2::run(args),
         Command::Shm(command) => cmd::shm::run(&command),
-        Command::Decode(command) => cmd::decode::run(&command),
+        Command::Decode(args) => cmd::decode::run(&args),
+        Command::Replay(args) => cmd::record::replay(&args),
         Command::Encode(command) => cmd::encode::run(&command),
     };
     match result {

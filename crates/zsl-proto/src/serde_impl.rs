@@ -139,3 +139,15 @@ impl Serialize for LowLevelState {
         map.end()
     }
 }
+
+/// The datagram inside, as its own JSON form.
+impl Serialize for crate::udp::AnyDatagram {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Self::HighLevelCommand(d) => d.serialize(s),
+            Self::HighLevelState(d) => d.serialize(s),
+            Self::LowLevelCommand(d) => d.serialize(s),
+            Self::LowLevelState(d) => d.serialize(s),
+        }
+    }
+}

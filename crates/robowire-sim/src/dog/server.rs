@@ -40,6 +40,10 @@ pub struct DogSimConfig {
     pub state_period: Duration,
     /// Pin the simulator's threads to this CPU (Linux), to keep them off a control loop's core.
     pub cpu: Option<usize>,
+    /// Hand every HighLevel datagram sent and received to a recorder. Default `None`.
+    pub high_level_tap: Option<robowire_tap::Tap>,
+    /// Hand every LowLevel datagram sent and received to a recorder. Default `None`.
+    pub low_level_tap: Option<robowire_tap::Tap>,
 }
 
 impl Default for DogSimConfig {
@@ -52,6 +56,8 @@ impl Default for DogSimConfig {
             model: Model::Zsl1,
             state_period: Duration::from_millis(2),
             cpu: None,
+            high_level_tap: None,
+            low_level_tap: None,
         }
     }
 }
@@ -211,14 +217,16 @@ fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<
         io::Error::new(kind, format!("dog simulator cannot bind {}:{port}: {}", config.bind, error_chain(&e)))
     };
     runtime.block_on(async {
-        let high =
+        let mut high =
             UdpLink::bind(SocketAddr::new(config.bind, config.high_level_port), reply, HighLevelDogCodec::default())
                 .await
                 .map_err(|e| bind_error(config.high_level_port, e))?;
-        let low =
+        let mut low =
             UdpLink::bind(SocketAddr::new(config.bind, config.low_level_port), reply, LowLevelDogCodec::default())
                 .await
                 .map_err(|e| bind_error(config.low_level_port, e))?;
+        high.set_tap(config.high_level_tap.clone());
+        low.set_tap(config.low_level_tap.clone());
         let (high_tx, high_rx) = high.into_split();
         let (low_tx, low_rx) = low.into_split();
         let shared = Shared {

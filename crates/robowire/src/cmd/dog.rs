@@ -52,6 +52,9 @@ pub(crate) struct DogArgs {
     /// Seconds to wait for the robot's first state.
     #[arg(long, default_value_t = 3.0)]
     connect_timeout_s: f64,
+    /// Record every datagram both ways, raw and decoded, into this MCAP file.
+    #[arg(long, value_name = "FILE.mcap")]
+    record: Option<std::path::PathBuf>,
     #[command(subcommand)]
     command: DogCommand,
 }
@@ -141,7 +144,12 @@ fn duration(name: &str, seconds: f64) -> anyhow::Result<Duration> {
 }
 
 async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
-    let dog = HighLevel::connect(options(&args)).await.context("starting the HighLevel client")?;
+    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire dog")?;
+    let mut options = options(&args);
+    if let Some(recorder) = &recorder {
+        options = options.with_tap(recorder.link("dog/high_level", robowire_record::Protocol::ZslHighLevel));
+    }
+    let dog = HighLevel::connect(options).await.context("starting the HighLevel client")?;
     let timeout = Duration::from_secs_f64(args.connect_timeout_s);
     if !dog.wait_connected(timeout).await {
         anyhow::bail!(
@@ -223,6 +231,8 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
         stats.header_anomalies,
         stats.disconnects
     );
+    dog.close().await;
+    crate::cmd::record::finish(recorder)?;
     Ok(if outcome { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 

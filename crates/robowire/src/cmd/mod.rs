@@ -8,6 +8,7 @@ pub(crate) mod encode;
 pub(crate) mod go2;
 pub(crate) mod kmc;
 pub(crate) mod live;
+pub(crate) mod record;
 pub(crate) mod ros2;
 pub(crate) mod shm;
 pub(crate) mod sim;

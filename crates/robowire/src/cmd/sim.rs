@@ -50,6 +50,9 @@ pub(crate) struct DogSimArgs {
     /// Print the simulator's state every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
+    /// Record every datagram both ways, raw and decoded, into this MCAP file.
+    #[arg(long, value_name = "FILE.mcap")]
+    record: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -180,13 +183,17 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
+    use robowire_record::Protocol;
     use robowire_sim::dog::{DogSim, DogSimConfig};
+    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire sim dog")?;
     let config = DogSimConfig {
         bind: args.bind,
         high_level_port: args.high_level_port,
         low_level_port: args.low_level_port,
         client: args.client,
         model: args.model.into(),
+        high_level_tap: recorder.as_ref().map(|r| r.link("dog/high_level", Protocol::ZslHighLevel)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("dog/low_level", Protocol::ZslLowLevel)),
         ..DogSimConfig::default()
     };
     let sim = DogSim::spawn(config).context("starting the dog simulator")?;
@@ -217,6 +224,8 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
             s.low_level.states_sent
         );
     })?;
+    drop(sim); // its links (and taps) closed before the capture is
+    crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)
 }
 

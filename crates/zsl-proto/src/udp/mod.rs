@@ -66,6 +66,52 @@ pub enum DatagramError {
     /// The output buffer is shorter than the datagram.
     #[error(transparent)]
     Buffer(#[from] BufferTooSmall),
+    /// No datagram has this length.
+    #[error(
+        "{found} bytes is no ZSL-1 datagram (40 HighLevel command, 560 HighLevel state, 248 LowLevel command, 272 LowLevel state)"
+    )]
+    Unknown {
+        /// Bytes given.
+        found: usize,
+    },
+}
+
+/// Any of the four datagrams, told by its length: what a capture or a pasted hex dump holds.
+// Variants as large as the datagrams: no allocation here (no_std), and a value is short-lived.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyDatagram {
+    /// 40 bytes, client → dog.
+    HighLevelCommand(HighLevelCommand),
+    /// 560 bytes, dog → client.
+    HighLevelState(HighLevelState),
+    /// 248 bytes, client → dog.
+    LowLevelCommand(LowLevelCommand),
+    /// 272 bytes, dog → client.
+    LowLevelState(LowLevelState),
+}
+
+impl AnyDatagram {
+    /// Decodes `bytes` strictly as the datagram of its length.
+    pub fn decode(bytes: &[u8]) -> Result<Self, DatagramError> {
+        Ok(match bytes.len() {
+            HighLevelCommand::LEN => Self::HighLevelCommand(HighLevelCommand::decode(bytes)?.0),
+            LowLevelCommand::LEN => Self::LowLevelCommand(LowLevelCommand::decode(bytes)?.0),
+            HighLevelState::LEN => Self::HighLevelState(HighLevelState::decode_strict(bytes)?),
+            LowLevelState::LEN => Self::LowLevelState(LowLevelState::decode_strict(bytes)?),
+            found => return Err(DatagramError::Unknown { found }),
+        })
+    }
+
+    /// The datagram's name: `HighLevelCommand`, `HighLevelState`, `LowLevelCommand`, `LowLevelState`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::HighLevelCommand(_) => "HighLevelCommand",
+            Self::HighLevelState(_) => "HighLevelState",
+            Self::LowLevelCommand(_) => "LowLevelCommand",
+            Self::LowLevelState(_) => "LowLevelState",
+        }
+    }
 }
 
 /// The robot model, told by the command magic.

@@ -32,6 +32,8 @@ pub struct ClientOptions {
     pub cpu_affinity: Option<usize>,
     /// Lock the process's memory (`mlockall`) when the stream starts.
     pub lock_memory: bool,
+    /// Hand every datagram sent and received to a recorder (`robowire-record`). Default `None`.
+    pub tap: Option<robowire_tap::Tap>,
 }
 
 /// Shortest accepted command period.
@@ -52,6 +54,7 @@ impl ClientOptions {
             realtime_priority: None,
             cpu_affinity: None,
             lock_memory: false,
+            tap: None,
         }
     }
 
@@ -63,6 +66,12 @@ impl ClientOptions {
     /// LowLevel: commands to `dog_ip:43900`.
     pub fn low_level(local_ip: IpAddr, local_port: u16, dog_ip: IpAddr) -> Self {
         Self::new(local_ip, local_port, dog_ip, LOW_LEVEL_PORT)
+    }
+
+    /// The same options, every datagram handed to `tap`.
+    pub fn with_tap(mut self, tap: robowire_tap::Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// Sets the model.

@@ -160,7 +160,8 @@ impl<I: Wire> Running<I> {
         let codec = Codec::<I>::new(options.model, options.state_decoding);
         // The robot's sending port is not documented (spec §2): accept state from any port of its
         // IP, nothing from anyone else.
-        let link = UdpLink::bind(options.local, Peer::AnyPortOf(options.dog), codec).await?;
+        let mut link = UdpLink::bind(options.local, Peer::AnyPortOf(options.dog), codec).await?;
+        link.set_tap(options.tap.clone());
         let local = link.local_addr().map_err(UdpError::from)?;
         let stats = link.stats_handle();
         let (sender, receiver) = link.into_split();

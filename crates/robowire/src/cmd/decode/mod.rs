@@ -9,11 +9,24 @@ pub(crate) mod zsl;
 
 use std::process::ExitCode;
 
-use clap::Subcommand;
+use clap::{Args, Subcommand};
 use serde::Serialize;
 use serde_json::Value;
 
 use unitree::UnitreeMessage;
+
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub(crate) struct DecodeArgs {
+    /// Summarize an MCAP capture instead: channels, counts, rates, gaps, decode errors.
+    #[arg(long, value_name = "FILE.mcap")]
+    mcap: Option<std::path::PathBuf>,
+    /// With --mcap: the summary as one JSON object.
+    #[arg(long, requires = "mcap")]
+    json: bool,
+    #[command(subcommand)]
+    command: Option<DecodeCommand>,
+}
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum DecodeCommand {
@@ -31,7 +44,12 @@ pub(crate) enum DecodeCommand {
     LowstateHg(unitree::DecodeArgs),
 }
 
-pub(crate) fn run(command: &DecodeCommand) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: &DecodeArgs) -> anyhow::Result<ExitCode> {
+    let command = match (&args.mcap, &args.command) {
+        (Some(path), _) => return crate::cmd::record::summarize(path, args.json),
+        (None, Some(command)) => command,
+        (None, None) => anyhow::bail!("give what to decode (kmc, zsl, lowcmd, …) or --mcap FILE"),
+    };
     match command {
         DecodeCommand::Kmc(args) => kmc::run(args),
         DecodeCommand::Zsl(args) => zsl::run(args),

@@ -2,10 +2,9 @@
 
 use std::process::ExitCode;
 
-use anyhow::bail;
 use clap::Args;
 use serde_json::Value;
-use zsl_proto::udp::{HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState};
+use zsl_proto::udp::AnyDatagram;
 
 use super::json_value;
 use crate::hex;
@@ -21,15 +20,7 @@ pub(crate) struct ZslDecodeArgs {
 
 /// The datagram as JSON (zsl-proto's `serde` form).
 fn decode(bytes: &[u8]) -> anyhow::Result<Value> {
-    match bytes.len() {
-        HighLevelCommand::LEN => json_value(&HighLevelCommand::decode(bytes)?.0),
-        LowLevelCommand::LEN => json_value(&LowLevelCommand::decode(bytes)?.0),
-        HighLevelState::LEN => json_value(&HighLevelState::decode_strict(bytes)?),
-        LowLevelState::LEN => json_value(&LowLevelState::decode_strict(bytes)?),
-        n => bail!(
-            "{n} bytes is no ZSL-1 datagram (40 HighLevel command, 560 HighLevel state, 248 LowLevel command, 272 LowLevel state)"
-        ),
-    }
+    json_value(&AnyDatagram::decode(bytes)?)
 }
 
 pub(super) fn run(args: &ZslDecodeArgs) -> anyhow::Result<ExitCode> {

@@ -1,0 +1,37 @@
+//! MCAP captures of robowire's links, and reading them back.
+//!
+//! A [`Recorder`] hands out a [`Tap`] per link ([`Recorder::link`]); the transports hand every
+//! frame they send or receive to it, and the recorder's thread writes each into two channels:
+//!
+//! - `/{link}/{sent|received}/raw`: the bytes exactly as on the wire (message encoding
+//!   [`RAW_ENCODING`], no schema), what [`read_frames`] and `robowire replay` read back;
+//! - `/{link}/{sent|received}`: the decoded message as JSON with a JSON schema, for Foxglove.
+//!
+//! A metadata record `robowire` names robowire's version, the command that recorded and each
+//! link's protocol. The queue between the links and the thread is bounded: a full queue drops
+//! frames (counted in [`RecordingSummary::dropped`]) rather than slowing a link.
+
+mod framing;
+mod protocol;
+mod read;
+mod schema;
+mod write;
+
+pub use protocol::Protocol;
+pub use read::{CaptureSummary, ChannelSummary, ReadError, RecordedFrame, read_frames, summarize};
+pub use robowire_tap::{Direction, Tap};
+pub use write::{RecordError, Recorder, RecordingSummary};
+
+/// The message encoding of the raw channels: the frame's bytes, as on the wire.
+pub const RAW_ENCODING: &str = "robowire.raw";
+
+/// The replay reader's check for the fuzz target: any bytes read as a capture give frames or a
+/// typed error, never a panic; what reads as frames also summarizes.
+pub fn fuzz_read(bytes: &[u8]) {
+    let frames = read_frames(bytes);
+    let summary = summarize(bytes);
+    if let (Ok(frames), Ok(summary)) = (frames, summary) {
+        let raw: u64 = summary.channels.iter().filter(|c| c.encoding == RAW_ENCODING).map(|c| c.count).sum();
+        assert_eq!(raw, frames.len() as u64, "the summary counts every raw frame read");
+    }
+}

@@ -1,0 +1,86 @@
+//! A capture holds every tapped frame byte for byte, in order, with its direction and time; any
+//! truncation or corruption of it is a typed error, never a panic.
+
+use proptest::prelude::*;
+use robowire_record::{Direction, Protocol, Recorder, read_frames, summarize};
+use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model};
+
+fn capture(frames: &[(Direction, Vec<u8>)]) -> Vec<u8> {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = std::env::temp_dir().join(format!("robowire-capture-{}-{n}.mcap", std::process::id()));
+    let recorder = Recorder::create(&path, "test").unwrap();
+    let tap = recorder.link("dog/high_level", Protocol::ZslHighLevel);
+    for (direction, bytes) in frames {
+        tap.record(*direction, bytes);
+    }
+    let summary = recorder.finish().unwrap();
+    assert_eq!((summary.frames, summary.dropped), (frames.len() as u64, 0));
+    let bytes = std::fs::read(&path).unwrap();
+    let _ = std::fs::remove_file(path);
+    bytes
+}
+
+fn session() -> Vec<(Direction, Vec<u8>)> {
+    let stand = HighLevelCommand::stand_up().encode(Model::Zsl1).to_vec();
+    let walk = HighLevelCommand::move_velocity(0.5, 0.0, 0.1).encode(Model::Zsl1).to_vec();
+    let state = HighLevelState { header: HIGH_LEVEL_STATE_HEADER, ..HighLevelState::default() }.encode().to_vec();
+    vec![
+        (Direction::Sent, stand),
+        (Direction::Received, state.clone()),
+        (Direction::Sent, walk),
+        (Direction::Received, vec![1, 2, 3]),
+    ]
+}
+
+#[test]
+fn frames_come_back_byte_for_byte_in_order() {
+    let frames = session();
+    let read = read_frames(&capture(&frames)).unwrap();
+    let got: Vec<_> = read.iter().map(|f| (f.direction, f.bytes.clone())).collect();
+    assert_eq!(got, frames);
+    assert!(read.windows(2).all(|w| w[0].unix_ns <= w[1].unix_ns));
+    assert!(read.iter().all(|f| f.link == "dog/high_level" && f.protocol == Protocol::ZslHighLevel));
+}
+
+#[test]
+fn the_summary_counts_channels_and_decode_errors() {
+    let summary = summarize(&capture(&session())).unwrap();
+    let topic = |t: &str| summary.channels.iter().find(|c| c.topic == t).unwrap_or_else(|| panic!("{t}: {summary:?}"));
+    assert_eq!(topic("/dog/high_level/sent/raw").count, 2);
+    assert_eq!(topic("/dog/high_level/received/raw").count, 2);
+    assert_eq!(topic("/dog/high_level/received/raw").decode_errors, 1, "the 3-byte junk");
+    assert_eq!(topic("/dog/high_level/received").count, 1, "only the state decoded");
+    assert_eq!(summary.metadata["command"], "test");
+    assert_eq!(summary.metadata["link:dog/high_level"], "zsl1.high_level (zsl1-udp, vendor SDK v0.2.7)");
+}
+
+#[test]
+fn every_truncation_is_an_error_or_a_prefix_never_a_panic() {
+    let whole = capture(&session());
+    for len in 0..whole.len() {
+        let _ = summarize(&whole[..len]);
+        if let Ok(frames) = read_frames(&whole[..len]) {
+            assert!(frames.len() <= 4);
+        }
+    }
+}
+
+proptest! {
+    #[test]
+    fn corrupt_bytes_never_panic(flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
+        let mut bytes = capture(&session());
+        for (at, value) in flips {
+            let i = at.index(bytes.len());
+            bytes[i] = value;
+        }
+        let _ = read_frames(&bytes);
+        let _ = summarize(&bytes);
+    }
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
+        let _ = read_frames(&bytes);
+        let _ = summarize(&bytes);
+    }
+}

@@ -1,0 +1,123 @@
+//! `--record FILE.mcap` for the commands that have it, and `robowire replay`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Args;
+use robowire_record::Recorder;
+
+/// A recorder on `path`, if given.
+pub(crate) fn start(path: Option<&Path>, command: &str) -> anyhow::Result<Option<Recorder>> {
+    path.map(|p| Recorder::create(p, command).with_context(|| format!("recording to {}", p.display()))).transpose()
+}
+
+/// Closes the capture and says what it holds.
+pub(crate) fn finish(recorder: Option<Recorder>) -> anyhow::Result<()> {
+    if let Some(recorder) = recorder {
+        let summary = recorder.finish().context("closing the capture")?;
+        eprintln!(
+            "record: {} frames written, {} dropped (the writer fell behind), {} not decodable",
+            summary.frames, summary.dropped, summary.decode_errors
+        );
+    }
+    Ok(())
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ReplayArgs {
+    /// The capture (`--record FILE.mcap` of another command).
+    file: PathBuf,
+    /// Playback speed: 2 is twice as fast as recorded.
+    #[arg(long, default_value_t = 1.0, conflicts_with = "fast")]
+    speed: f64,
+    /// As fast as possible.
+    #[arg(long)]
+    fast: bool,
+    /// One JSON object per frame on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Replays a capture into the decoders, at the recorded pace (or `--speed`, or `--fast`).
+pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.speed.is_finite() && args.speed > 0.0 && args.speed <= 1e6,
+        "--speed must be in (0, 1e6], got {}",
+        args.speed
+    );
+    let bytes = std::fs::read(&args.file).with_context(|| format!("reading {}", args.file.display()))?;
+    let frames = robowire_record::read_frames(&bytes).with_context(|| format!("{}", args.file.display()))?;
+    let Some(first) = frames.first().map(|f| f.unix_ns) else {
+        eprintln!("{}: no frames", args.file.display());
+        return Ok(ExitCode::SUCCESS);
+    };
+    let started = Instant::now();
+    let mut errors = 0u64;
+    for frame in &frames {
+        let offset_ns = frame.unix_ns.saturating_sub(first);
+        if !args.fast {
+            let due = Duration::from_nanos((offset_ns as f64 / args.speed) as u64);
+            if let Some(wait) = due.checked_sub(started.elapsed()) {
+                std::thread::sleep(wait);
+            }
+        }
+        let t = offset_ns as f64 / 1e9;
+        let direction = frame.direction.name();
+        match frame.protocol.decode(&frame.bytes) {
+            Ok((name, value)) if args.json => println!(
+                "{}",
+                serde_json::json!({ "t_s": t, "link": frame.link, "direction": direction, "message": name, "value": value })
+            ),
+            Ok((name, value)) => println!("{t:10.6} {} {direction:8} {name}: {value}", frame.link),
+            Err(e) => {
+                errors += 1;
+                eprintln!("{t:10.6} {} {direction:8} {} bytes do not decode: {e}", frame.link, frame.bytes.len());
+            }
+        }
+    }
+    eprintln!("replay: {} frames, {errors} not decodable", frames.len());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `robowire decode --mcap FILE`: channels, counts, rates, gaps, decode errors.
+pub(crate) fn summarize(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let summary = robowire_record::summarize(&bytes).with_context(|| format!("{}", path.display()))?;
+    if json {
+        let channels: Vec<_> = summary
+            .channels
+            .iter()
+            .map(|c| {
+                serde_json::json!({
+                    "topic": c.topic, "encoding": c.encoding, "count": c.count, "rate_hz": c.rate_hz,
+                    "first_ns": c.span_ns.0, "last_ns": c.span_ns.1, "max_gap_ns": c.max_gap_ns,
+                    "out_of_order": c.out_of_order, "decode_errors": c.decode_errors,
+                })
+            })
+            .collect();
+        println!("{}", serde_json::json!({ "metadata": summary.metadata, "channels": channels }));
+        return Ok(ExitCode::SUCCESS);
+    }
+    for (key, value) in &summary.metadata {
+        println!("{key}: {value}");
+    }
+    println!(
+        "{:<36} {:>12} {:>8} {:>9} {:>11} {:>6} {:>7}",
+        "channel", "encoding", "count", "rate Hz", "max gap ms", "order", "errors"
+    );
+    for c in &summary.channels {
+        println!(
+            "{:<36} {:>12} {:>8} {:>9.1} {:>11.2} {:>6} {:>7}",
+            c.topic,
+            c.encoding,
+            c.count,
+            c.rate_hz,
+            c.max_gap_ns as f64 / 1e6,
+            c.out_of_order,
+            c.decode_errors
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,116 @@
+//! `--record` captures read back by an independent MCAP reader (the `mcap` Python package, in
+//! `robowire_fixtures::peers`' environment): every JSON channel has a JSON schema, every JSON
+//! message parses, log times are monotonic per channel, raw and decoded counts agree with each
+//! other and with what the simulator counted. Then `robowire decode --mcap` and `robowire replay`
+//! on the same file; a truncated capture is a clear error, not a panic.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use serde_json::Value;
+
+fn robowire() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+fn temp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("robowire-record-{}-{name}", std::process::id()))
+}
+
+#[test]
+fn a_recorded_dog_session_reads_back_everywhere() {
+    let (sim_capture, client_capture) = (temp("sim.mcap"), temp("client.mcap"));
+    let mut sim = robowire()
+        .args(["sim", "dog", "--bind", "127.0.0.23", "--report-every-s", "0", "--record"])
+        .arg(&sim_capture)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
+    let walk = robowire()
+        .args(["dog", "--dog-ip", "127.0.0.23", "--local-ip", "127.0.0.23", "--record"])
+        .arg(&client_capture)
+        .args(["stand"])
+        .output()
+        .unwrap();
+    assert!(walk.status.success(), "{}", String::from_utf8_lossy(&walk.stderr));
+    let walk = robowire()
+        .args([
+            "dog",
+            "--dog-ip",
+            "127.0.0.23",
+            "--local-ip",
+            "127.0.0.23",
+            "move",
+            "0.5",
+            "0",
+            "0",
+            "--duration",
+            "0.5",
+        ])
+        .output()
+        .unwrap();
+    assert!(walk.status.success(), "{}", String::from_utf8_lossy(&walk.stderr));
+    rustix::process::kill_process(rustix::process::Pid::from_child(&sim), rustix::process::Signal::INT).unwrap();
+    let out = sim.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(log.contains("record:") && log.contains(" 0 dropped"), "{log}");
+
+    let python = robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"));
+    for capture in [&sim_capture, &client_capture] {
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
+        let read = Command::new(&python).arg(script).arg(capture).output().unwrap();
+        assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
+        let seen: Value = serde_json::from_slice(&read.stdout).unwrap();
+        let channels = seen["channels"].as_object().unwrap();
+        for direction in ["sent", "received"] {
+            let raw = &channels[&format!("/dog/high_level/{direction}/raw")];
+            let json = &channels[&format!("/dog/high_level/{direction}")];
+            assert_eq!(raw["encoding"], "robowire.raw");
+            assert_eq!(raw["metadata"]["protocol"], "zsl1.high_level");
+            assert_eq!(json["schema_encoding"], "jsonschema", "{json}");
+            assert_eq!(json["schema_parses"], true);
+            assert_eq!(json["json_ok"], json["count"], "every JSON message parses");
+            assert_eq!(raw["count"], json["count"], "each raw frame decoded beside it: {seen}");
+            assert!(raw["count"].as_u64().unwrap() > 0);
+            assert_eq!((raw["monotonic"].as_bool(), json["monotonic"].as_bool()), (Some(true), Some(true)));
+        }
+        let metadata = &seen["metadata"]["robowire"];
+        assert_eq!(metadata["robowire_version"], env!("CARGO_PKG_VERSION"));
+        assert!(metadata["link:dog/high_level"].as_str().unwrap().starts_with("zsl1.high_level"));
+    }
+    // The simulator sent a state for each command it got, at least: states ≥ commands seen.
+    let summary = robowire().args(["decode", "--json", "--mcap"]).arg(&sim_capture).output().unwrap();
+    assert!(summary.status.success(), "{}", String::from_utf8_lossy(&summary.stderr));
+    let summary: Value = serde_json::from_slice(&summary.stdout).unwrap();
+    let channel =
+        |topic: &str| summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == topic).unwrap().clone();
+    let commands = channel("/dog/high_level/received/raw");
+    assert_eq!(commands["decode_errors"], 0);
+    assert_eq!(commands["out_of_order"], 0);
+    assert!(commands["rate_hz"].as_f64().unwrap() > 100.0, "the 500 Hz stream: {commands}");
+
+    let replay = robowire().args(["replay", "--fast", "--json"]).arg(&client_capture).output().unwrap();
+    assert!(replay.status.success(), "{}", String::from_utf8_lossy(&replay.stderr));
+    let lines: Vec<Value> =
+        String::from_utf8_lossy(&replay.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(lines.iter().any(|l| l["message"] == "zsl1.HighLevelCommand" && l["value"]["mode_name"] == "Stand"));
+    assert!(lines.iter().any(|l| l["direction"] == "received" && l["message"] == "zsl1.HighLevelState"));
+
+    let bytes = std::fs::read(&sim_capture).unwrap();
+    let cut = temp("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    for args in [&["decode", "--mcap"][..], &["replay", "--fast"][..]] {
+        let out = robowire().args(args).arg(&cut).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "a clean error, not a panic: {out:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("not a readable MCAP capture") && !err.contains("panicked"), "{err}");
+    }
+    for f in [sim_capture, client_capture, cut] {
+        let _ = std::fs::remove_file(f);
+    }
+}
