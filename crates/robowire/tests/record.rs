@@ -108,7 +108,11 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         let out = robowire().args(args).arg(&cut).output().unwrap();
         assert_eq!(out.status.code(), Some(1), "a clean error, not a panic: {out:?}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("not a readable MCAP capture") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.contains("corrupt capture at byte") && err.contains("expected"),
+            "the offset and what was expected: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
     }
     for f in [sim_capture, client_capture, cut] {
         let _ = std::fs::remove_file(f);
