@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use clap::Parser;
 use robowire_sim::spline::{LYING_POSE_RAD, STANDING_POSE_RAD, SplineSim, SplineSimConfig};
-use zsl::{ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock};
+use zsl::{ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock, SplineError, SplineStateBlock};
 
 /// ZSL-1 spline client demo.
 #[derive(Debug, Parser)]
@@ -43,6 +43,25 @@ fn pose(pose: [f32; 3]) -> SplineCommandBlock {
     command
 }
 
+/// How long a stalled daemon is waited for before the example gives up.
+const STALL_LIMIT: Duration = Duration::from_secs(1);
+
+/// The next fresh state. A stall (no fresh state for 10 ms: the client reports it once) is
+/// counted and waited out, up to [`STALL_LIMIT`]; a daemon silent longer ends the example.
+fn next_state(client: &mut SplineClient, stalls: &mut u32) -> anyhow::Result<SplineStateBlock> {
+    let give_up = Instant::now() + STALL_LIMIT;
+    loop {
+        match client.wait_state(Duration::from_millis(50)) {
+            Ok(state) => return Ok(state),
+            Err(SplineError::DaemonStalled { stalled_for }) if Instant::now() < give_up => {
+                *stalls += 1;
+                eprintln!("daemon stalled: no fresh state for {stalled_for:?}; waiting");
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
     anyhow::ensure!(args.seconds.is_finite() && args.seconds > 0.0, "--seconds must be positive");
@@ -59,7 +78,8 @@ fn main() -> anyhow::Result<()> {
     println!("daemon on {spline_name} and {imu_name}");
 
     // The loop runs on the daemon's clock: each fresh state triggers the next command.
-    let first = client.wait_state(Duration::from_millis(50))?;
+    let mut stalls = 0u32;
+    let first = next_state(&mut client, &mut stalls)?;
     let start = [JointIndex::Abad, JointIndex::Hip, JointIndex::Knee].map(|j| first.joint(Leg::FrontRight, j).p.get());
     println!("FR leg at {start:?} rad (lying: {LYING_POSE_RAD:?})");
     let duration = Duration::from_secs_f64(args.seconds);
@@ -70,14 +90,14 @@ fn main() -> anyhow::Result<()> {
         let s = s * s * (3.0 - 2.0 * s);
         let target = std::array::from_fn(|j| start[j] + (STANDING_POSE_RAD[j] - start[j]) * s);
         client.write_command(&pose(target))?;
-        client.wait_state(Duration::from_millis(50))?;
+        next_state(&mut client, &mut stalls)?;
         cycles += 1;
     }
-    let state = client.wait_state(Duration::from_millis(50))?;
+    let state = next_state(&mut client, &mut stalls)?;
     let knee = state.joint(Leg::FrontRight, JointIndex::Knee).p.get();
     let sample = imu.read()?;
     println!(
-        "{cycles} cycles in {:.1} s; FR knee {knee:+.3} rad (target {:+.3}); IMU acc z {:.2} m/s², age {:.2} ms",
+        "{cycles} cycles in {:.1} s, {stalls} stalls waited out; FR knee {knee:+.3} rad (target {:+.3}); IMU acc z {:.2} m/s², age {:.2} ms",
         began.elapsed().as_secs_f64(),
         STANDING_POSE_RAD[2],
         sample.acc_mps2[2],

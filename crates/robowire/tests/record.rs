@@ -118,3 +118,83 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         let _ = std::fs::remove_file(f);
     }
 }
+
+/// The distinct consecutive modes of HighLevel states.
+fn modes(states: impl Iterator<Item = zsl_proto::udp::HighLevelState>) -> Vec<u32> {
+    let mut modes: Vec<u32> = states.map(|s| s.control_mode.get()).collect();
+    modes.dedup();
+    modes
+}
+
+#[test]
+fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
+    use zsl_proto::udp::{AnyDatagram, HighLevelState};
+    let capture = temp("walk.mcap");
+    let mut sim = robowire()
+        .args(["sim", "dog", "--bind", "127.0.0.26", "--report-every-s", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
+    let dog = |args: &[&str], record: bool| {
+        let mut command = robowire();
+        command.args(["dog", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26"]);
+        if record {
+            command.arg("--record").arg(&capture);
+        }
+        let out = command.args(args).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    dog(&["stand"], false);
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    dog(&["move", "0.5", "0", "0", "--duration", "0.5"], true);
+    let _ = sim.kill();
+    let _ = sim.wait();
+
+    let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap())
+        .unwrap()
+        .into_iter()
+        .filter_map(|f| match AnyDatagram::decode(&f.bytes) {
+            Ok(AnyDatagram::HighLevelState(s)) => Some(s),
+            _ => None,
+        })
+        .collect();
+    let recorded_modes = modes(recorded.iter().copied());
+    assert!(recorded_modes.contains(&18), "the recorded walk: {recorded_modes:?}");
+
+    let mut replay = robowire()
+        .args(["replay", "--as-device", "--bind", "127.0.0.27"])
+        .arg(&capture)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut addr = String::new();
+    BufReader::new(replay.stdout.as_mut().unwrap()).read_line(&mut addr).unwrap();
+    assert_eq!(addr.trim(), "127.0.0.27:43997");
+
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+    let (seen, states_received) = runtime.block_on(async {
+        let options = zsl::udp::ClientOptions::high_level([127, 0, 0, 26].into(), 0, [127, 0, 0, 27].into());
+        let client = zsl::udp::HighLevel::connect(options).await.unwrap();
+        let mut updates = client.state_updates();
+        let mut seen = Vec::new();
+        // Until the replay has gone quiet for a second.
+        while let Ok(Ok(())) = tokio::time::timeout(std::time::Duration::from_secs(1), updates.changed()).await {
+            if let Some(state) = *updates.borrow_and_update() {
+                seen.push(state);
+            }
+        }
+        let states = client.stats().states;
+        client.close().await;
+        (seen, states)
+    });
+    let out = replay.wait_with_output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(modes(seen.iter().copied()), recorded_modes, "the live client went through the recorded modes");
+    assert_eq!(states_received, recorded.len() as u64, "every recorded state arrived");
+    assert_eq!(seen.last(), recorded.last(), "ending in the recorded last state, field for field");
+    let _ = std::fs::remove_file(capture);
+}

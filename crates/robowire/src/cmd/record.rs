@@ -38,6 +38,16 @@ pub(crate) struct ReplayArgs {
     /// One JSON object per frame on stdout.
     #[arg(long)]
     json: bool,
+    /// Play the device's side of the capture to a live client instead (ZSL-1 UDP: the states,
+    /// on the HighLevel or LowLevel port of --bind).
+    #[arg(long)]
+    as_device: bool,
+    /// With --as-device: the address to serve on.
+    #[arg(long, default_value = "127.0.0.1", requires = "as_device")]
+    bind: std::net::IpAddr,
+    /// With --as-device: the link to play (default: the first with device frames).
+    #[arg(long, requires = "as_device")]
+    link: Option<String>,
 }
 
 /// Replays a capture into the decoders, at the recorded pace (or `--speed`, or `--fast`).
@@ -49,6 +59,10 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
     );
     let bytes = std::fs::read(&args.file).with_context(|| format!("reading {}", args.file.display()))?;
     let frames = robowire_record::read_frames(&bytes).with_context(|| format!("{}", args.file.display()))?;
+    if args.as_device {
+        let speed = (!args.fast).then_some(args.speed);
+        return crate::cmd::replay_device::run(&frames, args.link.as_deref(), args.bind, speed);
+    }
     let Some(first) = frames.first().map(|f| f.unix_ns) else {
         eprintln!("{}: no frames", args.file.display());
         return Ok(ExitCode::SUCCESS);
