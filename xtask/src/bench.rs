@@ -22,6 +22,7 @@ const BENCHES: &[(&str, &str)] = &[
     ("robowire", "streams"),
     ("robowire", "dds"),
     ("robowire-ros2", "cmd_vel"),
+    ("robowire-record", "record"),
 ];
 
 /// One row of the table.
@@ -65,6 +66,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let streams_meta_path = target.join("bench-meta-streams.json");
     let dds_meta_path = target.join("bench-meta-dds.json");
     let ros2_meta_path = target.join("bench-meta-ros2.json");
+    let record_meta_path = target.join("bench-meta-record.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -81,6 +83,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META_STREAMS", &streams_meta_path)
             .env("ROBOWIRE_BENCH_META_DDS", &dds_meta_path)
             .env("ROBOWIRE_BENCH_META_ROS2", &ros2_meta_path)
+            .env("ROBOWIRE_BENCH_META_RECORD", &record_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -144,7 +147,10 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let dds: Value = serde_json::from_str(&std::fs::read_to_string(&dds_meta_path).context("DDS bench metadata")?)?;
     rows.extend(dds_rows(&dds)?);
     let ros2: Value = serde_json::from_str(&std::fs::read_to_string(&ros2_meta_path).context("ROS 2 bench metadata")?)?;
-    rows.push(ros2_row(&ros2)?);
+    rows.push(crate::bench_apps::ros2_row(&ros2)?);
+    let record: Value =
+        serde_json::from_str(&std::fs::read_to_string(&record_meta_path).context("recording bench metadata")?)?;
+    rows.extend(crate::bench_apps::record_rows(&record)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");
@@ -426,21 +432,6 @@ fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         met: None,
     });
     Ok(rows)
-}
-
-/// The ROS 2 bridge: `cmd_vel` → the ZSL-1 datagram, beside its two legs measured in the same run.
-fn ros2_row(meta: &Value) -> anyhow::Result<Row> {
-    let us = |key: &str| meta[key].as_f64().with_context(|| format!("ros2 meta {key}"));
-    let (p50, p99) = (us("cmd_vel_to_wire_p50_us")?, us("cmd_vel_to_wire_p99_us")?);
-    let (dds, call) = (us("dds_twist_p50_us")?, us("call_to_wire_p50_us")?);
-    Ok(Row {
-        path: "ROS 2 cmd_vel (Twist written) → ZSL-1 datagram at the dog, through robowire ros2".into(),
-        figure: format!("p50 {p50:.1} µs, p99 {p99:.1} µs"),
-        baseline: format!("its legs: DDS Twist delivery p50 {dds:.1} µs + move_velocity() → wire p50 {call:.1} µs"),
-        ratio: format!("{:.2}× the legs", p50 / (dds + call)),
-        target: "–".into(),
-        met: None,
-    })
 }
 
 /// The table as Markdown.

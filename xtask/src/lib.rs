@@ -1,6 +1,7 @@
 //! robowire project automation, as a library so that its checks also run under `cargo test`.
 
 pub mod bench;
+mod bench_apps;
 pub mod fuzz;
 pub mod golden;
 pub mod python;

@@ -1,0 +1,92 @@
+//! Recording's cost, measured in one run:
+//!
+//! - the ZSL-1 HighLevel command stream's send lateness (2 ms period, the client's own figures)
+//!   with its link recorded and without, against the simulated dog, alternating;
+//! - the recorder's throughput: 560-byte states tapped as fast as one thread can, written raw
+//!   and decoded to JSON; frames/s and MB/s of what was written, and what the queue dropped.
+//!
+//! Figures to `ROBOWIRE_BENCH_META_RECORD` for `cargo xtask bench`.
+
+use std::time::{Duration, Instant};
+
+use robowire_record::{Direction, Protocol, Recorder};
+use robowire_sim::dog::{DogSim, DogSimConfig};
+use serde_json::json;
+use zsl::udp::{ClientOptions, HighLevel};
+use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
+
+fn temp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("robowire-bench-{}-{name}.mcap", std::process::id()))
+}
+
+/// The stream's lateness over `seconds`, recorded or not: (p50 µs, p99 µs, frames dropped).
+fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32, u32, u64) {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let recorder = record.then(|| Recorder::create(temp("stream"), "bench").unwrap());
+    let (lateness, dropped) = runtime.block_on(async {
+        let mut options = ClientOptions {
+            dog: sim.high_level_addr(),
+            ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into())
+        };
+        if let Some(recorder) = &recorder {
+            options = options.with_tap(recorder.link("dog/high_level", Protocol::ZslHighLevel));
+        }
+        let dog = HighLevel::connect(options).await.unwrap();
+        assert!(dog.wait_connected(Duration::from_secs(2)).await);
+        tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
+        let lateness = dog.stats().stream_lateness;
+        dog.close().await;
+        (lateness, recorder.as_ref().map_or(0, Recorder::dropped))
+    });
+    if let Some(recorder) = recorder {
+        recorder.finish().unwrap();
+        let _ = std::fs::remove_file(temp("stream"));
+    }
+    (lateness.p50_us, lateness.p99_us, dropped)
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return;
+    }
+    let quick = std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some();
+    let (rounds, seconds, frames) = if quick { (2, 1.0, 50_000) } else { (5, 3.0, 300_000) };
+    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+    let (mut plain, mut recorded, mut dropped) = (Vec::new(), Vec::new(), 0);
+    for _ in 0..rounds {
+        plain.push(stream(&runtime, seconds, false));
+        let r = stream(&runtime, seconds, true);
+        dropped += r.2;
+        recorded.push(r);
+    }
+    let median = |v: &mut Vec<(u32, u32, u64)>, pick: fn(&(u32, u32, u64)) -> u32| {
+        let mut xs: Vec<u32> = v.iter().map(pick).collect();
+        xs.sort_unstable();
+        xs[xs.len() / 2]
+    };
+
+    let state =
+        HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() }.encode();
+    let path = temp("throughput");
+    let recorder = Recorder::create(&path, "bench").unwrap();
+    let tap = recorder.link("dog/high_level", Protocol::ZslHighLevel);
+    let start = Instant::now();
+    for _ in 0..frames {
+        tap.record(Direction::Received, &state);
+    }
+    let summary = recorder.finish().unwrap();
+    let elapsed = start.elapsed().as_secs_f64();
+    let _ = std::fs::remove_file(&path);
+    let meta = json!({
+        "lateness_plain_p50_us": median(&mut plain, |r| r.0), "lateness_plain_p99_us": median(&mut plain, |r| r.1),
+        "lateness_recorded_p50_us": median(&mut recorded, |r| r.0), "lateness_recorded_p99_us": median(&mut recorded, |r| r.1),
+        "stream_frames_dropped": dropped,
+        "throughput_frames_per_s": summary.frames as f64 / elapsed,
+        "throughput_mb_per_s": summary.frames as f64 * state.len() as f64 / elapsed / 1e6,
+        "throughput_offered": frames, "throughput_written": summary.frames, "throughput_dropped": summary.dropped,
+    });
+    println!("record: {meta}");
+    if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_RECORD") {
+        std::fs::write(path, meta.to_string()).unwrap();
+    }
+}

@@ -1,0 +1,57 @@
+//! Rows of the benchmarks of the apps above the facades: the ROS 2 bridge and recording.
+
+use anyhow::Context;
+use serde_json::Value;
+
+use crate::bench::Row;
+
+/// The ROS 2 bridge: `cmd_vel` → the ZSL-1 datagram, beside its two legs measured in the same run.
+pub(crate) fn ros2_row(meta: &Value) -> anyhow::Result<Row> {
+    let us = |key: &str| meta[key].as_f64().with_context(|| format!("ros2 meta {key}"));
+    let (p50, p99) = (us("cmd_vel_to_wire_p50_us")?, us("cmd_vel_to_wire_p99_us")?);
+    let (dds, call) = (us("dds_twist_p50_us")?, us("call_to_wire_p50_us")?);
+    Ok(Row {
+        path: "ROS 2 cmd_vel (Twist written) → ZSL-1 datagram at the dog, through robowire ros2".into(),
+        figure: format!("p50 {p50:.1} µs, p99 {p99:.1} µs"),
+        baseline: format!("its legs: DDS Twist delivery p50 {dds:.1} µs + move_velocity() → wire p50 {call:.1} µs"),
+        ratio: format!("{:.2}× the legs", p50 / (dds + call)),
+        target: "–".into(),
+        met: None,
+    })
+}
+
+/// Recording: the stream's send lateness with its link recorded and without, and the
+/// recorder's throughput.
+pub(crate) fn record_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let n = |key: &str| meta[key].as_f64().with_context(|| format!("record meta {key}"));
+    let (p50, p99) = (n("lateness_recorded_p50_us")?, n("lateness_recorded_p99_us")?);
+    let (b50, b99) = (n("lateness_plain_p50_us")?, n("lateness_plain_p99_us")?);
+    let dropped = n("stream_frames_dropped")?;
+    Ok(vec![
+        Row {
+            path: "ZSL-1 HighLevel stream send lateness, its link recorded to MCAP".into(),
+            figure: format!("p50 {p50:.0} µs, p99 {p99:.0} µs ({dropped:.0} frames dropped)"),
+            baseline: format!("not recorded: p50 {b50:.0} µs, p99 {b99:.0} µs"),
+            ratio: format!("p99 {:+.0} µs", p99 - b99),
+            target: "–".into(),
+            met: None,
+        },
+        Row {
+            path: "Recorder throughput: 560-byte ZSL-1 states, raw and decoded to JSON".into(),
+            figure: format!(
+                "{:.0} k frames/s, {:.1} MB/s",
+                n("throughput_frames_per_s")? / 1e3,
+                n("throughput_mb_per_s")?
+            ),
+            baseline: format!(
+                "offered {:.0} frames as fast as one thread taps; written {:.0}, dropped {:.0}",
+                n("throughput_offered")?,
+                n("throughput_written")?,
+                n("throughput_dropped")?
+            ),
+            ratio: "–".into(),
+            target: "–".into(),
+            met: None,
+        },
+    ])
+}
