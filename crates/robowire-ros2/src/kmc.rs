@@ -14,8 +14,7 @@ use ros2_proto::nav::Odometry;
 use ros2_proto::sensor::BatteryState;
 use ros2_proto::tf::TfMessage;
 
-use crate::guard::{CmdVelGuard, Verdict};
-use crate::node::{LogLimiter, Node, stamp_now};
+use crate::node::{CmdVel, Node, stamp_now};
 use crate::odom::PlanarOdometry;
 use crate::report::DeviceReport;
 
@@ -37,13 +36,12 @@ pub(crate) async fn run(
     let diagnostics_writer = node.writer::<DiagnosticArray>("diagnostics", Qos::ROS_DEFAULT)?;
     let mut cmd_vel = node.reader::<Twist>("cmd_vel", Qos::ROS_DEFAULT)?;
     let ns = node.options.namespace.clone();
-    let mut guard = CmdVelGuard::new(node.options.armed, node.options.deadman);
+    let mut cmd_vel_guard = CmdVel::new(&node.options);
     let mut odom = PlanarOdometry::default();
     let mut curvature_per_m = 0.0f64;
     // The live command, refreshed inside the driver's 300 ms command timeout until the deadman.
     let mut live: Option<(f32, f32, Instant)> = None;
     let mut limiter = node.limiter();
-    let mut invalid_log = LogLimiter::default();
     let epoch = Instant::now();
     let mut drain = tokio::time::interval(DRAIN_PERIOD);
     drain.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
@@ -53,7 +51,7 @@ pub(crate) async fn run(
             () = &mut stop => return Ok(()),
             _ = drain.tick() => {
                 let now = Instant::now();
-                if guard.on_tick(now) {
+                if cmd_vel_guard.guard.on_tick(now) {
                     let _ = driver.set_command(0.0, 0.0);
                     curvature_per_m = 0.0;
                     live = None;
@@ -84,32 +82,20 @@ pub(crate) async fn run(
                         ChassisFrame::Af(_) => {}
                     }
                 }
-                report.set_guard(guard.counters());
+                report.set_guard(cmd_vel_guard.guard.counters());
             }
             sample = cmd_vel.recv() => {
                 let sample = sample?;
                 let now = Instant::now();
-                let (verdict, second) = guard.on_twist(now, &sample.value, sample.writer);
-                if let Some(count) = second {
-                    eprintln!("{ns}/cmd_vel: {count} publishers now command this chassis; the latest twist wins");
+                if let Some((vx_mps, _, yaw_rate_radps)) = cmd_vel_guard.receive(now, &sample) {
+                    if cmd_vel_guard.outcome(now, driver.set_command(vx_mps, yaw_rate_radps)) {
+                        live = Some((vx_mps, yaw_rate_radps, now));
+                        curvature_per_m = if vx_mps.abs() > 1e-3 { f64::from(yaw_rate_radps / vx_mps) } else { 0.0 };
+                    } else {
+                        live = None;
+                    }
                 }
-                match verdict {
-                    Verdict::Drive { vx_mps, yaw_rate_radps, .. } => match driver.set_command(vx_mps, yaw_rate_radps) {
-                        Ok(()) => {
-                            guard.applied();
-                            live = Some((vx_mps, yaw_rate_radps, now));
-                            curvature_per_m = if vx_mps.abs() > 1e-3 { f64::from(yaw_rate_radps / vx_mps) } else { 0.0 };
-                        }
-                        Err(e) => {
-                            guard.refused();
-                            live = None;
-                            invalid_log.log(now, || format!("{ns}/cmd_vel refused: {e}"));
-                        }
-                    },
-                    Verdict::Invalid => invalid_log.log(now, || format!("{ns}/cmd_vel dropped: not finite {:?}", sample.value)),
-                    Verdict::Unarmed => {}
-                }
-                report.set_guard(guard.counters());
+                report.set_guard(cmd_vel_guard.guard.counters());
             }
         }
     }

@@ -4,6 +4,10 @@
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use robowire_core::cdr::CdrType;
+use robowire_dds::Sample;
+use ros2_proto::geometry::Twist;
+
+use crate::guard::{CmdVelGuard, Verdict};
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, Participant, Reader, Writer};
 use ros2_proto::builtin::{Header, Time};
@@ -79,6 +83,57 @@ impl RateLimiter {
             self.last = Some(now);
         }
         due
+    }
+}
+
+/// A device's `cmd_vel`: the guard, its log, and what the device made of each twist.
+pub(crate) struct CmdVel {
+    pub(crate) guard: CmdVelGuard,
+    log: LogLimiter,
+    topic: String,
+}
+
+impl CmdVel {
+    pub(crate) fn new(options: &NodeOptions) -> Self {
+        Self {
+            guard: CmdVelGuard::new(options.armed, options.deadman),
+            log: LogLimiter::default(),
+            topic: format!("{}/cmd_vel", options.namespace),
+        }
+    }
+
+    /// A received twist: forward m/s, sideways m/s, yaw rate rad/s for the device, or `None`
+    /// (unarmed, or not finite: counted, the latter logged). A new publisher is logged.
+    pub(crate) fn receive(&mut self, now: Instant, sample: &Sample<Twist>) -> Option<(f32, f32, f32)> {
+        let (verdict, second) = self.guard.on_twist(now, &sample.value, sample.writer);
+        if let Some(count) = second {
+            eprintln!("{}: {count} publishers now command this device; the latest twist wins", self.topic);
+        }
+        match verdict {
+            Verdict::Drive { vx_mps, vy_mps, yaw_rate_radps } => Some((vx_mps, vy_mps, yaw_rate_radps)),
+            Verdict::Invalid => {
+                let topic = &self.topic;
+                self.log.log(now, || format!("{topic} dropped: not finite {:?}", sample.value));
+                None
+            }
+            Verdict::Unarmed => None,
+        }
+    }
+
+    /// What the device made of the twist [`receive`](Self::receive) passed on; whether it took it.
+    pub(crate) fn outcome<E: std::fmt::Display>(&mut self, now: Instant, result: Result<(), E>) -> bool {
+        match result {
+            Ok(()) => {
+                self.guard.applied();
+                true
+            }
+            Err(e) => {
+                self.guard.refused();
+                let topic = &self.topic;
+                self.log.log(now, || format!("{topic} refused: {e}"));
+                false
+            }
+        }
     }
 }
 

@@ -13,8 +13,7 @@ use ros2_proto::sensor::{BatteryState, Imu, JointState};
 use ros2_proto::tf::TfMessage;
 use zsl::udp::{CallError, HighLevel, Model, RobotState};
 
-use crate::guard::{CmdVelGuard, Verdict};
-use crate::node::{LogLimiter, Node, stamp_now};
+use crate::node::{CmdVel, Node, stamp_now};
 use crate::report::DeviceReport;
 use crate::service::TriggerService;
 
@@ -56,14 +55,13 @@ pub(crate) async fn run(
         TriggerService::new(node.participant, &ns, "lie_down")?,
         TriggerService::new(node.participant, &ns, "passive")?,
     ];
-    let mut guard = CmdVelGuard::new(node.options.armed, node.options.deadman);
+    let mut cmd_vel_guard = CmdVel::new(&node.options);
     let mut updates = dog.state_updates();
     let mut limiter = node.limiter();
-    let mut invalid_log = LogLimiter::default();
     let names = joint_names(model);
     tokio::pin!(stop);
     loop {
-        let deadman = guard.deadline().map(tokio::time::Instant::from_std);
+        let deadman = cmd_vel_guard.guard.deadline().map(tokio::time::Instant::from_std);
         tokio::select! {
             () = &mut stop => return Ok(()),
             changed = updates.changed() => {
@@ -79,32 +77,22 @@ pub(crate) async fn run(
             sample = cmd_vel.recv() => {
                 let sample = sample?;
                 let now = Instant::now();
-                let (verdict, second) = guard.on_twist(now, &sample.value, sample.writer);
-                if let Some(count) = second {
-                    eprintln!("{ns}/cmd_vel: {count} publishers now command this robot; the latest twist wins");
+                if let Some((vx_mps, vy_mps, yaw_rate_radps)) = cmd_vel_guard.receive(now, &sample) {
+                    // Not yet acknowledged is still queued: the vendor's 0 for the first ten.
+                    let result = match dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps).await {
+                        Err(CallError::NotAcknowledged { .. }) => Ok(()),
+                        other => other,
+                    };
+                    cmd_vel_guard.outcome(now, result);
                 }
-                match verdict {
-                    Verdict::Drive { vx_mps, vy_mps, yaw_rate_radps } => {
-                        match dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps).await {
-                            Ok(()) => guard.applied(),
-                            Err(CallError::NotAcknowledged { .. }) => guard.applied(),
-                            Err(e) => {
-                                guard.refused();
-                                invalid_log.log(now, || format!("{ns}/cmd_vel refused: {e}"));
-                            }
-                        }
-                    }
-                    Verdict::Invalid => invalid_log.log(now, || format!("{ns}/cmd_vel dropped: not finite {:?}", sample.value)),
-                    Verdict::Unarmed => {}
-                }
-                report.set_guard(guard.counters());
+                report.set_guard(cmd_vel_guard.guard.counters());
             }
             () = async { tokio::time::sleep_until(deadman.unwrap_or_else(tokio::time::Instant::now)).await }, if deadman.is_some() => {
-                if guard.on_tick(Instant::now()) {
+                if cmd_vel_guard.guard.on_tick(Instant::now()) {
                     let _ = dog.move_velocity(0.0, 0.0, 0.0).await;
                     eprintln!("{ns}/cmd_vel: no twist for {:?}, stopped", node.options.deadman);
                 }
-                report.set_guard(guard.counters());
+                report.set_guard(cmd_vel_guard.guard.counters());
             }
             (i, request) = next_request(&mut services) => {
                 let request = request?.value;

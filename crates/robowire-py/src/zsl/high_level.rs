@@ -1,8 +1,8 @@
 //! The drop-in `HighLevel` of `robowire.zsl1` and `robowire.zsl1w`: the vendor's methods with
 //! the vendor's names, arguments and return codes, over the `zsl` facade.
 
+use super::session::session_methods;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use zsl::udp::{HighLevel, Model};
 
 use super::session::Session;
@@ -197,51 +197,6 @@ macro_rules! high_level_class {
             }
 
             $($extra)*
-
-            /// robowire: why the last call returned a non-zero code (`None` after a 0).
-            #[getter]
-            fn last_error(&self) -> Option<String> {
-                self.session.last_error()
-            }
-
-            /// robowire: `"waiting"` (no state yet), `"connected"`, `"disconnected"` (silent
-            /// for 3 s; the latched motion was stopped) or `"closed"`.
-            #[getter]
-            fn connection(&self) -> &'static str {
-                self.session.connection()
-            }
-
-            /// robowire: the bound `(ip, port)`.
-            #[getter]
-            fn local_addr(&self) -> PyResult<(String, u16)> {
-                self.session.local_addr()
-            }
-
-            /// robowire: waits up to `timeout_s` for state; whether it came. Ctrl-C interrupts.
-            #[pyo3(signature = (timeout_s = 3.0))]
-            fn wait_connected(&self, py: Python<'_>, timeout_s: f64) -> PyResult<bool> {
-                self.session.wait_connected(py, timeout_s)
-            }
-
-            /// robowire: the link's and the stream's counters.
-            fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-                self.session.stats(py)
-            }
-
-            /// robowire: stops streaming and frees the port (the robot stops a walk on its own
-            /// command timeout). Idempotent; `initRobot` connects again.
-            fn close(&self, py: Python<'_>) -> PyResult<()> {
-                self.session.close(py)
-            }
-
-            fn __enter__(slf: Py<Self>) -> Py<Self> {
-                slf
-            }
-
-            #[pyo3(signature = (*_exc))]
-            fn __exit__(&self, py: Python<'_>, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<()> {
-                self.close(py)
-            }
         }
     };
 }
@@ -335,3 +290,6 @@ high_level_class! {
         }
     }
 }
+
+session_methods!(Zsl1HighLevel);
+session_methods!(Zsl1wHighLevel);

@@ -1,7 +1,7 @@
 //! The drop-in `LowLevel` of `robowire.zsl1`: twelve motors, the vendor's calls and codes.
 
+use super::session::session_methods;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use zsl::udp::{LowLevel, Model};
 
 use super::motor::{MotorCommand, MotorState};
@@ -82,47 +82,6 @@ impl Zsl1LowLevel {
     fn getBodyGyro(&self) -> PyResult<Floats> {
         self.session.read(|c| c.body_gyro().map(floats))
     }
-
-    /// robowire: why the last `sendMotorCmd` returned -1 (`None` after a 0).
-    #[getter]
-    fn last_error(&self) -> Option<String> {
-        self.session.last_error()
-    }
-
-    /// robowire: `"waiting"`, `"connected"`, `"disconnected"` or `"closed"`.
-    #[getter]
-    fn connection(&self) -> &'static str {
-        self.session.connection()
-    }
-
-    /// robowire: the bound `(ip, port)`.
-    #[getter]
-    fn local_addr(&self) -> PyResult<(String, u16)> {
-        self.session.local_addr()
-    }
-
-    /// robowire: waits up to `timeout_s` for state; whether it came. Ctrl-C interrupts.
-    #[pyo3(signature = (timeout_s = 3.0))]
-    fn wait_connected(&self, py: Python<'_>, timeout_s: f64) -> PyResult<bool> {
-        self.session.wait_connected(py, timeout_s)
-    }
-
-    /// robowire: the link's and the stream's counters.
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.session.stats(py)
-    }
-
-    /// robowire: stops streaming and frees the port. Idempotent.
-    fn close(&self, py: Python<'_>) -> PyResult<()> {
-        self.session.close(py)
-    }
-
-    fn __enter__(slf: Py<Self>) -> Py<Self> {
-        slf
-    }
-
-    #[pyo3(signature = (*_exc))]
-    fn __exit__(&self, py: Python<'_>, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<()> {
-        self.close(py)
-    }
 }
+
+session_methods!(Zsl1LowLevel);

@@ -228,3 +228,63 @@ fn no_state<T: Facade>(client: &T, dog: SocketAddr) -> PyErr {
     };
     error(Kind::NoState, format!("{}: {why}", T::NAME))
 }
+
+/// robowire's extras on a drop-in client class (a field `session: Session<_>`), in a
+/// `#[pymethods]` block of their own: `last_error`, `connection`, `local_addr`,
+/// `wait_connected`, `stats`, `close` and the context manager.
+macro_rules! session_methods {
+    ($class:ty) => {
+        #[pyo3::pymethods]
+        impl $class {
+            /// robowire: why the last call returned a non-zero code (`None` after a 0).
+            #[getter]
+            fn last_error(&self) -> Option<String> {
+                self.session.last_error()
+            }
+
+            /// robowire: `"waiting"` (no state yet), `"connected"`, `"disconnected"` (silent
+            /// for 3 s; the latched motion was stopped) or `"closed"`.
+            #[getter]
+            fn connection(&self) -> &'static str {
+                self.session.connection()
+            }
+
+            /// robowire: the bound `(ip, port)`.
+            #[getter]
+            fn local_addr(&self) -> pyo3::PyResult<(String, u16)> {
+                self.session.local_addr()
+            }
+
+            /// robowire: waits up to `timeout_s` for state; whether it came. Ctrl-C interrupts.
+            #[pyo3(signature = (timeout_s = 3.0))]
+            fn wait_connected(&self, py: pyo3::Python<'_>, timeout_s: f64) -> pyo3::PyResult<bool> {
+                self.session.wait_connected(py, timeout_s)
+            }
+
+            /// robowire: the link's and the stream's counters.
+            fn stats<'py>(&self, py: pyo3::Python<'py>) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyDict>> {
+                self.session.stats(py)
+            }
+
+            /// robowire: stops streaming and frees the port (the robot stops a walk on its own
+            /// command timeout). Idempotent; `initRobot` connects again.
+            fn close(&self, py: pyo3::Python<'_>) -> pyo3::PyResult<()> {
+                self.session.close(py)
+            }
+
+            fn __enter__(slf: pyo3::Py<Self>) -> pyo3::Py<Self> {
+                slf
+            }
+
+            #[pyo3(signature = (*_exc))]
+            fn __exit__(
+                &self,
+                py: pyo3::Python<'_>,
+                _exc: &pyo3::Bound<'_, pyo3::types::PyTuple>,
+            ) -> pyo3::PyResult<()> {
+                self.close(py)
+            }
+        }
+    };
+}
+pub(crate) use session_methods;
