@@ -1,15 +1,4 @@
-//! MCAP captures of robowire's links, and reading them back.
-//!
-//! A [`Recorder`] hands out a [`Tap`] per link ([`Recorder::link`]); the transports hand every
-//! frame they send or receive to it, and the recorder's thread writes each into two channels:
-//!
-//! - `/{link}/{sent|received}/raw`: the bytes exactly as on the wire (message encoding
-//!   [`RAW_ENCODING`], no schema), what [`read_frames`] and `robowire replay` read back;
-//! - `/{link}/{sent|received}`: the decoded message as JSON with a JSON schema, for Foxglove.
-//!
-//! A metadata record `robowire` names robowire's version, the command that recorded and each
-//! link's protocol. The queue between the links and the thread is bounded: a full queue drops
-//! frames (counted in [`RecordingSummary::dropped`]) rather than slowing a link.
+#![doc = include_str!("../README.md")]
 
 mod framing;
 mod protocol;

@@ -1,10 +1,4 @@
-//! ROS 2 on the wire for every robowire device, without a ROS installation: each device a node
-//! with the topics and services a ROS user expects, on robowire's DDS transport with the ROS 2
-//! names, types and QoS of `ros2-proto`. `robowire ros2` is this crate's front end.
-//!
-//! Safe by default: without `armed` a bridge only publishes; armed, a `cmd_vel` older than the
-//! deadman time stops the robot, and NaN, infinite or out-of-range twists are dropped and
-//! counted, never sent.
+#![doc = include_str!("../README.md")]
 
 pub mod address;
 mod bridge;

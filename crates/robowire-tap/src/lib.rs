@@ -1,19 +1,4 @@
-//! A tap on a link: every frame it sends or receives, with its time, handed to a recorder
-//! without slowing the link. The queue is bounded; when it is full the frame is dropped and
-//! counted, and the link goes on as if no one were listening. The transports call
-//! [`Tap::record`]; a recorder (`robowire-record`) owns the [`TapQueue`]'s receiving end.
-//!
-//! ```
-//! use robowire_tap::{Direction, TapQueue};
-//!
-//! let (queue, frames) = TapQueue::bounded(2);
-//! let tap = queue.tap(7);
-//! tap.record(Direction::Sent, b"abc");
-//! tap.record(Direction::Received, b"de");
-//! tap.record(Direction::Sent, b"f"); // the queue is full: dropped, counted
-//! assert_eq!(frames.recv().unwrap().bytes, b"abc");
-//! assert_eq!((queue.counters().recorded(), queue.counters().dropped()), (2, 1));
-//! ```
+#![doc = include_str!("../README.md")]
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -1,25 +1,4 @@
-//! ROS 2 messages on the wire, without a ROS installation.
-//!
-//! ROS 2 over DDS (rmw_cyclonedds, rmw_fastrtps) maps a ROS topic `/ns/name` to the DDS topic
-//! `rt/ns/name` ([`topic`]) and a type `pkg/msg/Type` to the DDS type `pkg::msg::dds_::Type_`;
-//! samples are XCDR1 little endian in the ROS 2 IDL layouts. A service `name` is two topics,
-//! `rq/nameRequest` and `rr/nameReply` ([`request_topic`], [`reply_topic`]), each sample prefixed
-//! by rmw_cyclonedds' [`RequestId`] (client GUID, sequence number).
-//!
-//! Every message here is a [`CdrType`](robowire_core::cdr::CdrType) a DDS transport publishes
-//! as is. Decoding reads XCDR1 (what every ROS 2 middleware writes) and refuses XCDR2.
-//!
-//! ```
-//! use robowire_core::cdr::{CdrEncoding, CdrType};
-//! use ros2_proto::geometry::{Twist, Vector3};
-//!
-//! let twist = Twist { linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: 0.3 } };
-//! let mut body = [0u8; 48];
-//! assert_eq!(twist.encode_body(&mut body), Ok(48));
-//! assert_eq!(Twist::decode_body(CdrEncoding::Xcdr1, &body).unwrap(), twist);
-//! assert_eq!(Twist::TYPE_NAME, "geometry_msgs::msg::dds_::Twist_");
-//! ```
-
+#![doc = include_str!("../README.md")]
 #![no_std]
 
 extern crate alloc;
