@@ -62,22 +62,11 @@ pub(crate) async fn run(
         })?;
         let bms = &state.bms_state;
         battery_writer.write(BatteryState {
-            header: node.header(stamp, "base_link"),
             voltage: state.power_v.get(),
-            temperature: f32::NAN,
             current: state.power_a.get(),
-            charge: f32::NAN,
-            capacity: f32::NAN,
-            design_capacity: f32::NAN,
             percentage: f32::from(bms.soc) / 100.0,
-            power_supply_status: BatteryState::STATUS_UNKNOWN,
-            power_supply_health: BatteryState::HEALTH_UNKNOWN,
-            power_supply_technology: BatteryState::TECHNOLOGY_LION,
-            present: true,
             cell_voltage: bms.cell_vol.iter().map(|mv| f32::from(mv.get()) / 1000.0).collect(),
-            cell_temperature: Vec::new(),
-            location: String::new(),
-            serial_number: String::new(),
+            ..BatteryState::unmeasured(node.header(stamp, "base_link"))
         })?;
         lowstate_writer.write(state)?;
         report.published(4);

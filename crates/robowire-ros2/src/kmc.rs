@@ -130,24 +130,7 @@ fn publish_odom(
 }
 
 fn battery_state(node: &Node<'_>, stamp: ros2_proto::builtin::Time, volts: f32) -> BatteryState {
-    BatteryState {
-        header: node.header(stamp, "base_link"),
-        voltage: volts,
-        temperature: f32::NAN,
-        current: f32::NAN,
-        charge: f32::NAN,
-        capacity: f32::NAN,
-        design_capacity: f32::NAN,
-        percentage: f32::NAN,
-        power_supply_status: BatteryState::STATUS_UNKNOWN,
-        power_supply_health: BatteryState::HEALTH_UNKNOWN,
-        power_supply_technology: BatteryState::TECHNOLOGY_LION,
-        present: true,
-        cell_voltage: Vec::new(),
-        cell_temperature: Vec::new(),
-        location: String::new(),
-        serial_number: String::new(),
-    }
+    BatteryState { voltage: volts, ..BatteryState::unmeasured(node.header(stamp, "base_link")) }
 }
 
 fn diagnostics(node: &Node<'_>, stamp: ros2_proto::builtin::Time, state: &kmc::AllState) -> DiagnosticArray {

@@ -190,22 +190,8 @@ fn publish(
         effort: column(&joints.torque_nm),
     })?;
     topics.battery.write(BatteryState {
-        header: node.header(stamp, "base_link"),
-        voltage: f32::NAN,
-        temperature: f32::NAN,
-        current: f32::NAN,
-        charge: f32::NAN,
-        capacity: f32::NAN,
-        design_capacity: f32::NAN,
         percentage: body.battery_percent as f32 / 100.0,
-        power_supply_status: BatteryState::STATUS_UNKNOWN,
-        power_supply_health: BatteryState::HEALTH_UNKNOWN,
-        power_supply_technology: BatteryState::TECHNOLOGY_LION,
-        present: true,
-        cell_voltage: Vec::new(),
-        cell_temperature: Vec::new(),
-        location: String::new(),
-        serial_number: String::new(),
+        ..BatteryState::unmeasured(node.header(stamp, "base_link"))
     })?;
     Ok(())
 }

@@ -84,6 +84,29 @@ ros_struct! {
 }
 
 impl BatteryState {
+    /// A present lithium-ion battery with every quantity unmeasured (NaN, as ROS specifies),
+    /// status and health unknown: fill in what the device reports.
+    pub fn unmeasured(header: Header) -> Self {
+        Self {
+            header,
+            voltage: f32::NAN,
+            temperature: f32::NAN,
+            current: f32::NAN,
+            charge: f32::NAN,
+            capacity: f32::NAN,
+            design_capacity: f32::NAN,
+            percentage: f32::NAN,
+            power_supply_status: Self::STATUS_UNKNOWN,
+            power_supply_health: Self::HEALTH_UNKNOWN,
+            power_supply_technology: Self::TECHNOLOGY_LION,
+            present: true,
+            cell_voltage: Vec::new(),
+            cell_temperature: Vec::new(),
+            location: String::new(),
+            serial_number: String::new(),
+        }
+    }
+
     /// `power_supply_status`: unknown.
     pub const STATUS_UNKNOWN: u8 = 0;
     /// `power_supply_status`: discharging.
