@@ -178,25 +178,24 @@ pub(crate) struct StructView {
 }
 
 impl StructView {
-    pub(crate) fn get_field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let f = field(self.layout, name).ok_or_else(|| {
+    /// The IDL field `name`, or an `AttributeError` listing the struct's fields.
+    fn lookup(&self, name: &str) -> PyResult<&'static Field> {
+        field(self.layout, name).ok_or_else(|| {
             PyAttributeError::new_err(format!(
                 "{} has no field {name:?} (fields: {})",
                 self.layout.name,
                 names(self.layout)
             ))
-        })?;
+        })
+    }
+
+    pub(crate) fn get_field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let f = self.lookup(name)?;
         read_field(py, &self.image, f, self.base + f.offset, format!("{}.{name}", self.path))
     }
 
     pub(crate) fn set_field(&self, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let f = field(self.layout, name).ok_or_else(|| {
-            PyAttributeError::new_err(format!(
-                "{} has no field {name:?} (fields: {})",
-                self.layout.name,
-                names(self.layout)
-            ))
-        })?;
+        let f = self.lookup(name)?;
         assign_field(&self.image, f, self.base + f.offset, value, &format!("{}.{name}", self.path))
     }
 
