@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, ensure};
 use clap::Parser;
-use go2::{Go2, JointCommand, LowLevel, LowLevelOptions, ParticipantOptions, STAND_POSE_RAD};
+use go2::trajectory::JointTrajectory;
+use go2::{Go2, LowLevel, LowLevelOptions, ParticipantOptions};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 
 /// Unitree Go2 low-level stand.
@@ -27,10 +28,6 @@ struct Args {
     #[arg(long, default_value_t = 2.0)]
     hold: f64,
 }
-
-/// Unitree's stand gains.
-const KP: f32 = 60.0;
-const KD: f32 = 5.0;
 
 fn main() -> anyhow::Result<()> {
     let args = Args::parse();
@@ -55,23 +52,22 @@ fn simulated(args: &Args) -> anyhow::Result<()> {
 fn stand(args: &Args, participant: ParticipantOptions, sim: Option<&Go2Sim>) -> anyhow::Result<()> {
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
-        let robot = LowLevel::<Go2>::connect(LowLevelOptions { participant, ..LowLevelOptions::default() }).await?;
+        let robot = LowLevel::<Go2>::open(LowLevelOptions { participant, ..LowLevelOptions::default() })?;
         let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
         let start: [f32; 12] = std::array::from_fn(|i| first.motor_state[i].q.get());
         let calls = robot.release_sport_mode().await?;
         println!("sport mode released ({calls} ReleaseMode)");
         let (duration, hold) = (Duration::from_secs_f64(args.duration), Duration::from_secs_f64(args.hold));
+        // Unitree's stand: from where the joints are to the stand pose, kp 60, kd 5.
+        let stand = JointTrajectory::stand_up(start, duration);
         let began = Instant::now();
         let mut ticker = tokio::time::interval(Duration::from_millis(2));
         while began.elapsed() < duration + hold {
             ticker.tick().await;
-            let s = (began.elapsed().as_secs_f32() / duration.as_secs_f32()).min(1.0);
-            let joints: [JointCommand; 12] =
-                std::array::from_fn(|i| JointCommand::hold(start[i] + (STAND_POSE_RAD[i % 3] - start[i]) * s, KP, KD));
-            robot.set_joints(&joints)?;
+            robot.set_joints(&stand.joints_at(began.elapsed()))?;
         }
         let q = robot.joint_positions().context("no state")?;
-        let worst = q.iter().enumerate().map(|(i, q)| (q - STAND_POSE_RAD[i % 3]).abs()).fold(0.0f32, f32::max);
+        let worst = stand.largest_error_rad(&q);
         println!("standing: largest joint error {worst:.3} rad");
         robot.damp();
         tokio::time::sleep(Duration::from_millis(300)).await;

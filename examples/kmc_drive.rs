@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use kmc::{ChassisFrame, Driver, DriverOptions};
+use kmc::{ChassisFrame, Device, Driver, DriverOptions};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 
 /// KMC chassis drive demo.
@@ -57,16 +57,19 @@ fn main() -> anyhow::Result<()> {
     };
     let port = args.port.clone().or_else(|| sim.as_ref().map(ChassisSim::path)).context("no port")?;
     println!("chassis on {}", port.display());
-    let mut driver = Driver::new(&port, DriverOptions { poll_battery: true, ..Default::default() })?;
-    driver.start()?;
+    let driver = Driver::open(&port, DriverOptions { poll_battery: true, ..Default::default() })?;
 
     println!("setCommand(0.5 m/s, 0.2 rad/s): curvature 0.4 1/m");
     drive(&driver, args.phase_s, |d| d.set_command(0.5, 0.2))?;
     println!("set_command_curvature(0.3 m/s, -1.0 1/m): a tighter turn the other way");
     drive(&driver, args.phase_s, |d| d.set_command_curvature(0.3, -1.0))?;
 
-    driver.stop()?; // three (0, 0) frames
     let stats = driver.stats();
+    if let Some(chassis) = driver.latest() {
+        let o = chassis.state.odometry;
+        println!("odometry: x {:+.2} m, y {:+.2} m, heading {:+.2} rad", o.x_m, o.y_m, o.heading_rad);
+    }
+    driver.close()?; // three (0, 0) frames, then the port is closed
     println!(
         "stopped: {} control frames, lateness p50 {} µs p99 {} µs, {} frames received",
         stats.control_frames_sent, stats.control_lateness.p50_us, stats.control_lateness.p99_us, stats.frames_received

@@ -12,7 +12,7 @@ use std::time::Duration;
 use anyhow::{Context, ensure};
 use clap::Parser;
 use robowire_sim::dog::{DogSim, DogSimConfig};
-use zsl::udp::{ClientOptions, ControlMode, HighLevel};
+use zsl::udp::{ClientOptions, ControlMode, Device, HighLevel};
 
 /// ZsiBot ZSL-1 high-level demo.
 #[derive(Debug, Parser)]
@@ -44,21 +44,21 @@ async fn main() -> anyhow::Result<()> {
             (Some(sim), options)
         }
     };
-    let dog = HighLevel::connect(options).await?;
+    let dog = HighLevel::open(options)?;
     // `checkConnect()`.
     ensure!(dog.wait_connected(WAIT).await, "no state from the robot: check --dog-ip and --local-ip");
     println!("connected, battery {} %", dog.battery_percent().unwrap_or(0));
 
     // `standUp()`, then wait until the robot reports it.
-    dog.stand_up().await?;
-    dog.wait_for_state(WAIT, |s| s.body.mode == ControlMode::Stand && s.body.position_m[2] > 0.25)
+    dog.stand_up()?;
+    dog.wait_for_state(WAIT, move |s| s.body.mode == ControlMode::Stand && s.body.position_m[2] > 0.25)
         .await
         .context("the robot did not stand up")?;
     println!("standing");
 
     // `move(0.3, 0, 0)` for 2 s, then turn on the spot at 0.5 rad/s for 2 s.
     for (what, vx, yaw_rate) in [("forward", 0.3, 0.0), ("turning", 0.0, 0.5)] {
-        dog.move_velocity(vx, 0.0, yaw_rate).await?;
+        dog.move_velocity(vx, 0.0, yaw_rate)?;
         tokio::time::sleep(Duration::from_secs(2)).await;
         let body = dog.body().context("state lost")?;
         println!(
@@ -66,21 +66,21 @@ async fn main() -> anyhow::Result<()> {
             body.position_m[0], body.position_m[1], body.imu.rpy_rad[2]
         );
     }
-    dog.move_velocity(0.0, 0.0, 0.0).await?;
-    dog.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0].abs() < 0.05 && s.body.imu.gyro_radps[2].abs() < 0.05)
+    dog.move_velocity(0.0, 0.0, 0.0)?;
+    dog.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0].abs() < 0.05 && s.body.imu.gyro_radps[2].abs() < 0.05)
         .await
         .context("the robot did not stop")?;
 
     // `attitudeControl(0, 0.3, 0, 0)`: pitch the body for a second, then back.
-    dog.attitude_control(0.0, 0.3, 0.0, 0.0).await?;
+    dog.attitude_control(0.0, 0.3, 0.0, 0.0)?;
     tokio::time::sleep(Duration::from_secs(1)).await;
     println!("pitched to {:+.2} rad", dog.rpy().map_or(0.0, |r| r[1]));
-    dog.attitude_control(0.0, -0.3, 0.0, 0.0).await?;
+    dog.attitude_control(0.0, -0.3, 0.0, 0.0)?;
     tokio::time::sleep(Duration::from_secs(1)).await;
-    dog.attitude_control(0.0, 0.0, 0.0, 0.0).await?;
+    dog.attitude_control(0.0, 0.0, 0.0, 0.0)?;
 
     // `lieDown()`.
-    dog.lie_down().await?;
+    dog.lie_down()?;
     dog.wait_for_mode(ControlMode::LieDown, WAIT).await.context("the robot did not lie down")?;
     println!("lying down; {} commands sent", dog.stats().link.sent);
     Ok(())

@@ -61,7 +61,7 @@ async fn main() -> anyhow::Result<()> {
             (Some(sim), options)
         }
     };
-    let low = LowLevel::connect(options).await?;
+    let low = LowLevel::open(options)?;
     ensure!(low.wait_connected(Duration::from_secs(5)).await, "no state from the robot");
     let start = low.motor_state().context("no motor state")?.q_rad;
     println!("legs at abad/hip/knee {:?} rad (FR)", [start[0][0], start[1][0], start[2][0]]);
@@ -73,7 +73,7 @@ async fn main() -> anyhow::Result<()> {
         let mut next = Instant::now();
         while began.elapsed() < stage {
             let fraction = began.elapsed().as_secs_f64() / stage.as_secs_f64();
-            low.send_motor_command(&MotorCommand::pd_hold(blend(from, target, fraction), KP, KD)).await?;
+            low.send_motor_command(&MotorCommand::pd_hold(blend(from, target, fraction), KP, KD))?;
             next += PERIOD;
             tokio::time::sleep_until(next.into()).await;
         }
@@ -81,7 +81,7 @@ async fn main() -> anyhow::Result<()> {
         let q = low.motor_state().context("state lost")?.q_rad;
         println!("{name:<6} FR abad/hip/knee {:+.2} {:+.2} {:+.2} rad", q[0][0], q[1][0], q[2][0]);
     }
-    low.send_motor_command(&MotorCommand::pd_hold(from, KP, KD)).await?;
+    low.send_motor_command(&MotorCommand::pd_hold(from, KP, KD))?;
     tokio::time::sleep(Duration::from_secs(1)).await;
     let q = low.motor_state().context("state lost")?.q_rad;
     let worst = (0..3).flat_map(|j| q[j].iter().map(move |v| (v - STAND_RAD[j]).abs())).fold(0.0f32, f32::max);

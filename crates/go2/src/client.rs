@@ -4,24 +4,22 @@
 
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use lowcmd_proto::api::{motion_switcher, sport, status};
 use lowcmd_proto::go2::MotorCmd;
 use lowcmd_proto::robot::{Go2, Robot};
 use lowcmd_proto::stream::CommandStream;
 use lowcmd_proto::{LowCmd, Message};
-use robowire_core::schedule::{Connection, Watchdog};
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
-use robowire_dds::rpc::RpcClient;
 use robowire_dds::{Participant, Reader, StatsHandle, TopicStats};
 use robowire_rt::Time;
-use robowire_rt::runner::{Runner, Waker};
-use robowire_rt::stats::{Counter, SharedLateness, micros};
-use tokio::sync::watch;
-use tokio::task::JoinHandle;
+use robowire_rt::device::{Device, Receive, Received, Receiving, Stamped};
+use robowire_rt::runner::{Runner, RunnerOptions, Waker};
+use robowire_rt::stats::Counter;
+use robowire_core::schedule::Watchdog;
 
+use crate::services::Services;
 use crate::stream::{StreamJob, StreamShared};
 use crate::{Go2Error, LowLevelOptions};
 
@@ -47,15 +45,6 @@ impl JointCommand {
     }
 }
 
-/// The latest state and how old it is.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StateSnapshot<S> {
-    /// The state (its CRC was verified).
-    pub state: S,
-    /// Time since it arrived.
-    pub age: Duration,
-}
-
 /// What the client did and saw.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Go2Stats {
@@ -71,6 +60,8 @@ pub struct Go2Stats {
     pub command_timeouts: u64,
     /// Stream ticks skipped because the thread was more than a period late.
     pub missed_ticks: u64,
+    /// LowCmds the middleware did not take (its send window full, or an error): dropped, counted.
+    pub write_drops: u64,
     /// LowStates missing by their `tick` (gaps beyond the usual step).
     pub lost_by_tick: u64,
     /// LowStates whose `tick` was not after the previous one's.
@@ -85,20 +76,46 @@ pub struct Go2Stats {
     pub state_gap: LatenessSummary,
 }
 
-/// The receive side's state, shared with the user's threads.
-struct StateShared<S> {
-    latest: watch::Sender<Option<(Instant, S)>>,
-    connection: watch::Sender<Connection>,
+/// What the receive loop counts beyond the feed.
+#[derive(Debug, Default)]
+struct TickCounters {
     lost_by_tick: Counter,
     late_by_tick: Counter,
-    disconnects: Counter,
-    reconnects: Counter,
-    gaps: SharedLateness<1024>,
 }
 
-/// A Unitree robot's low-level interface (`R`: [`Go2`] or [`Hg`](crate::Hg)). Needs a tokio
-/// runtime for its receive task; the LowCmd stream runs on its own thread. Both stop on drop,
-/// after a burst of damping commands.
+/// `rt/lowstate` as robowire-rt's receive loop drives it.
+struct StateLink<R: Robot> {
+    reader: Reader<R::State>,
+    ticks: Ticks,
+    counters: Arc<TickCounters>,
+}
+
+impl<R: Robot> Receive for StateLink<R>
+where
+    R::State: Send + Sync,
+{
+    type Item = R::State;
+    type State = R::State;
+
+    async fn receive(&mut self) -> Received<R::State> {
+        match self.reader.recv().await {
+            Ok(sample) => Received::Item(sample.value),
+            Err(_) => Received::Closed,
+        }
+    }
+
+    fn on_item(&mut self, _: Time, state: R::State) -> Option<R::State> {
+        let (lost, late) = self.ticks.on(R::tick(&state));
+        self.counters.lost_by_tick.add(lost);
+        self.counters.late_by_tick.add(late);
+        Some(state)
+    }
+}
+
+/// A Unitree robot's low-level interface (`R`: [`Go2`] or [`Hg`](crate::Hg)): the LowCmd stream
+/// on a thread of its own, `rt/lowstate` and the robot's services on a receive thread. No runtime
+/// needed. Closing (or dropping) ends both after a burst of damping commands, if anything was
+/// ever sent.
 ///
 /// Nothing is sent until the first [`set_command`](Self::set_command) (or
 /// [`damp`](Self::damp)); from then on the latched command goes out every 2 ms on absolute
@@ -107,29 +124,32 @@ struct StateShared<S> {
 ///
 /// ```no_run
 /// # async fn demo() -> Result<(), go2::Go2Error> {
-/// use go2::{JointCommand, LowLevel, LowLevelOptions, STAND_POSE_RAD};
-/// let robot = LowLevel::<go2::Go2>::connect(LowLevelOptions::on(Some("eth0"), 0)).await?;
+/// use go2::trajectory::JointTrajectory;
+/// use go2::{JointCommand, LowLevel, LowLevelOptions};
+/// let robot = LowLevel::<go2::Go2>::open(LowLevelOptions::on(Some("eth0"), 0))?;
+/// let lying = robot.wait_state(std::time::Duration::from_secs(3), |_| true).await.expect("rt/lowstate");
 /// robot.release_sport_mode().await?; // the robot lies down, its sport mode lets go
-/// let stand: [JointCommand; 12] = std::array::from_fn(|i| JointCommand::hold(STAND_POSE_RAD[i % 3], 60.0, 5.0));
-/// for _ in 0..1000 {
-///     robot.set_joints(&stand)?;
+/// let stand = JointTrajectory::stand_up(std::array::from_fn(|i| lying.motor_state[i].q.get()), std::time::Duration::from_secs(2));
+/// let start = std::time::Instant::now();
+/// while start.elapsed() < std::time::Duration::from_secs(3) {
+///     robot.set_joints(&stand.joints_at(start.elapsed()))?;
 ///     tokio::time::sleep(std::time::Duration::from_millis(2)).await;
 /// }
-/// robot.damp();
+/// robot.close(); // damping, then closed
 /// # Ok(()) }
 /// ```
 pub struct LowLevel<R: Robot = Go2> {
     options: LowLevelOptions,
     shared: Arc<StreamShared<R>>,
-    state: Arc<StateShared<R::State>>,
     stream: Option<Runner<StreamJob<R>>>,
     waker: Waker,
-    receive: JoinHandle<()>,
+    ticks: Arc<TickCounters>,
     lowcmd: StatsHandle,
     lowstate: StatsHandle,
-    switcher: RpcClient,
-    sport: RpcClient,
+    services: Arc<Services>,
     _participant: Arc<Participant>,
+    /// Dropped last: the receive thread ends after the stream's damping went out.
+    receiving: Receiving<R::State>,
 }
 
 impl<R: Robot> std::fmt::Debug for LowLevel<R> {
@@ -138,82 +158,86 @@ impl<R: Robot> std::fmt::Debug for LowLevel<R> {
     }
 }
 
-impl<R: Robot> LowLevel<R> {
-    /// Joins the domain on the interface, starts the receive task and the (idle) stream.
-    pub async fn connect(options: LowLevelOptions) -> Result<Self, Go2Error> {
+/// What the receive thread opens and hands to the client.
+struct Opened<R: Robot> {
+    participant: Arc<Participant>,
+    writer: robowire_dds::Writer<R::Cmd>,
+    lowstate: StatsHandle,
+    services: Arc<Services>,
+}
+
+impl<R: Robot> LowLevel<R>
+where
+    R::State: Send + Sync,
+{
+    /// Joins the domain on the interface, starts the receive thread and the (idle) stream.
+    pub fn open(options: LowLevelOptions) -> Result<Self, Go2Error> {
         options.validate()?;
-        let participant = Arc::new(Participant::new(options.participant.clone())?);
-        let writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::WRITER)?;
-        let reader = participant.reader::<R::State>(R::State::TOPIC, Qos::READER)?;
-        let (lowcmd, lowstate) = (writer.stats_handle(), reader.stats_handle());
-        let switcher = RpcClient::new(&participant, motion_switcher::SERVICE)?;
-        let sport = RpcClient::new(&participant, sport::SERVICE)?;
-        let shared = Arc::new(StreamShared::default());
-        let state = Arc::new(StateShared {
-            latest: watch::Sender::new(None),
-            connection: watch::Sender::new(Connection::Waiting),
-            lost_by_tick: Counter::default(),
-            late_by_tick: Counter::default(),
-            disconnects: Counter::default(),
-            reconnects: Counter::default(),
-            gaps: SharedLateness::new(),
-        });
         let now = robowire_rt::now();
-        let job = StreamJob::new(CommandStream::new(now, options.stream), writer, shared.clone());
-        let stream = Runner::spawn(options.runner_options(), job)?;
-        let waker = stream.waker();
         let first = now + options.state_timeout.max(crate::options::FIRST_STATE_TIMEOUT);
         let watchdog = Watchdog::waiting_until(first, options.state_timeout);
-        let receive = tokio::spawn(receive::<R>(reader, state.clone(), watchdog));
+        let ticks = Arc::new(TickCounters::default());
+        let name = R::NAME.to_ascii_lowercase();
+        let (receiving, opened) = Receiving::spawn(&format!("{name}-receive"), watchdog, {
+            let (participant_options, service_timeout, ticks) =
+                (options.participant.clone(), options.service_timeout, ticks.clone());
+            move || async move {
+                let participant = Arc::new(Participant::new(participant_options)?);
+                let writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::WRITER)?;
+                let reader = participant.reader::<R::State>(R::State::TOPIC, Qos::READER)?;
+                let lowstate = reader.stats_handle();
+                // Their answers are read by tasks of this thread's runtime.
+                let services = Arc::new(Services::new(&participant, service_timeout)?);
+                let link = StateLink::<R> { reader, ticks: Ticks::default(), counters: ticks };
+                Ok::<_, Go2Error>((link, Opened::<R> { participant, writer, lowstate, services }))
+            }
+        })?;
+        let Opened { participant, writer, lowstate, services } = opened;
+        let lowcmd = writer.stats_handle();
+        let shared = Arc::new(StreamShared::default());
+        let job = StreamJob::new(CommandStream::new(now, options.stream), writer, shared.clone());
+        let stream = Runner::spawn(RunnerOptions::placed(format!("{name}-lowcmd"), options.placement), job)?;
+        let waker = stream.waker();
         Ok(Self {
             options,
             shared,
-            state,
             stream: Some(stream),
             waker,
-            receive,
+            ticks,
             lowcmd,
             lowstate,
-            switcher,
-            sport,
+            services,
             _participant: participant,
+            receiving,
         })
+    }
+
+    /// Runs `call` on the receive thread's runtime (where the services' answers arrive) and waits
+    /// for its outcome, on any executor.
+    async fn on_device<T, F>(&self, call: impl FnOnce(Arc<Services>) -> F + Send + 'static) -> Result<T, Go2Error>
+    where
+        T: Send + 'static,
+        F: Future<Output = Result<T, Go2Error>> + Send + 'static,
+    {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        let services = self.services.clone();
+        self.receiving.runtime().spawn(async move {
+            let _ = tx.send(call(services).await);
+        });
+        rx.await.map_err(|_| Go2Error::Closed)?
     }
 
     /// Releases the sport mode the way Unitree's low-level example does: CheckMode; while a
     /// mode owns the motors, sport StandDown, motion_switcher ReleaseMode, CheckMode again.
     /// Returns the ReleaseMode calls it took (0 if nothing owned the motors). A service that does
-    /// not answer within the service timeout, or answers an error, is an error.
+    /// not answer within the service timeout, or answers an error, is an error. Any executor.
     pub async fn release_sport_mode(&self) -> Result<u32, Go2Error> {
-        const MAX_ATTEMPTS: u32 = 10;
-        let timeout = self.options.service_timeout;
-        let mut attempts = 0;
-        loop {
-            let answer = self.switcher.call(motion_switcher::CHECK_MODE, "{}", timeout).await?;
-            check_code(motion_switcher::SERVICE, motion_switcher::CHECK_MODE, answer.code)?;
-            let unexpected = || Go2Error::Unexpected { service: motion_switcher::SERVICE, data: answer.data.clone() };
-            let mode = motion_switcher::mode_name(&answer.data).ok_or_else(unexpected)?;
-            if mode.is_empty() {
-                return Ok(attempts);
-            }
-            if attempts == MAX_ATTEMPTS {
-                return Err(Go2Error::NotReleased { mode: mode.into(), attempts });
-            }
-            let down = self.sport.call(sport::STAND_DOWN, "{}", timeout).await?;
-            check_code(sport::SERVICE, sport::STAND_DOWN, down.code)?;
-            let release = self.switcher.call(motion_switcher::RELEASE_MODE, "{}", timeout).await?;
-            check_code(motion_switcher::SERVICE, motion_switcher::RELEASE_MODE, release.code)?;
-            attempts += 1;
-        }
+        self.on_device(|services| async move { services.release_sport_mode().await }).await
     }
 
-    /// The sport mode owning the motors (empty: none), as CheckMode reports it.
+    /// The sport mode owning the motors (empty: none), as CheckMode reports it. Any executor.
     pub async fn sport_mode(&self) -> Result<String, Go2Error> {
-        let answer = self.switcher.call(motion_switcher::CHECK_MODE, "{}", self.options.service_timeout).await?;
-        check_code(motion_switcher::SERVICE, motion_switcher::CHECK_MODE, answer.code)?;
-        motion_switcher::mode_name(&answer.data)
-            .map(str::to_owned)
-            .ok_or(Go2Error::Unexpected { service: motion_switcher::SERVICE, data: answer.data })
+        self.on_device(|services| async move { services.sport_mode().await }).await
     }
 
     /// Latches `command` if the robot's rules allow it (NaN, infinities, gains, torques, the
@@ -231,34 +255,49 @@ impl<R: Robot> LowLevel<R> {
         self.waker.wake();
     }
 
-    /// The latest state and its age (`None` before the first).
-    pub fn state(&self) -> Option<StateSnapshot<R::State>> {
-        self.state.latest.borrow().as_ref().map(|(at, state)| StateSnapshot { state: *state, age: at.elapsed() })
+    /// Waits up to `timeout` for a state that satisfies `accept` (the latest counts). Any
+    /// executor.
+    pub async fn wait_state(
+        &self,
+        timeout: Duration,
+        accept: impl Fn(&R::State) -> bool + Send + Sync + 'static,
+    ) -> Option<R::State> {
+        self.receiving.wait_for(timeout, accept).await.map(|s| s.state)
     }
 
-    /// Waits up to `timeout` for a state that satisfies `accept`.
-    pub async fn wait_state(&self, timeout: Duration, accept: impl Fn(&R::State) -> bool) -> Option<R::State> {
-        let mut rx = self.state.latest.subscribe();
-        let wait = rx.wait_for(|s| s.as_ref().is_some_and(|(_, s)| accept(s)));
-        match tokio::time::timeout(timeout, wait).await {
-            Ok(Ok(state)) => state.as_ref().map(|(_, s)| *s),
-            _ => None,
-        }
+    /// Every state from now on, in order, stamped with its arrival.
+    pub fn every_state(&self) -> tokio::sync::broadcast::Receiver<Stamped<R::State>> {
+        self.receiving.every_state()
     }
 
-    /// The connection as the watchdog sees it.
-    pub fn connection(&self) -> Connection {
-        *self.state.connection.borrow()
+    /// The options in force.
+    pub fn options(&self) -> &LowLevelOptions {
+        &self.options
     }
 
-    /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
-    pub fn connection_events(&self) -> watch::Receiver<Connection> {
-        self.state.connection.subscribe()
+    /// Damping (if anything was sent), then both threads end and the participant leaves.
+    /// Dropping the client does the same.
+    pub fn close(self) {
+        drop(self);
+    }
+}
+
+impl<R: Robot> Device for LowLevel<R>
+where
+    R::State: Send + Sync,
+{
+    type State = R::State;
+    type Stats = Go2Stats;
+    type Error = std::convert::Infallible;
+
+    fn receiving(&self) -> &Receiving<R::State> {
+        &self.receiving
     }
 
     /// Counters and timing.
-    pub fn stats(&self) -> Go2Stats {
-        let (s, st) = (&self.shared, &self.state);
+    fn stats(&self) -> Go2Stats {
+        let s = &self.shared;
+        let feed = self.receiving.stats();
         Go2Stats {
             lowcmd: self.lowcmd.get(),
             lowstate: self.lowstate.get(),
@@ -266,18 +305,19 @@ impl<R: Robot> LowLevel<R> {
             damping_sent: s.damping.get(),
             command_timeouts: s.command_timeouts.get(),
             missed_ticks: s.missed_ticks.get(),
-            lost_by_tick: st.lost_by_tick.get(),
-            late_by_tick: st.late_by_tick.get(),
-            disconnects: st.disconnects.get(),
-            reconnects: st.reconnects.get(),
+            write_drops: s.write_errors.get(),
+            lost_by_tick: self.ticks.lost_by_tick.get(),
+            late_by_tick: self.ticks.late_by_tick.get(),
+            disconnects: feed.disconnects,
+            reconnects: feed.reconnects,
             send_lateness: s.lateness.summary(),
-            state_gap: st.gaps.summary(),
+            state_gap: feed.state_gap,
         }
     }
 
-    /// The options in force.
-    pub fn options(&self) -> &LowLevelOptions {
-        &self.options
+    fn close(self) -> Result<(), std::convert::Infallible> {
+        drop(self);
+        Ok(())
     }
 }
 
@@ -294,13 +334,12 @@ impl LowLevel<Go2> {
 
     /// Joint positions of the latest state, rad, motor order.
     pub fn joint_positions(&self) -> Option<[f32; 12]> {
-        self.state().map(|s| std::array::from_fn(|i| s.state.motor_state[i].q.get()))
+        self.latest().map(|s| std::array::from_fn(|i| s.state.motor_state[i].q.get()))
     }
 }
 
 impl<R: Robot> Drop for LowLevel<R> {
     fn drop(&mut self) {
-        self.receive.abort();
         if let Some(stream) = self.stream.take()
             && let Some(job) = stream.stop()
         {
@@ -310,10 +349,6 @@ impl<R: Robot> Drop for LowLevel<R> {
             }
         }
     }
-}
-
-fn check_code(service: &'static str, api_id: i64, code: i32) -> Result<(), Go2Error> {
-    if code == status::OK { Ok(()) } else { Err(Go2Error::Refused { service, api_id, code }) }
 }
 
 /// Tick bookkeeping: the usual step is the smallest positive one seen.
@@ -335,49 +370,6 @@ impl Ticks {
         self.step = Some(step.min(delta));
         let step = step.min(delta);
         (u64::from(delta / step).saturating_sub(1), 0)
-    }
-}
-
-fn tokio_instant(at: Time) -> tokio::time::Instant {
-    tokio::time::Instant::now() + at.saturating_duration_since(robowire_rt::now())
-}
-
-/// Receives states, runs the watchdog, keeps the latest.
-async fn receive<R: Robot>(mut reader: Reader<R::State>, state: Arc<StateShared<R::State>>, mut watchdog: Watchdog) {
-    let mut ticks = Ticks::default();
-    let mut last: Option<Time> = None;
-    loop {
-        let expires = watchdog.poll_timeout();
-        let timeout = async {
-            match expires {
-                Some(at) => tokio::time::sleep_until(tokio_instant(at)).await,
-                None => std::future::pending().await,
-            }
-        };
-        tokio::select! {
-            sample = reader.recv() => {
-                let Ok(sample) = sample else { return };
-                let now = robowire_rt::now();
-                if let Some(previous) = last.replace(now) {
-                    state.gaps.record(micros(now.saturating_duration_since(previous)));
-                }
-                let (lost, late) = ticks.on(R::tick(&sample.value));
-                state.lost_by_tick.add(lost);
-                state.late_by_tick.add(late);
-                // The connection first: whoever wakes on the state sees it connected.
-                if watchdog.feed(now).is_some() {
-                    state.reconnects.set(watchdog.counters().reconnects);
-                    state.connection.send_replace(watchdog.connection());
-                }
-                state.latest.send_replace(Some((Instant::now(), sample.value)));
-            }
-            () = timeout => {
-                if watchdog.poll_event(robowire_rt::now()).is_some() {
-                    state.disconnects.set(watchdog.counters().disconnects);
-                    state.connection.send_replace(Connection::Disconnected);
-                }
-            }
-        }
     }
 }
 

@@ -11,9 +11,9 @@ pub enum Go2Error {
     /// DDS: a participant, a topic, a write, a call without answer.
     #[error(transparent)]
     Dds(#[from] DdsError),
-    /// The stream thread could not be placed or started.
-    #[error("the LowCmd stream thread: {0}")]
-    StreamThread(#[from] RtError),
+    /// A thread could not be placed (priority, CPU, memory lock) or started.
+    #[error("the client's threads")]
+    Thread(#[from] RtError),
     /// An option is out of range.
     #[error("option {name}: {reason}")]
     Option {
@@ -25,6 +25,17 @@ pub enum Go2Error {
     /// A command the robot's rules refuse; nothing was sent, the previous command stays.
     #[error(transparent)]
     Command(#[from] CommandError),
+    /// A service call failed: no answer in time, or the middleware refused the request.
+    #[error("{service} api {api_id}")]
+    Service {
+        /// The service.
+        service: &'static str,
+        /// The API id.
+        api_id: i64,
+        /// What failed.
+        #[source]
+        source: DdsError,
+    },
     /// A service answered with an error code.
     #[error("{service} api {api_id} answered code {code}")]
     Refused {
@@ -43,7 +54,7 @@ pub enum Go2Error {
         /// ReleaseMode calls made.
         attempts: u32,
     },
-    /// An answer the client cannot read (CheckMode without a name).
+    /// An answer the client cannot read (CheckMode without a name, an answer to another API).
     #[error("{service} answered {data:?}, which is not what its API promises")]
     Unexpected {
         /// The service.
@@ -51,7 +62,8 @@ pub enum Go2Error {
         /// The data.
         data: String,
     },
-    /// The stream halted (the client was closed).
+    /// The client's receive thread has ended (the client is being closed): a service call
+    /// cannot be made.
     #[error("the client is closed")]
     Closed,
 }

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use lowcmd_proto::stream::StreamConfig;
 use robowire_dds::ParticipantOptions;
-use robowire_rt::runner::RunnerOptions;
+use robowire_rt::Placement;
 
 use crate::Go2Error;
 
@@ -28,12 +28,8 @@ pub struct LowLevelOptions {
     pub state_timeout: Duration,
     /// How long a service call (motion_switcher, sport) may take. Default 5 s (Unitree's examples).
     pub service_timeout: Duration,
-    /// `SCHED_FIFO` priority 1..=99 for the stream thread; `None` keeps normal scheduling.
-    pub realtime_priority: Option<u8>,
-    /// CPU to pin the stream thread to.
-    pub cpu_affinity: Option<usize>,
-    /// Lock the process's memory when the stream starts.
-    pub lock_memory: bool,
+    /// Where the LowCmd stream thread runs (priority, CPU, memory lock).
+    pub placement: Placement,
 }
 
 impl Default for LowLevelOptions {
@@ -44,9 +40,7 @@ impl Default for LowLevelOptions {
             stream: StreamConfig::default(),
             state_timeout: STATE_TIMEOUT,
             service_timeout: Duration::from_secs(5),
-            realtime_priority: None,
-            cpu_affinity: None,
-            lock_memory: false,
+            placement: Placement::default(),
         }
     }
 }
@@ -75,20 +69,7 @@ impl LowLevelOptions {
         if self.state_timeout < s.period {
             return bad("state_timeout", format!("{:?} is shorter than the period", self.state_timeout));
         }
-        if let Some(priority) = self.realtime_priority
-            && !(1..=99).contains(&priority)
-        {
-            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
-        }
+        self.placement.validate()?;
         Ok(())
-    }
-
-    pub(crate) fn runner_options(&self) -> RunnerOptions {
-        RunnerOptions {
-            realtime_priority: self.realtime_priority,
-            cpu: self.cpu_affinity,
-            lock_memory: self.lock_memory,
-            ..RunnerOptions::named("go2-lowcmd")
-        }
     }
 }

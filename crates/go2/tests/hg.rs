@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use go2::{Connection, Go2Error, Hg, HgLowCmd, LowLevel, LowLevelOptions};
+use go2::{Connection, Device, Go2Error, Hg, HgLowCmd, LowLevel, LowLevelOptions};
 use lowcmd_proto::Message;
 use robowire_dds::netns::in_loopback_namespace;
 use robowire_dds::qos::Qos;
@@ -22,7 +22,7 @@ fn hg_commands_and_damping_keep_the_machine_mode() {
             let robot_end = Participant::new(lo.clone()).unwrap();
             let mut commands = robot_end.reader::<HgLowCmd>(HgLowCmd::TOPIC, Qos::READER).unwrap();
             let options = LowLevelOptions { participant: lo, ..LowLevelOptions::default() };
-            let robot = LowLevel::<Hg>::connect(options).await.unwrap();
+            let robot = LowLevel::<Hg>::open(options).unwrap();
 
             let mut cmd = HgLowCmd::default();
             cmd.mode_machine = 5;

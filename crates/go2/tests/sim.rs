@@ -6,7 +6,7 @@
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use go2::{Connection, Go2, Go2Error, JointCommand, LowLevel, LowLevelOptions, STAND_POSE_RAD};
+use go2::{Connection, Device, Go2, Go2Error, JointCommand, LowLevel, LowLevelOptions, STAND_POSE_RAD};
 use robowire_dds::netns::in_loopback_namespace;
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 
@@ -33,7 +33,7 @@ where
                 ..Default::default()
             })
             .expect("simulator");
-            let client = LowLevel::<Go2>::connect(LowLevelOptions::on(Some("lo"), 0)).await.expect("client");
+            let client = LowLevel::<Go2>::open(LowLevelOptions::on(Some("lo"), 0)).expect("client");
             scenario(sim, client).await;
         })
     })
@@ -55,7 +55,7 @@ fn stand() -> [JointCommand; 12] {
 #[test]
 fn release_then_stand_up_then_damping_when_the_command_goes_stale() {
     with_go2(|sim, robot| async move {
-        assert!(robot.wait_state(WAIT, |_| true).await.is_some(), "state arrives");
+        assert!(robot.wait_state(WAIT, move |_| true).await.is_some(), "state arrives");
         assert_eq!(robot.connection(), Connection::Connected);
         // Before the release the robot ignores LowCmds, and says so.
         robot.set_joints(&stand()).unwrap();
@@ -104,11 +104,11 @@ fn bad_commands_are_refused_before_anything_is_sent() {
 #[test]
 fn the_watchdog_and_faults_on_the_wire() {
     with_go2(|sim, robot| async move {
-        assert!(robot.wait_state(WAIT, |_| true).await.is_some());
+        assert!(robot.wait_state(WAIT, move |_| true).await.is_some());
         let mut events = robot.connection_events();
         sim.inject(Go2Fault::Silence);
         tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Disconnected)).await.unwrap().unwrap();
-        let age = robot.state().unwrap().age;
+        let age = robot.latest().unwrap().age();
         assert!(age >= robot.options().state_timeout, "the last state is kept with its age: {age:?}");
         sim.clear_faults();
         tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Connected)).await.unwrap().unwrap();
@@ -121,8 +121,8 @@ fn the_watchdog_and_faults_on_the_wire() {
 
         sim.inject(Go2Fault::MotorFault { motor: 7 });
         assert!(
-            robot.wait_state(WAIT, |s| s.motor_state[7].mode == 0 && s.motor_state[7].lost.get() > 0).await.is_some()
+            robot.wait_state(WAIT, move |s| s.motor_state[7].mode == 0 && s.motor_state[7].lost.get() > 0).await.is_some()
         );
-        assert!(robot.state().unwrap().state.motor_state[6].mode == 1, "the others are fine");
+        assert!(robot.latest().unwrap().state.motor_state[6].mode == 1, "the others are fine");
     });
 }

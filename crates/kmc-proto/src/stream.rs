@@ -194,6 +194,12 @@ impl CommandStream {
         self.command_at = Some(set_at);
     }
 
+    /// Sets the command timeout: a command older than `timeout` is replaced by (0, 0) from the next
+    /// control tick on.
+    pub fn set_command_timeout(&mut self, timeout: Duration) {
+        self.config.command_timeout = timeout;
+    }
+
     /// Whether the latched command is fresh at `now`. A command stamped after `now` (set by
     /// another thread after the stream read its clock) counts as fresh.
     pub fn is_command_fresh(&self, now: Time) -> bool {

@@ -83,6 +83,9 @@ fn a_command_older_than_the_timeout_becomes_a_stop() {
     // A refresh in time keeps it going.
     stream.handle_command(T0 + 700 * MS, drive);
     assert!(stream.is_command_fresh(T0 + 1000 * MS) && !stream.is_command_fresh(T0 + 1001 * MS));
+    // A longer timeout (a bridge with its own deadman) takes effect at once.
+    stream.set_command_timeout(500 * MS);
+    assert!(stream.is_command_fresh(T0 + 1200 * MS) && !stream.is_command_fresh(T0 + 1201 * MS));
 }
 
 #[test]

@@ -8,6 +8,7 @@ use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME
 use robowire_serial::{LinkCounters, SerialLink, SerialPortOptions};
 
 use crate::KmcError;
+use robowire_rt::RtError;
 use robowire_core::finite;
 
 /// Sends single frames to a KMC chassis and receives its responses.
@@ -108,7 +109,10 @@ pub struct BlockingUartClient {
 impl BlockingUartClient {
     /// Opens the serial port, with a private single-threaded runtime.
     pub fn open(path: impl AsRef<Path>, options: &SerialPortOptions) -> Result<Self, KmcError> {
-        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(KmcError::Thread)?;
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .map_err(|source| RtError::Thread { name: "kmc-uart".into(), source })?;
         let client = {
             let _entered = runtime.enter();
             UartClient::open(path, options)?

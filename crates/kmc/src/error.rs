@@ -1,8 +1,6 @@
 //! Facade errors: bad arguments, bad options, a failed link and a failed start are kept apart.
 //! (Bad bytes from the chassis are not errors: the decoder skips and counts them.)
 
-use std::io;
-
 use kmc_proto::EncodeError;
 use robowire_core::NonFinite;
 use robowire_rt::RtError;
@@ -29,16 +27,10 @@ pub enum KmcError {
     /// A frame could not be encoded (cannot happen for validated arguments).
     #[error("cannot encode frame: {0}")]
     Encode(#[from] EncodeError),
-    /// The driver is not running.
+    /// The driver's stream has ended (closed, or its thread died): nothing can be queued.
     #[error("the driver is not running")]
     NotRunning,
-    /// [`Driver::start`](crate::Driver::start) on a running driver.
-    #[error("the driver is already running")]
-    AlreadyRunning,
-    /// `realtime_priority` or `cpu_affinity` could not be applied to the driver thread.
-    #[error("the driver thread could not be placed as asked")]
-    Placement(#[from] RtError),
-    /// The driver thread or its runtime could not be created.
-    #[error("cannot start the driver thread")]
-    Thread(#[source] io::Error),
+    /// A thread could not be placed (priority, CPU, memory lock) or started.
+    #[error("the driver's threads")]
+    Thread(#[from] RtError),
 }

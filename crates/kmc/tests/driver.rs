@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use kmc::{ChassisFrame, Driver, DriverOptions, KmcError, LinkState, NonFinite, RtError};
+use kmc::{ChassisFrame, Connection, Device, Driver, DriverOptions, KmcError, LinkState, NonFinite, Placement, RtError};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 
@@ -44,18 +44,17 @@ fn wait_until(what: &str, mut condition: impl FnMut() -> bool) {
 #[test]
 fn streams_the_latched_command_and_speed_requests() {
     let sim = sim();
-    let mut driver = Driver::new(sim.path(), never_stale()).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), never_stale()).unwrap();
     let command = PcControl::from_yaw_rate(0.5, 0.2).unwrap(); // curvature 0.4 1/m
     driver.set_command(0.5, 0.2).unwrap();
     wait_until("50 frames of the command", || controls(&sim).iter().filter(|c| **c == command).count() >= 50);
-    driver.stop().unwrap();
     let stats = driver.stats();
-    wait_until("every frame sent has arrived", || {
-        let seen = sim.stats();
-        (seen.control_frames, seen.speed_requests)
-            == (stats.control_frames_sent + stats.stop_frames_sent, stats.speed_requests_sent)
-    });
+    assert!(stats.speed_requests_sent > 0);
+    assert_eq!(stats.control_lateness.count, stats.control_frames_sent, "every tick measured");
+    assert_eq!((stats.command_timeouts, stats.write_errors), (0, 0));
+    driver.close().unwrap();
+    // The stop burst is the sentinel: once it has arrived, so has everything sent before it.
+    wait_until("the stop burst after the command", || controls(&sim).ends_with(&[command, PcControl::STOP, PcControl::STOP, PcControl::STOP]));
     let frames = controls(&sim);
     // (0, 0) until the command was latched, then the command without a gap, then the burst.
     let first = frames.iter().position(|c| *c == command).unwrap();
@@ -63,17 +62,14 @@ fn streams_the_latched_command_and_speed_requests() {
     let (moving, tail) = frames[first..].split_at(frames.len() - first - 3);
     assert!(moving.iter().all(|c| *c == command), "{frames:?}");
     assert_eq!(tail, [PcControl::STOP; 3]);
-    assert!(stats.speed_requests_sent > 0);
-    assert_eq!(stats.control_lateness.count, stats.control_frames_sent, "every tick measured");
-    assert_eq!((stats.command_timeouts, stats.write_errors), (0, 0));
+    assert!(sim.stats().speed_requests > 0);
 }
 
 #[test]
 fn a_stale_command_becomes_stop_without_a_call() {
     let sim = sim();
     let options = DriverOptions { command_timeout: Duration::from_millis(100), ..Default::default() };
-    let mut driver = Driver::new(sim.path(), options).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), options).unwrap();
     let drive = PcControl { velocity_mps: 0.4, curvature_per_m: 0.0 };
     driver.set_command(0.4, 0.0).unwrap();
     // The command went out, then (0, 0) by itself, for a while.
@@ -91,42 +87,33 @@ fn a_stale_command_becomes_stop_without_a_call() {
     assert_eq!(stats.command_timeouts, 1);
     assert!(stats.timeout_frames_sent as usize >= frames.len() - first - moving);
     assert_eq!(sim.state().commanded_velocity_mps, 0.0);
-    driver.stop().unwrap();
+    driver.close().unwrap();
 }
 
 #[test]
-fn stop_sends_the_burst_and_nothing_after() {
+fn close_sends_the_burst_and_frees_the_port() {
     let sim = sim();
-    let mut driver = Driver::new(sim.path(), never_stale()).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), never_stale()).unwrap();
     assert!(driver.is_running());
     assert_eq!(driver.link_state(), LinkState::Connected);
     driver.set_command(1.0, 0.0).unwrap();
     wait_until("the command on the line", || controls(&sim).iter().any(|c| c.velocity_mps == 1.0));
-    driver.stop().unwrap();
-    assert!(!driver.is_running());
-    assert_eq!(driver.link_state(), LinkState::Stopped);
-    driver.stop().unwrap(); // idempotent
-    let stats = driver.stats();
-    assert_eq!(stats.stop_frames_sent, 3);
-    let sent = stats.control_frames_sent + stats.stop_frames_sent;
-    wait_until("every frame sent has arrived", || sim.stats().control_frames == sent);
-    let frames = controls(&sim);
-    assert_eq!(frames[frames.len() - 3..], [PcControl::STOP; 3], "the last three frames are (0, 0)");
-    assert_eq!(frames[frames.len() - 4].velocity_mps, 1.0, "the burst follows the command");
-    assert!(matches!(driver.request_battery_once(0), Err(KmcError::NotRunning)));
-    // The port is free again: a new driver opens it.
-    let mut again = Driver::new(sim.path(), DriverOptions::default()).unwrap();
-    again.start().unwrap();
-    again.stop().unwrap();
+    driver.close().unwrap();
+    let drive = PcControl { velocity_mps: 1.0, curvature_per_m: 0.0 };
+    let burst = [drive, PcControl::STOP, PcControl::STOP, PcControl::STOP];
+    wait_until("the burst after the command", || controls(&sim).ends_with(&burst));
+    // The port is free again at once: a new driver opens it, and dropping it stops it too.
+    let again = Driver::open(sim.path(), DriverOptions::default()).unwrap();
+    assert_eq!(again.link_state(), LinkState::Connected);
+    drop(again);
+    wait_until("the dropped driver's burst", || controls(&sim).ends_with(&[PcControl::STOP; 6]));
 }
 
 #[test]
 fn unplug_is_reported_and_the_driver_reconnects() {
     let link = std::env::temp_dir().join(format!("robowire-kmc-driver-{}", std::process::id()));
     let sim = ChassisSim::spawn(ChassisSimConfig { link: Some(link.clone()), ..Default::default() }).unwrap();
-    let mut driver = Driver::new(&link, never_stale()).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(&link, never_stale()).unwrap();
     driver.set_command(0.3, 0.0).unwrap();
     wait_until("the command on the line", || sim.state().commanded_velocity_mps == 0.3);
     sim.inject(Fault::HangUp);
@@ -140,15 +127,14 @@ fn unplug_is_reported_and_the_driver_reconnects() {
     wait_until("the stream resumed on the new line", || sim.stats().control_frames > before + 5);
     assert_eq!(sim.state().commanded_velocity_mps, 0.3, "with the latched command");
     assert_eq!(driver.stats().link.reopens, 1);
-    driver.stop().unwrap();
+    driver.close().unwrap();
 }
 
 #[test]
 fn polls_and_one_shot_requests_deliver_messages() {
     let sim = sim();
     let options = DriverOptions { poll_battery: true, poll_allstate: true, ..never_stale() };
-    let mut driver = Driver::new(sim.path(), options).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), options).unwrap();
     driver.set_command(0.8, 0.0).unwrap();
     let (mut speeds, mut batteries, mut states) = (Vec::new(), 0, [0; 2]);
     // First-order response: the speed rises towards 0.8 m/s.
@@ -175,19 +161,25 @@ fn polls_and_one_shot_requests_deliver_messages() {
             .find(|f| matches!(f, ChassisFrame::BatteryVoltage(b) if b.motor_id == 1));
         one_shot.is_some()
     });
-    driver.stop().unwrap();
     assert_eq!(driver.stats().command_timeouts, 0);
     assert_eq!(driver.stats().link.decoder.skipped_bytes, 0);
+    // The same reports in the driver's state, with the odometry integrated from the speed.
+    let state = driver.latest().expect("a chassis state").state;
+    assert!(state.battery.is_some() && state.motors.iter().all(Option::is_some), "{state:?}");
+    assert!(state.odometry.x_m > 0.0 && state.odometry.y_m.abs() < 1e-9, "{:?}", state.odometry);
+    driver.close().unwrap();
 }
 
 #[test]
 fn full_queue_drops_the_oldest_and_counts() {
     let sim = sim();
     let options = DriverOptions { max_queue: 4, vehicle_speed_rate_hz: 200.0, ..Default::default() };
-    let mut driver = Driver::new(sim.path(), options).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), options).unwrap();
     wait_until("frames dropped from the full queue", || driver.stats().queue_dropped > 10);
-    driver.stop().unwrap();
+    // The chassis falls silent; once everything it sent has arrived, the counts stand still.
+    sim.inject(Fault::DropResponses { count: u32::MAX });
+    wait_until("a response swallowed", || sim.stats().responses_dropped > 0);
+    wait_until("every response sent received", || driver.stats().frames_received == sim.stats().responses_sent);
     let stats = driver.stats();
     let queued = std::iter::from_fn(|| driver.try_pop_message()).count() as u64;
     assert_eq!(queued, 4, "the queue holds max_queue frames");
@@ -197,8 +189,7 @@ fn full_queue_drops_the_oldest_and_counts() {
 #[test]
 fn invalid_arguments_are_refused_before_anything_is_sent() {
     let sim = sim();
-    let mut driver = Driver::new(sim.path(), never_stale()).unwrap();
-    driver.start().unwrap();
+    let driver = Driver::open(sim.path(), never_stale()).unwrap();
     driver.set_command(0.2, 0.0).unwrap();
     for (v, w) in [(f32::NAN, 0.0), (0.0, f32::INFINITY), (f32::NEG_INFINITY, 1.0)] {
         let err = driver.set_command(v, w).unwrap_err();
@@ -212,42 +203,73 @@ fn invalid_arguments_are_refused_before_anything_is_sent() {
     let frames = controls(&sim);
     assert!(frames.iter().all(|c| c.velocity_mps.is_finite() && c.curvature_per_m.is_finite()));
     assert_eq!(frames.last().unwrap().velocity_mps, 0.2, "the previous command stays");
-    driver.stop().unwrap();
+    driver.close().unwrap();
 }
 
 #[test]
-fn invalid_options_and_start_failures_are_typed() {
+fn invalid_options_and_open_failures_are_typed() {
     let bad = [
         DriverOptions { control_rate_hz: 0.0, ..Default::default() },
         DriverOptions { vehicle_speed_rate_hz: f64::NAN, ..Default::default() },
         DriverOptions { control_rate_hz: 5000.0, ..Default::default() },
         DriverOptions { stop_burst_count: 0, ..Default::default() },
         DriverOptions { max_queue: 0, ..Default::default() },
-        DriverOptions { realtime_priority: Some(0), ..Default::default() },
+        DriverOptions { command_timeout: Duration::ZERO, ..Default::default() },
+        DriverOptions { command_timeout: Duration::from_secs(3601), ..Default::default() },
+        DriverOptions { state_timeout: Duration::from_millis(1), ..Default::default() },
     ];
     for options in bad {
-        assert!(matches!(Driver::new("/dev/null", options), Err(KmcError::Option { .. })));
+        assert!(matches!(Driver::open("/dev/null", options), Err(KmcError::Option { .. })));
     }
-    let mut missing = Driver::new("/dev/robowire-no-such-chassis", DriverOptions::default()).unwrap();
-    let err = missing.start().unwrap_err();
+    let priority = DriverOptions { placement: Placement::realtime(0, None), ..Default::default() };
+    assert!(matches!(Driver::open("/dev/null", priority), Err(KmcError::Thread(RtError::RealtimePriority { .. }))));
+    let err = Driver::open("/dev/robowire-no-such-chassis", DriverOptions::default()).unwrap_err();
     assert!(matches!(err, KmcError::Link(_)), "{err}");
-    assert!(!missing.is_running());
 
     let sim = sim();
-    let mut pinned = Driver::new(sim.path(), DriverOptions { cpu_affinity: Some(0), ..Default::default() }).unwrap();
-    pinned.start().unwrap();
-    assert!(matches!(pinned.start(), Err(KmcError::AlreadyRunning)));
-    pinned.stop().unwrap();
-    let mut nowhere =
-        Driver::new(sim.path(), DriverOptions { cpu_affinity: Some(1 << 20), ..Default::default() }).unwrap();
-    assert!(matches!(nowhere.start(), Err(KmcError::Placement(RtError::CpuAffinity { cpu, .. })) if cpu == 1 << 20));
+    let on_cpu =
+        |cpu| DriverOptions { placement: Placement { cpu: Some(cpu), ..Placement::default() }, ..Default::default() };
+    let pinned = Driver::open(sim.path(), on_cpu(0)).unwrap();
+    assert!(matches!(pinned.set_command_timeout(Duration::from_secs(3601)), Err(KmcError::Option { .. })));
+    pinned.close().unwrap();
+    let nowhere = Driver::open(sim.path(), on_cpu(1 << 20));
+    assert!(matches!(nowhere, Err(KmcError::Thread(RtError::CpuAffinity { cpu, .. })) if cpu == 1 << 20));
     // SCHED_FIFO needs privileges this machine may or may not grant: either it works, or the
-    // error says which priority failed. The failed start above left the port free.
-    let mut realtime =
-        Driver::new(sim.path(), DriverOptions { realtime_priority: Some(10), ..Default::default() }).unwrap();
-    match realtime.start() {
-        Ok(()) => realtime.stop().unwrap(),
-        Err(KmcError::Placement(RtError::RealtimePriority { priority: 10, .. })) => {}
+    // error says which priority failed. The failed open above left the port free.
+    match Driver::open(sim.path(), DriverOptions { placement: Placement::realtime(10, None), ..Default::default() }) {
+        Ok(realtime) => realtime.close().unwrap(),
+        Err(KmcError::Thread(RtError::RealtimePriority { priority: 10, .. })) => {}
         Err(other) => panic!("unexpected error {other}"),
     }
+}
+
+#[test]
+fn a_longer_command_timeout_keeps_a_command_alive_without_refreshes() {
+    let sim = sim();
+    let options = DriverOptions { command_timeout: Duration::from_millis(50), ..Default::default() };
+    let driver = Driver::open(sim.path(), options).unwrap();
+    // A bridge with a deadman of its own: one command, no keep-alive.
+    driver.set_command_timeout(Duration::from_secs(10)).unwrap();
+    driver.set_command(0.4, 0.0).unwrap();
+    let drive = PcControl { velocity_mps: 0.4, curvature_per_m: 0.0 };
+    wait_until("100 frames of the one command", || controls(&sim).iter().filter(|c| **c == drive).count() >= 100);
+    assert_eq!(driver.stats().command_timeouts, 0, "never stale");
+    // Shortened again: the same command goes stale, and (0, 0) follows.
+    driver.set_command_timeout(Duration::from_millis(20)).unwrap();
+    wait_until("a stop after the timeout", || driver.stats().command_timeouts == 1);
+    driver.close().unwrap();
+}
+
+#[test]
+fn a_silent_chassis_is_noticed_and_its_return_reconnects() {
+    let sim = sim();
+    let options = DriverOptions { state_timeout: Duration::from_millis(100), ..never_stale() };
+    let driver = Driver::open(sim.path(), options).unwrap();
+    assert!(driver.wait_state(WATCHDOG, |s| s.speed_mps.is_some()).is_some(), "speed reports arrive");
+    assert_eq!(driver.connection(), Connection::Connected);
+    sim.inject(Fault::DropResponses { count: 100 });
+    wait_until("disconnected", || driver.stats().state_timeouts == 1);
+    wait_until("reconnected when the chassis answers again", || driver.connection() == Connection::Connected);
+    assert_eq!(driver.link_state(), LinkState::Connected, "the port itself never went away");
+    driver.close().unwrap();
 }

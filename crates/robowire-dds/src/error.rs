@@ -1,4 +1,7 @@
-//! Why a DDS operation failed.
+//! Why a DDS operation failed. The middleware's own error is kept as the source.
+
+use rustdds::dds::CreateError;
+use rustdds::dds::WriteError;
 
 /// Why a participant, a writer, a reader or a call failed.
 #[derive(Debug, thiserror::Error)]
@@ -13,42 +16,43 @@ pub enum DdsError {
         available: String,
     },
     /// The participant could not be created (sockets, ports).
-    #[error("cannot create a DDS participant in domain {domain}: {reason}")]
+    #[error("cannot create a DDS participant in domain {domain}")]
     Participant {
         /// The domain.
         domain: u16,
-        /// The library's reason.
-        reason: String,
+        /// What the middleware said.
+        #[source]
+        source: CreateError,
     },
     /// A topic, writer or reader could not be created.
-    #[error("cannot create the {what} of topic {topic}: {reason}")]
+    #[error("cannot create the {what} of topic {topic}")]
     Create {
         /// Writer, reader or topic.
         what: &'static str,
         /// The topic name.
         topic: String,
-        /// The library's reason.
-        reason: String,
+        /// What the middleware said.
+        #[source]
+        source: CreateError,
     },
     /// A sample could not be written.
-    #[error("writing to {topic} failed: {reason}")]
+    #[error("writing to {topic} failed")]
     Write {
         /// The topic.
         topic: String,
-        /// The reason.
-        reason: String,
+        /// What the middleware said.
+        #[source]
+        source: WriteError<()>,
     },
     /// A request got no answer in time.
-    #[error("no answer from service {service} (api {api_id}) within {timeout:?}")]
+    #[error("no answer on {topic} within {timeout:?}")]
     NoAnswer {
-        /// The service.
-        service: String,
-        /// The API id.
-        api_id: i64,
+        /// The answers' topic.
+        topic: String,
         /// How long the call waited.
         timeout: std::time::Duration,
     },
-    /// A reader's stream ended (the participant is gone).
+    /// A reader's stream ended, or the participant is gone.
     #[error("the reader of {topic} was closed")]
     Closed {
         /// The topic.

@@ -75,12 +75,11 @@ impl Participant {
             let ips = interface_addresses(name)?;
             builder = builder.with_only_networks(ips.into_iter().map(IpAddr::V4));
         }
-        let failed =
-            |e: &dyn std::fmt::Display| DdsError::Participant { domain: options.domain, reason: e.to_string() };
-        let inner = builder.build().map_err(|e| failed(&e))?;
+        let failed = |source| DdsError::Participant { domain: options.domain, source };
+        let inner = builder.build().map_err(failed)?;
         let qos = Qos::WRITER.policies();
-        let publisher = inner.create_publisher(&qos).map_err(|e| failed(&e))?;
-        let subscriber = inner.create_subscriber(&Qos::READER.policies()).map_err(|e| failed(&e))?;
+        let publisher = inner.create_publisher(&qos).map_err(failed)?;
+        let subscriber = inner.create_subscriber(&Qos::READER.policies()).map_err(failed)?;
         Ok(Self { inner, publisher, subscriber, options })
     }
 
@@ -92,7 +91,7 @@ impl Participant {
     fn topic(&self, name: &str, type_name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
         self.inner
             .create_topic(name.into(), type_name.into(), &qos.policies(), TopicKind::NoKey)
-            .map_err(|e| DdsError::Create { what, topic: name.into(), reason: e.to_string() })
+            .map_err(|source| DdsError::Create { what, topic: name.into(), source })
     }
 
     /// A writer of `T` on topic `name`.
@@ -101,7 +100,19 @@ impl Participant {
         let inner = self
             .publisher
             .create_datawriter_no_key::<T, CdrAdapter<T>>(&topic, Some(qos.policies()))
-            .map_err(|e| DdsError::Create { what: "writer", topic: name.into(), reason: e.to_string() })?;
+            .map_err(|source| DdsError::Create { what: "writer", topic: name.into(), source })?;
+        Ok(Writer::new(inner, name))
+    }
+
+    /// A writer of topic `name` whose samples are given as bytes ([`RawSample`]: an XCDR1 body),
+    /// announced with the type name `type_name` (a passthrough of a message robowire does not
+    /// decode here).
+    pub fn raw_writer(&self, name: &str, type_name: &str, qos: Qos) -> Result<Writer<RawSample>, DdsError> {
+        let topic = self.topic(name, type_name, qos, "writer")?;
+        let inner = self
+            .publisher
+            .create_datawriter_no_key::<RawSample, CdrAdapter<RawSample>>(&topic, Some(qos.policies()))
+            .map_err(|source| DdsError::Create { what: "writer", topic: name.into(), source })?;
         Ok(Writer::new(inner, name))
     }
 
@@ -126,7 +137,7 @@ impl Participant {
         let inner = self
             .subscriber
             .create_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))
-            .map_err(|e| DdsError::Create { what: "reader", topic: name.into(), reason: e.to_string() })?;
+            .map_err(|source| DdsError::Create { what: "reader", topic: name.into(), source })?;
         Ok(Reader::new(inner, name))
     }
 

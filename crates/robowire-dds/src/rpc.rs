@@ -1,18 +1,19 @@
-//! Requests and answers of the robot's services over `rt/api/<service>/request` and
-//! `/response` (spec `unitree-dds.md`): a client that matches answers to its calls by
-//! `identity.id` (and checks `api_id`), and a server that hands out requests and answers them.
+//! Request and answer over two topics, for any request/answer pair of CDR types: a client that
+//! pairs answers with its calls by an id the [`Service`] reads out of both, and a server that
+//! hands out requests and writes answers. The types and how they correlate are the caller's (a
+//! vendor's service protocol lives with its device, not here).
 //!
-//! DDS discovery takes a moment and the topics are volatile: a request written before the
-//! service's reader is matched is lost. The client therefore waits for a matched reader before
-//! its first write and writes the same request again (same id) until an answer comes or the
-//! call times out; the services robowire calls are idempotent.
+//! DDS discovery takes a moment and volatile topics keep nothing for late readers: a request
+//! written before the service's reader is matched is lost. The client therefore waits for a
+//! matched reader before its first write and writes the same request again until an answer
+//! comes or the call times out, so a service's calls must be idempotent.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicI64, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, Response};
+use robowire_core::cdr::CdrType;
+use robowire_rt::lock;
 use tokio::sync::oneshot;
 use tokio::task::JoinHandle;
 
@@ -22,80 +23,87 @@ use crate::{DdsError, Participant, Reader, Writer};
 /// How often a request without an answer is written again.
 pub const RESEND_EVERY: Duration = Duration::from_millis(250);
 
-type Pending = Arc<Mutex<HashMap<i64, oneshot::Sender<ApiResponse>>>>;
+/// How often a call looks for a matched service reader before its first write.
+const DISCOVERY_POLL: Duration = Duration::from_millis(10);
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(PoisonError::into_inner)
+/// A request/answer protocol: its two types and how an answer names its request.
+pub trait Service: 'static {
+    /// What a client writes.
+    type Request: CdrType + Clone + Send + Sync + 'static;
+    /// What the service answers.
+    type Answer: CdrType + Send + 'static;
+    /// The id that pairs `request` with its answer.
+    fn request_id(request: &Self::Request) -> i64;
+    /// The id of the request `answer` answers.
+    fn answer_id(answer: &Self::Answer) -> i64;
 }
 
-/// Calls one service. Needs a tokio runtime: a task reads the answers.
-#[derive(Debug)]
-pub struct RpcClient {
-    service: String,
-    requests: Writer<ApiRequest>,
-    pending: Pending,
-    next_id: AtomicI64,
+type Pending<A> = Arc<Mutex<HashMap<i64, oneshot::Sender<A>>>>;
+
+/// Calls one service. Create it inside a tokio runtime: a task of that runtime reads the
+/// answers, and calls need its timer.
+pub struct RpcClient<S: Service> {
+    requests: Writer<S::Request>,
+    answer_topic: String,
+    pending: Pending<S::Answer>,
     answers: JoinHandle<()>,
 }
 
-impl Drop for RpcClient {
+impl<S: Service> std::fmt::Debug for RpcClient<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RpcClient").field("requests", &self.requests.topic()).finish_non_exhaustive()
+    }
+}
+
+impl<S: Service> Drop for RpcClient<S> {
     fn drop(&mut self) {
         self.answers.abort();
     }
 }
 
-impl RpcClient {
-    /// A client of `service` (`motion_switcher`, `sport`, …).
-    pub fn new(participant: &Participant, service: &str) -> Result<Self, DdsError> {
-        let requests = participant.writer::<ApiRequest>(&api::request_topic(service).to_string(), Qos::WRITER)?;
-        let mut answers =
-            participant.reader::<ApiResponse>(&api::response_topic(service).to_string(), Qos::RPC_READER)?;
-        let pending: Pending = Arc::default();
+impl<S: Service> RpcClient<S> {
+    /// A client writing requests to `request_topic` and reading answers from `answer_topic`.
+    pub fn new(participant: &Participant, request_topic: &str, answer_topic: &str) -> Result<Self, DdsError> {
+        let requests = participant.writer::<S::Request>(request_topic, Qos::WRITER)?;
+        let mut answers = participant.reader::<S::Answer>(answer_topic, Qos::RPC_READER)?;
+        let pending: Pending<S::Answer> = Arc::default();
         let task = tokio::spawn({
             let pending = pending.clone();
             async move {
                 while let Ok(answer) = answers.recv().await {
                     // An answer to another client's call, or to a call that gave up: dropped.
-                    if let Some(waiter) = lock(&pending).remove(&answer.value.id) {
+                    let waiter = lock(&pending).remove(&S::answer_id(&answer.value));
+                    if let Some(waiter) = waiter {
                         let _ = waiter.send(answer.value);
                     }
                 }
             }
         });
-        // Request ids as Unitree's SDKs make them: the monotonic clock in ns, unique per call.
-        let first_id = i64::try_from(robowire_now_ns()).unwrap_or(1);
-        Ok(Self { service: service.into(), requests, pending, next_id: AtomicI64::new(first_id), answers: task })
+        Ok(Self { requests, answer_topic: answer_topic.into(), pending, answers: task })
     }
 
-    /// The service.
-    pub fn service(&self) -> &str {
-        &self.service
-    }
-
-    /// Calls `api_id` with `parameter` (JSON by convention) and waits up to `timeout` for the
-    /// answer (whatever its status code: check [`ApiResponse::code`]).
-    pub async fn call(&self, api_id: i64, parameter: &str, timeout: Duration) -> Result<ApiResponse, DdsError> {
-        let id = self.next_id.fetch_add(1, Ordering::Relaxed);
+    /// Writes `request` (again every [`RESEND_EVERY`]) until its answer arrives, up to
+    /// `timeout`. The caller makes the request's id unique among its calls.
+    pub async fn call(&self, request: S::Request, timeout: Duration) -> Result<S::Answer, DdsError> {
+        let id = S::request_id(&request);
         let (tx, mut rx) = oneshot::channel();
         lock(&self.pending).insert(id, tx);
-        let request =
-            ApiRequest { header: RequestHeader::call(id, api_id), parameter: parameter.into(), binary: Vec::new() };
         let deadline = Instant::now() + timeout;
-        let no_answer = || DdsError::NoAnswer { service: self.service.clone(), api_id, timeout };
+        let no_answer = || DdsError::NoAnswer { topic: self.answer_topic.clone(), timeout };
         let result = async {
             // Discovery first: a request nobody reads is lost.
             while self.requests.matched_readers() == 0 {
                 if Instant::now() >= deadline {
                     return Err(no_answer());
                 }
-                tokio::time::sleep(Duration::from_millis(10)).await;
+                tokio::time::sleep(DISCOVERY_POLL).await;
             }
             loop {
                 self.requests.write(request.clone())?;
                 let wait = RESEND_EVERY.min(deadline.saturating_duration_since(Instant::now()));
                 match tokio::time::timeout(wait, &mut rx).await {
-                    Ok(Ok(answer)) if answer.api_id == api_id => return Ok(answer),
-                    Ok(Ok(_)) | Ok(Err(_)) => return Err(no_answer()),
+                    Ok(Ok(answer)) => return Ok(answer),
+                    Ok(Err(_)) => return Err(no_answer()),
                     Err(_) if Instant::now() >= deadline => return Err(no_answer()),
                     Err(_) => {}
                 }
@@ -107,45 +115,36 @@ impl RpcClient {
     }
 }
 
-fn robowire_now_ns() -> u64 {
-    let t = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
-    u64::try_from(t.as_nanos()).unwrap_or(1)
+/// Serves one service: hands out its requests (`Q`), writes its answers (`A`). The answer names
+/// its request the way the protocol says (the server needs no [`Service`]).
+pub struct RpcServer<Q: CdrType + 'static, A: CdrType + 'static> {
+    requests: Reader<Q>,
+    answers: Writer<A>,
 }
 
-/// Serves one service: hands out its requests, writes its answers.
-#[derive(Debug)]
-pub struct RpcServer {
-    service: String,
-    requests: Reader<ApiRequest>,
-    answers: Writer<ApiResponse>,
+impl<Q: CdrType + 'static, A: CdrType + 'static> std::fmt::Debug for RpcServer<Q, A> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RpcServer").field("requests", &self.requests.topic()).finish_non_exhaustive()
+    }
 }
 
-impl RpcServer {
-    /// A server of `service`.
-    pub fn new(participant: &Participant, service: &str) -> Result<Self, DdsError> {
+impl<Q: CdrType + 'static, A: CdrType + 'static> RpcServer<Q, A> {
+    /// A server reading requests from `request_topic` and answering on `answer_topic`.
+    pub fn new(participant: &Participant, request_topic: &str, answer_topic: &str) -> Result<Self, DdsError> {
         Ok(Self {
-            service: service.into(),
-            requests: participant.reader(&api::request_topic(service).to_string(), Qos::RPC_READER)?,
-            answers: participant.writer(&api::response_topic(service).to_string(), Qos::WRITER)?,
+            requests: participant.reader(request_topic, Qos::RPC_READER)?,
+            answers: participant.writer(answer_topic, Qos::WRITER)?,
         })
     }
 
-    /// The service.
-    pub fn service(&self) -> &str {
-        &self.service
-    }
-
     /// The next request.
-    pub async fn next_request(&mut self) -> Result<ApiRequest, DdsError> {
+    pub async fn next_request(&mut self) -> Result<Q, DdsError> {
         Ok(self.requests.recv().await?.value)
     }
 
-    /// Answers `request` with `code` and `data`, unless it asked for no answer.
-    pub fn answer(&self, request: &RequestHeader, code: i32, data: &str) -> Result<(), DdsError> {
-        if request.noreply {
-            return Ok(());
-        }
-        self.answers.write(Response::to(request, code, data).into())
+    /// Writes `answer`.
+    pub fn answer(&self, answer: A) -> Result<(), DdsError> {
+        self.answers.write(answer)
     }
 
     /// Counters of the request reader and the answer writer.

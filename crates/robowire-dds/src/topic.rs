@@ -88,7 +88,7 @@ impl<T: CdrType + 'static> Writer<T> {
             }
             Err(e) => {
                 Counters::bump(&self.counters.write_errors);
-                Err(DdsError::Write { topic: self.topic.clone(), reason: e.to_string() })
+                Err(DdsError::Write { topic: self.topic.clone(), source: e.forget_data() })
             }
         }
     }

@@ -3,14 +3,28 @@
 
 use std::time::Duration;
 
-use lowcmd_proto::api::{motion_switcher, status};
+use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, Response, motion_switcher, status};
 use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_dds::netns::in_loopback_namespace;
 use robowire_dds::qos::Qos;
-use robowire_dds::rpc::{RpcClient, RpcServer};
+use robowire_dds::rpc::{RpcClient, RpcServer, Service};
 use robowire_dds::{Participant, ParticipantOptions};
 
 const WAIT: Duration = Duration::from_secs(20);
+
+/// A request/answer protocol for the test: Unitree's service messages, paired by id.
+struct Api;
+
+impl Service for Api {
+    type Request = ApiRequest;
+    type Answer = ApiResponse;
+    fn request_id(request: &ApiRequest) -> i64 {
+        request.header.id
+    }
+    fn answer_id(answer: &ApiResponse) -> i64 {
+        answer.id
+    }
+}
 
 fn runtime() -> tokio::runtime::Runtime {
     tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap()
@@ -44,18 +58,28 @@ fn lowcmd_and_lowstate_between_two_participants_and_a_call() {
             assert!(commands.stats().samples >= 1 && commands.stats().checksum_errors == 0);
 
             // A service call.
-            let mut server = RpcServer::new(&robot, motion_switcher::SERVICE).unwrap();
+            let (requests, answers) = (
+                api::request_topic(motion_switcher::SERVICE).to_string(),
+                api::response_topic(motion_switcher::SERVICE).to_string(),
+            );
+            let mut server = RpcServer::<ApiRequest, ApiResponse>::new(&robot, &requests, &answers).unwrap();
             // A server answers every request: a client writes its request again until an answer
             // gets through (the first may be lost while discovery completes).
             let serve = tokio::spawn(async move {
                 while let Ok(request) = server.next_request().await {
                     assert_eq!(request.header.api_id, motion_switcher::CHECK_MODE);
-                    server.answer(&request.header, status::OK, r#"{"form":"0","name":"normal"}"#).unwrap();
+                    let answer = Response::to(&request.header, status::OK, r#"{"form":"0","name":"normal"}"#);
+                    server.answer(answer.into()).unwrap();
                 }
             });
-            let switcher = RpcClient::new(&client, motion_switcher::SERVICE).unwrap();
-            let answer = switcher.call(motion_switcher::CHECK_MODE, "{}", WAIT).await.unwrap();
-            assert_eq!((answer.code, answer.data.as_str()), (status::OK, r#"{"form":"0","name":"normal"}"#));
+            let switcher = RpcClient::<Api>::new(&client, &requests, &answers).unwrap();
+            let request = ApiRequest {
+                header: RequestHeader::call(7, motion_switcher::CHECK_MODE),
+                parameter: "{}".into(),
+                binary: Vec::new(),
+            };
+            let answer = switcher.call(request, WAIT).await.unwrap();
+            assert_eq!((answer.id, answer.code, answer.data.as_str()), (7, status::OK, r#"{"form":"0","name":"normal"}"#));
             serve.abort();
 
             let _ = LowState::default();

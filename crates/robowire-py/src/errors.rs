@@ -100,16 +100,4 @@ pub(crate) fn service_error(message: impl Display, service: &str, api_id: i64, c
 }
 
 /// An error and its sources, `: `-joined.
-pub(crate) fn chain(error: &dyn std::error::Error) -> String {
-    let mut text = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        let cause_text = cause.to_string();
-        if !text.contains(&cause_text) {
-            text.push_str(": ");
-            text.push_str(&cause_text);
-        }
-        source = cause.source();
-    }
-    text
-}
+pub(crate) use robowire_devices::error_chain as chain;

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use robowire_record::{Direction, Protocol, Recorder};
 use robowire_sim::dog::{DogSim, DogSimConfig};
 use serde_json::json;
-use zsl::udp::{ClientOptions, HighLevel};
+use zsl::udp::{ClientOptions, Device, HighLevel};
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
 fn temp(name: &str) -> std::path::PathBuf {
@@ -31,11 +31,11 @@ fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32
         if let Some(recorder) = &recorder {
             options = options.with_tap(recorder.link("dog/high_level", Protocol::ZslHighLevel));
         }
-        let dog = HighLevel::connect(options).await.unwrap();
+        let dog = HighLevel::open(options).unwrap();
         assert!(dog.wait_connected(Duration::from_secs(2)).await);
         tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
         let lateness = dog.stats().stream_lateness;
-        dog.close().await;
+        dog.close();
         (lateness, recorder.as_ref().map_or(0, Recorder::dropped))
     });
     if let Some(recorder) = recorder {

@@ -136,13 +136,13 @@ fn main() {
         let mut direct = Vec::with_capacity(n);
         runtime.block_on(async {
             let options = ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
-            let robot = HighLevel::connect(options).await.unwrap();
+            let robot = HighLevel::open(options).unwrap();
             let client = dog.greet();
             assert!(robot.wait_connected(Duration::from_secs(2)).await);
             for i in 0..n + 50 {
                 let vx = speeds[i % 2];
                 let start = Instant::now();
-                robot.move_velocity(vx, 0.0, 0.0).await.unwrap();
+                robot.move_velocity(vx, 0.0, 0.0).unwrap();
                 dog.wait_for_vx(vx);
                 if i >= 50 {
                     direct.push(start.elapsed().as_secs_f64() * 1e6);
@@ -151,7 +151,7 @@ fn main() {
                     dog.keep_alive(client);
                 }
             }
-            robot.close().await;
+            robot.close();
         });
         let (b50, b99) = percentiles(bridged);
         let (d50, d99) = percentiles(dds);

@@ -6,13 +6,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use robowire_dds::{DdsError, Participant, ParticipantOptions};
-use robowire_sim::dog::{DogSim, DogSimConfig};
-use robowire_sim::go2::{Go2Sim, Go2SimConfig};
-use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, OpenOptions};
 use tokio::sync::watch;
-use zsl::udp::{ClientOptions, HighLevel, Model};
 
-use crate::address::{DeviceAddress, SimKind, namespaces};
 use crate::node::{Node, NodeOptions};
 use crate::report::{DeviceCounters, DeviceReport};
 
@@ -60,13 +56,14 @@ pub enum BridgeError {
     /// DDS.
     #[error(transparent)]
     Dds(#[from] DdsError),
-    /// A device could not be opened.
-    #[error("{device}: {reason}")]
+    /// A device could not be opened, or refused what the bridge needs of it.
+    #[error("{address}")]
     Device {
         /// The device's address.
-        device: String,
+        address: DeviceAddress,
         /// Why.
-        reason: String,
+        #[source]
+        source: DeviceError,
     },
 }
 
@@ -89,6 +86,31 @@ impl BridgedDevice {
 }
 
 type DeviceFuture<'a> = Pin<Box<dyn Future<Output = Result<(), BridgeError>> + Send + 'a>>;
+
+/// The namespace of each device: with one device and no `--namespace`, the root; with one
+/// device and a namespace, that namespace; with several, `NS/KIND INDEX`, the index counted per
+/// kind (`/kmc0`, `/kmc1`, `/zsl1_0`: an underscore after a kind that ends in a digit).
+pub fn namespaces(devices: &[DeviceAddress], namespace: Option<&str>) -> Vec<String> {
+    let base = namespace.map(|ns| ns.trim_matches('/')).filter(|ns| !ns.is_empty());
+    if devices.len() == 1 {
+        return vec![base.map(|ns| format!("/{ns}")).unwrap_or_default()];
+    }
+    devices
+        .iter()
+        .enumerate()
+        .map(|(n, device)| {
+            let kind = device.kind();
+            let i = devices[..n].iter().filter(|d| d.kind() == kind).count();
+            let kind = kind.name();
+            let sep = if kind.ends_with(|c: char| c.is_ascii_digit()) { "_" } else { "" };
+            let own = format!("{kind}{sep}{i}");
+            match base {
+                Some(ns) => format!("/{ns}/{own}"),
+                None => format!("/{own}"),
+            }
+        })
+        .collect()
+}
 
 /// Runs the bridge until `stop` is set, then stops every device (chassis stop burst, dog
 /// stop) before returning. `started` receives the devices once every one is open.
@@ -116,9 +138,15 @@ pub async fn run(
         .zip(spaces)
         .map(|(address, namespace)| BridgedDevice { address: address.clone(), namespace, report: Arc::default() })
         .collect();
-    let mut opened = Vec::new();
+    let open_options = OpenOptions {
+        domain: options.domain,
+        sim_interface: options.interface.clone(),
+        ..OpenOptions::default()
+    };
+    let mut opened: Vec<AnyDevice> = Vec::new();
     for device in &devices {
-        opened.push(open(&device.address, &options).await?);
+        let failed = |source| BridgeError::Device { address: device.address.clone(), source };
+        opened.push(robowire_devices::open(&device.address, &open_options).map_err(failed)?);
     }
     started(&devices);
     let runs: Vec<DeviceFuture<'_>> = devices
@@ -139,104 +167,32 @@ pub async fn run(
                 let _ = stop.wait_for(|s| *s).await;
             };
             let report = &*device.report;
-            let run: DeviceFuture<'_> = match open {
-                Opened::Kmc { driver, .. } => {
-                    Box::pin(async move { Ok(crate::kmc::run(node, driver, report, stopped).await?) })
-                }
-                Opened::Zsl { dog, model, .. } => {
-                    Box::pin(async move { Ok(crate::zsl::run(node, dog, *model, report, stopped).await?) })
-                }
-                Opened::Go2 { robot, .. } => {
-                    Box::pin(async move { Ok(crate::go2::run(node, robot, report, stopped).await?) })
-                }
-            };
+            let run: DeviceFuture<'_> = Box::pin(crate::device::run(node, open, report, stopped));
             run
         })
         .collect();
     let outcome = futures::future::try_join_all(runs).await;
+    // Each device's safe action (the chassis's stop burst, the dog's stop, damping) on close.
     for device in opened {
-        device.close().await;
+        let address = device.address().clone();
+        if let Err(e) = device.close() {
+            eprintln!("{address}: closing: {}", robowire_devices::error_chain(&e));
+        }
     }
     outcome.map(|_| devices)
 }
 
-/// An open device with the simulator it needs, if any.
-enum Opened {
-    Kmc { driver: kmc::Driver, _sim: Option<ChassisSim> },
-    Zsl { dog: HighLevel, model: Model, _sim: Option<DogSim> },
-    Go2 { robot: Box<go2::LowLevel<go2::Go2>>, _sim: Option<Go2Sim> },
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl Opened {
-    /// Stops the device safely: the chassis's stop burst, the dog's stop and socket.
-    async fn close(self) {
-        match self {
-            Self::Kmc { mut driver, .. } => {
-                let _ = driver.stop();
-            }
-            Self::Zsl { dog, .. } => {
-                let _ = dog.move_velocity(0.0, 0.0, 0.0).await;
-                dog.close().await;
-            }
-            Self::Go2 { .. } => {}
-        }
-    }
-}
-
-async fn open(address: &DeviceAddress, options: &BridgeOptions) -> Result<Opened, BridgeError> {
-    let failed = |reason: String| BridgeError::Device { device: format!("{address:?}"), reason };
-    let kmc_options = kmc::DriverOptions { poll_battery: true, poll_allstate: true, ..Default::default() };
-    let go2_options = |interface: Option<&str>| go2::LowLevelOptions {
-        participant: ParticipantOptions::new(options.domain, interface),
-        ..Default::default()
-    };
-    match address {
-        DeviceAddress::Kmc(path) => {
-            let mut driver = kmc::Driver::new(path, kmc_options).map_err(|e| failed(e.to_string()))?;
-            driver.start().map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Kmc { driver, _sim: None })
-        }
-        DeviceAddress::Sim(SimKind::Kmc) => {
-            let sim = ChassisSim::spawn(ChassisSimConfig::default()).map_err(|e| failed(e.to_string()))?;
-            let mut driver = kmc::Driver::new(sim.path(), kmc_options).map_err(|e| failed(e.to_string()))?;
-            driver.start().map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Kmc { driver, _sim: Some(sim) })
-        }
-        DeviceAddress::Zsl { wheeled, ip } => {
-            let model = if *wheeled { Model::Zsl1W } else { Model::Zsl1 };
-            let client =
-                ClientOptions::high_level(std::net::Ipv4Addr::UNSPECIFIED.into(), 43988, *ip).with_model(model);
-            let dog = HighLevel::connect(client).await.map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Zsl { dog, model, _sim: None })
-        }
-        DeviceAddress::Sim(kind @ (SimKind::Zsl1 | SimKind::Zsl1w)) => {
-            let model = if *kind == SimKind::Zsl1w { Model::Zsl1W } else { Model::Zsl1 };
-            let sim =
-                DogSim::spawn(DogSimConfig { model, ..DogSimConfig::loopback() }).map_err(|e| failed(e.to_string()))?;
-            let client = ClientOptions {
-                dog: sim.high_level_addr(),
-                ..ClientOptions::high_level(std::net::Ipv4Addr::LOCALHOST.into(), 0, sim.high_level_addr().ip())
-            }
-            .with_model(model);
-            let dog = HighLevel::connect(client).await.map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Zsl { dog, model, _sim: Some(sim) })
-        }
-        DeviceAddress::Go2 { interface } => {
-            let robot = go2::LowLevel::<go2::Go2>::connect(go2_options(Some(interface)))
-                .await
-                .map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Go2 { robot: Box::new(robot), _sim: None })
-        }
-        DeviceAddress::Sim(SimKind::Go2) => {
-            let interface = options.interface.as_deref();
-            let sim = Go2Sim::spawn(Go2SimConfig {
-                participant: ParticipantOptions::new(options.domain, interface),
-                ..Go2SimConfig::default()
-            })
-            .map_err(|e| failed(e.to_string()))?;
-            let robot =
-                go2::LowLevel::<go2::Go2>::connect(go2_options(interface)).await.map_err(|e| failed(e.to_string()))?;
-            Ok(Opened::Go2 { robot: Box::new(robot), _sim: Some(sim) })
-        }
+    #[test]
+    fn one_device_is_at_the_root_several_by_kind_and_index() {
+        let kmc: DeviceAddress = "sim:kmc".parse().unwrap();
+        let dog: DeviceAddress = "sim:zsl1".parse().unwrap();
+        assert_eq!(namespaces(std::slice::from_ref(&kmc), None), [""]);
+        assert_eq!(namespaces(std::slice::from_ref(&kmc), Some("/robot1/")), ["/robot1"]);
+        assert_eq!(namespaces(&[kmc.clone(), dog.clone(), kmc.clone()], None), ["/kmc0", "/zsl1_0", "/kmc1"]);
+        assert_eq!(namespaces(&[kmc, dog], Some("lab")), ["/lab/kmc0", "/lab/zsl1_0"]);
     }
 }

@@ -1,16 +1,13 @@
 #![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
 
-pub mod address;
 mod bridge;
-mod go2;
+mod device;
 pub mod guard;
-mod kmc;
 mod node;
-pub mod odom;
 mod report;
 mod service;
-mod zsl;
 
-pub use address::{AddressError, DeviceAddress, SimKind};
-pub use bridge::{BridgeError, BridgeOptions, BridgedDevice, run};
+pub use bridge::{BridgeError, BridgeOptions, BridgedDevice, namespaces, run};
 pub use report::{DeviceCounters, DeviceReport};
+pub use robowire_devices::{AddressError, DeviceAddress, SimKind};

@@ -121,7 +121,7 @@ impl CmdVel {
     }
 
     /// What the device made of the twist [`receive`](Self::receive) passed on; whether it took it.
-    pub(crate) fn outcome<E: std::fmt::Display>(&mut self, now: Instant, result: Result<(), E>) -> bool {
+    pub(crate) fn outcome<E: std::error::Error>(&mut self, now: Instant, result: Result<(), E>) -> bool {
         match result {
             Ok(()) => {
                 self.guard.applied();
@@ -130,7 +130,7 @@ impl CmdVel {
             Err(e) => {
                 self.guard.refused();
                 let topic = &self.topic;
-                self.log.log(now, || format!("{topic} refused: {e}"));
+                self.log.log(now, || format!("{topic} refused: {}", robowire_devices::error_chain(&e)));
                 false
             }
         }

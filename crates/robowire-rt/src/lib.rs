@@ -1,12 +1,16 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+pub mod device;
 mod latest;
+mod placement;
 pub mod runner;
 pub mod stats;
 mod thread;
 
+pub use device::lock;
 pub use latest::Latest;
+pub use placement::Placement;
 pub use robowire_core::schedule;
 pub use robowire_core::schedule::Time;
 pub use thread::{RtError, lock_memory, pin_current_thread, set_fine_timer_slack, set_realtime_priority};

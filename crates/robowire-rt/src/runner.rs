@@ -38,7 +38,7 @@ use std::time::Duration;
 
 use robowire_core::schedule::Time;
 
-use crate::{RtError, now};
+use crate::{Placement, RtError, now};
 
 /// Periodic work for a [`Runner`].
 pub trait Job: Send + 'static {
@@ -56,13 +56,8 @@ pub trait Job: Send + 'static {
 pub struct RunnerOptions {
     /// The thread's name.
     pub name: String,
-    /// `SCHED_FIFO` priority, 1..=99; `None` keeps normal scheduling.
-    pub realtime_priority: Option<u8>,
-    /// Pin the thread to this CPU.
-    pub cpu: Option<usize>,
-    /// Lock the process's memory (`mlockall(MCL_CURRENT | MCL_FUTURE)`) so that no page fault
-    /// delays a deadline. Process-wide.
-    pub lock_memory: bool,
+    /// Priority, CPU and memory lock.
+    pub placement: Placement,
     /// The last part of every wait, spent spinning on the clock. Default [`DEFAULT_SPIN`].
     pub spin: Duration,
 }
@@ -76,7 +71,12 @@ pub const DEFAULT_SPIN: Duration = Duration::from_micros(100);
 impl RunnerOptions {
     /// Normal scheduling, no pinning, the default spin.
     pub fn named(name: impl Into<String>) -> Self {
-        Self { name: name.into(), realtime_priority: None, cpu: None, lock_memory: false, spin: DEFAULT_SPIN }
+        Self::placed(name, Placement::default())
+    }
+
+    /// `placement`, the default spin.
+    pub fn placed(name: impl Into<String>, placement: Placement) -> Self {
+        Self { name: name.into(), placement, spin: DEFAULT_SPIN }
     }
 }
 
@@ -126,7 +126,7 @@ impl<J: Job> Runner<J> {
             .spawn({
                 let control = control.clone();
                 move || {
-                    let placement = place(&options);
+                    let placement = options.placement.apply();
                     let ok = placement.is_ok();
                     let _ = placed_tx.send(placement);
                     if ok {
@@ -182,21 +182,6 @@ impl<J: Job> Drop for Runner<J> {
 
 fn options_name<T>(thread: &JoinHandle<T>) -> String {
     thread.thread().name().unwrap_or_default().to_string()
-}
-
-/// Priority, pinning, memory lock and timer slack for the calling thread.
-fn place(options: &RunnerOptions) -> Result<(), RtError> {
-    if options.lock_memory {
-        crate::lock_memory()?;
-    }
-    if let Some(cpu) = options.cpu {
-        crate::pin_current_thread(cpu)?;
-    }
-    if let Some(priority) = options.realtime_priority {
-        crate::set_realtime_priority(priority)?;
-    }
-    crate::set_fine_timer_slack();
-    Ok(())
 }
 
 fn run<J: Job>(job: &mut J, control: &Control, spin: Duration) {

@@ -40,11 +40,18 @@ pub enum RtError {
     },
 }
 
+/// CPU indices a thread can be pinned to are below this (`CPU_SETSIZE`).
+#[cfg(target_os = "linux")]
+pub(crate) const MAX_CPU: usize = rustix::thread::CpuSet::MAX_CPU;
+/// CPU indices a thread can be pinned to are below this.
+#[cfg(not(target_os = "linux"))]
+pub(crate) const MAX_CPU: usize = 1024;
+
 /// Pins the calling thread to `cpu`.
 #[cfg(target_os = "linux")]
 pub fn pin_current_thread(cpu: usize) -> Result<(), RtError> {
     use rustix::thread::{CpuSet, sched_setaffinity};
-    if cpu >= CpuSet::MAX_CPU {
+    if cpu >= MAX_CPU {
         let source = io::Error::new(io::ErrorKind::InvalidInput, "CPU index beyond CPU_SETSIZE");
         return Err(RtError::CpuAffinity { cpu, source });
     }

@@ -19,7 +19,6 @@ use std::time::{Duration, Instant};
 use lowcmd_proto::api::motion_switcher;
 use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_dds::qos::Qos;
-use robowire_dds::rpc::RpcClient;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use serde_json::json;
@@ -95,7 +94,7 @@ async fn round_trips(seconds: u32) -> Vec<f64> {
     };
     let _sim = on_cpu(PEER_CPU, || Go2Sim::spawn(config).expect("simulator"));
     let us = Participant::new(lo).expect("participant");
-    let switcher = RpcClient::new(&us, motion_switcher::SERVICE).unwrap();
+    let switcher = go2::services::ServiceClient::new(&us, motion_switcher::SERVICE).unwrap();
     let released = switcher.call(motion_switcher::RELEASE_MODE, "{}", Duration::from_secs(20)).await.unwrap();
     assert_eq!(released.code, 0);
     let writer = us.writer::<LowCmd>(LowCmd::TOPIC, Qos::WRITER).unwrap();

@@ -9,7 +9,7 @@
 
 use std::time::{Duration, Instant};
 
-use kmc::{Driver, DriverOptions};
+use kmc::{Device, Driver, DriverOptions};
 use robowire_core::schedule::{Periodic, Time};
 use robowire_core::timing::{LatenessRing, LatenessSummary};
 use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions};
@@ -96,15 +96,14 @@ fn runner_loop(period: Duration, seconds: f64, spin: Duration) -> (LatenessSumma
 fn kmc_stream(seconds: f64) -> LatenessSummary {
     let sim = ChassisSim::spawn(ChassisSimConfig::default()).expect("chassis simulator");
     let options = DriverOptions { command_timeout: Duration::from_secs(3600), ..DriverOptions::default() };
-    let mut driver = Driver::new(sim.path(), options).expect("driver");
-    driver.start().expect("driver start");
+    let driver = Driver::open(sim.path(), options).expect("driver");
     driver.set_command(0.3, 0.0).expect("command");
     let end = Instant::now() + Duration::from_secs_f64(seconds);
     while Instant::now() < end {
         for _frame in driver.messages_until(Instant::now() + Duration::from_millis(50)) {}
     }
     let lateness = driver.stats().control_lateness;
-    driver.stop().expect("driver stop");
+    driver.close().expect("driver stop");
     lateness
 }
 
@@ -119,7 +118,7 @@ fn zsl_high_level(seconds: f64) -> (LatenessSummary, LatenessSummary, LatenessSu
     let dog = sim.high_level_addr();
     runtime().block_on(async {
         let options = ClientOptions { dog, ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) };
-        let client = HighLevel::connect(options).await.expect("HighLevel client");
+        let client = HighLevel::open(options).expect("HighLevel client");
         tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
         let snapshot = sim.snapshot();
         (client.stats().stream_lateness, snapshot.state_lateness, snapshot.high_level.command_jitter)
@@ -132,7 +131,7 @@ fn zsl_low_level(seconds: f64) -> LatenessSummary {
     let dog = sim.low_level_addr();
     runtime().block_on(async {
         let options = ClientOptions { dog, ..ClientOptions::low_level([127, 0, 0, 1].into(), 0, dog.ip()) };
-        let client = LowLevel::connect(options).await.expect("LowLevel client");
+        let client = LowLevel::open(options).expect("LowLevel client");
         tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
         client.stats().stream_lateness
     })

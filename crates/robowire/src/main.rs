@@ -20,6 +20,10 @@ struct Cli {
 enum Command {
     /// Drive every simulated device through its client API and report what was seen.
     Demo(cmd::demo::DemoArgs),
+    /// Print one state of any device, by address (kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:KIND).
+    Status(cmd::device::StatusArgs),
+    /// Print the state of any device live, by address, until Ctrl-C.
+    Watch(cmd::device::DeviceArgs),
     /// Run a device simulator alone, for your own client to talk to.
     #[command(subcommand)]
     Sim(cmd::sim::SimCommand),
@@ -52,6 +56,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => cmd::demo::run(&args),
+        Command::Status(args) => cmd::device::status(&args),
+        Command::Watch(args) => cmd::device::watch(&args),
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),

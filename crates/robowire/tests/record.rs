@@ -148,7 +148,19 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     };
     dog(&["stand"], false);
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    // Wait for the stand-up to finish (mode 1 reported and the body up), not for a fixed time.
+    let standing = || {
+        let out = robowire()
+            .args(["dog", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26", "status", "--json"])
+            .output()
+            .unwrap();
+        let state: Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
+        state["mode"] == 1 && state["position_m"][2].as_f64().is_some_and(|z| z > 0.29)
+    };
+    let began = std::time::Instant::now();
+    while !standing() {
+        assert!(began.elapsed().as_secs() < 30, "the simulated dog never stood up");
+    }
     dog(&["move", "0.5", "0", "0", "--duration", "0.5"], true);
     let _ = sim.kill();
     let _ = sim.wait();
@@ -177,18 +189,20 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
 
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
     let (seen, states_received) = runtime.block_on(async {
+        use zsl::udp::{Device, HighLevel};
         let options = zsl::udp::ClientOptions::high_level([127, 0, 0, 26].into(), 0, [127, 0, 0, 27].into());
-        let client = zsl::udp::HighLevel::connect(options).await.unwrap();
-        let mut updates = client.state_updates();
+        let client = HighLevel::open(options).unwrap();
+        // Every state in order (not the coalescing latest), until as many as were recorded.
+        let mut every = client.every_state();
         let mut seen = Vec::new();
-        // Until the replay has gone quiet for a second.
-        while let Ok(Ok(())) = tokio::time::timeout(std::time::Duration::from_secs(1), updates.changed()).await {
-            if let Some(state) = *updates.borrow_and_update() {
-                seen.push(state);
+        while seen.len() < recorded.len() {
+            match tokio::time::timeout(std::time::Duration::from_secs(30), every.recv()).await {
+                Ok(Ok(state)) => seen.push(state.state),
+                other => panic!("after {} of {} states: {other:?}", seen.len(), recorded.len()),
             }
         }
         let states = client.stats().states;
-        client.close().await;
+        client.close();
         (seen, states)
     });
     let out = replay.wait_with_output().unwrap();

@@ -117,7 +117,7 @@ fn call_to_wire(runtime: &tokio::runtime::Runtime, samples: &mut Vec<u64>, n: us
     let wire = UdpSocket::bind("127.0.0.1:0").unwrap();
     runtime.block_on(async {
         let options = loopback_options(wire.local_addr().unwrap()).with_watchdog(Duration::from_secs(3600));
-        let dog = HighLevel::connect(options).await.unwrap();
+        let dog = HighLevel::open(options).unwrap();
         // The robot walks (mode 18): `move` passes the mode gate and is acknowledged.
         let walking = HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() };
         wire.send_to(&walking.encode(), dog.local_addr()).unwrap();
@@ -126,7 +126,7 @@ fn call_to_wire(runtime: &tokio::runtime::Runtime, samples: &mut Vec<u64>, n: us
         for i in 0..n + 200 {
             let vx = if i % 2 == 0 { 0.5 } else { 0.6 };
             let start = Instant::now();
-            dog.move_velocity(vx, 0.0, 0.0).await.unwrap();
+            dog.move_velocity(vx, 0.0, 0.0).unwrap();
             // Skip the 2 ms stream's repeats of the previous command.
             loop {
                 let len = wire.recv(&mut buf).unwrap();
@@ -154,7 +154,7 @@ fn round_trips(runtime: &tokio::runtime::Runtime, raw: &mut Vec<u64>, trip: &mut
             let out = HighLevelCommand::stand_up().encode(Model::Zsl1);
             let mut buf = [0u8; 600];
             let (mut raw, mut trip) = (Vec::with_capacity(n), Vec::with_capacity(n));
-            let dog = HighLevel::connect(loopback_options(addr)).await.unwrap();
+            let dog = HighLevel::open(loopback_options(addr)).unwrap();
             assert!(dog.wait_connected(Duration::from_secs(2)).await);
             for i in 0..n + 200 {
                 let start = Instant::now();
@@ -164,7 +164,7 @@ fn round_trips(runtime: &tokio::runtime::Runtime, raw: &mut Vec<u64>, trip: &mut
                 let start = Instant::now();
                 // The 11th call in a row made while the robot still reports the other mode is
                 // `NotAcknowledged` (it was sent all the same): the result does not matter here.
-                let _ = if i % 2 == 0 { dog.passive().await } else { dog.lie_down().await };
+                let _ = if i % 2 == 0 { dog.passive() } else { dog.lie_down() };
                 assert!(dog.wait_for_mode(target, Duration::from_secs(1)).await.is_some());
                 if i >= 200 {
                     trip.push(start.elapsed().as_nanos() as u64);

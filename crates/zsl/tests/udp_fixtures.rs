@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use robowire_fixtures::zsl1::{frames, motor_command, vendor_call};
 use serde_json::Value;
 use zsl::udp::{
-    CallError, ClientOptions, ControlMode, HighLevel, LowLevel, Model, MotorCommand, ReturnCode, StateDecoding,
+    CallError, ClientOptions, ControlMode, HighLevel, Latched, LowLevel, Model, MotorCommand, ReturnCode, StateDecoding,
 };
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
@@ -80,43 +80,45 @@ async fn high_level(dog: &ScriptedDog, model: Model) -> HighLevel {
         .with_model(model)
         .with_state_decoding(StateDecoding::Strict);
     let options = ClientOptions { dog: dog.addr(), ..options };
-    HighLevel::connect(options).await.unwrap()
+    HighLevel::open(options).unwrap()
 }
 
 /// Makes the client see `mode` (and `error_word`), waiting until it has.
 async fn report(dog: &ScriptedDog, client: &HighLevel, mode: u32, error_word: u32) {
     dog.send(&high_state(mode, error_word).encode(), client.local_addr());
     let seen = client
-        .wait_for_state(Duration::from_secs(2), |s| {
+        .wait_for_state(Duration::from_secs(2), move |s| {
             s.body.mode == ControlMode::from_raw(mode) && s.body.error.map_or(0, ReturnCode::raw) == error_word
         })
         .await;
     assert!(seen.is_some(), "the client sees mode {mode}");
 }
 
-async fn call(client: &HighLevel, name: &str, a: [f32; 4]) -> Result<(), CallError> {
+fn call(client: &HighLevel, name: &str, a: [f32; 4]) -> Result<Latched, CallError> {
     match name {
-        "standUp" => client.stand_up().await,
-        "lieDown" => client.lie_down().await,
-        "passive" => client.passive().await,
-        "move" => client.move_velocity(a[0], a[1], a[2]).await,
-        "jump" => client.jump().await,
-        "frontJump" => client.front_jump().await,
-        "backflip" => client.backflip().await,
-        "shakeHand" => client.shake_hand().await,
-        "twoLegStand" => client.two_leg_stand(a[0], a[1]).await,
-        "cancelTwoLegStand" => client.cancel_two_leg_stand().await,
-        "attitudeControl" => client.attitude_control(a[0], a[1], a[2], a[3]).await,
-        "crawl" => client.crawl(a[0], a[1], a[2]).await,
-        "climb" => client.climb(a[0], a[1], a[2]).await,
-        "cancelCrawl" => client.cancel_crawl().await,
-        "cancelClimb" => client.cancel_climb().await,
+        "standUp" => client.stand_up(),
+        "lieDown" => client.lie_down(),
+        "passive" => client.passive(),
+        "move" => client.move_velocity(a[0], a[1], a[2]),
+        "jump" => client.jump(),
+        "frontJump" => client.front_jump(),
+        "backflip" => client.backflip(),
+        "shakeHand" => client.shake_hand(),
+        "twoLegStand" => client.two_leg_stand(a[0], a[1]),
+        "cancelTwoLegStand" => client.cancel_two_leg_stand(),
+        "attitudeControl" => client.attitude_control(a[0], a[1], a[2], a[3]),
+        "crawl" => client.crawl(a[0], a[1], a[2]),
+        "climb" => client.climb(a[0], a[1], a[2]),
+        "cancelCrawl" => client.cancel_crawl(),
+        "cancelClimb" => client.cancel_climb(),
         other => panic!("no facade call for {other}"),
     }
 }
 
-fn return_code(result: &Result<(), CallError>) -> u32 {
-    result.as_ref().map_or_else(|e| e.return_code().raw(), |()| 0)
+/// The vendor's return code of a call: a refusal's, or the latched call's (0, or 0x3007 after 11
+/// unacknowledged calls).
+fn return_code(result: &Result<Latched, CallError>) -> u32 {
+    result.as_ref().map_or_else(|e| e.return_code().raw(), |latched| latched.return_code.raw())
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -140,11 +142,11 @@ async fn every_high_level_call_in_the_fixtures_puts_its_captured_datagram_on_the
         }
         if api.contains("error word") {
             report(&dog, &client, 18, 0).await;
-            client.move_velocity(0.5, 0.0, 0.0).await.unwrap();
+            client.move_velocity(0.5, 0.0, 0.0).unwrap();
             report(&dog, &client, 18, 0x3012).await;
             dog.drain();
             assert_eq!(dog.recv(), expected, "#{i} {api}: the stream forces mode 0");
-            let refused = client.move_velocity(0.5, 0.0, 0.0).await;
+            let refused = client.move_velocity(0.5, 0.0, 0.0);
             assert_eq!(return_code(&refused), 0x3012, "#{i}: the call returns the error word");
             checked += 1;
             continue;
@@ -154,13 +156,13 @@ async fn every_high_level_call_in_the_fixtures_puts_its_captured_datagram_on_the
         let mode = entry["dog_state_ctrl_mode"].as_u64().unwrap_or(1) as u32;
         report(&dog, &client, mode, 0).await;
         let idle = dog.recv();
-        let result = call(&client, name, args).await;
+        let result = call(&client, name, args);
         let vendor_return = entry["return_value"].as_u64();
 
         if args.iter().any(|a| a.is_nan()) {
             // Spec decision 1: the vendor sends NaN and returns 0; robowire refuses it and sends
             // nothing new.
-            assert!(matches!(result, Err(CallError::Argument(_))), "#{i} {api}: {result:?}");
+            assert!(matches!(result, Err(CallError::Refused(zsl::udp::Refusal::Argument(_)))), "#{i} {api}: {result:?}");
             dog.drain();
             assert_eq!(dog.recv(), idle, "#{i}: the previous command keeps streaming");
             checked += 1;
@@ -207,7 +209,7 @@ async fn dog_for_previous(model: Model, name: &str, args: [f32; 4]) -> Vec<u8> {
     let client = high_level(&dog, model).await;
     report(&dog, &client, 1, 0).await;
     let idle = dog.recv();
-    call(&client, name, args).await.unwrap();
+    call(&client, name, args).unwrap();
     dog.next_different(&idle)
 }
 
@@ -222,14 +224,14 @@ async fn every_low_level_call_in_the_fixtures_puts_its_captured_datagram_on_the_
         let expected = hex(entry["hex"].as_str().unwrap());
         let dog = ScriptedDog::new();
         let options = ClientOptions::low_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
-        let client = LowLevel::connect(ClientOptions { dog: dog.addr(), ..options }).await.unwrap();
+        let client = LowLevel::open(ClientOptions { dog: dog.addr(), ..options }).unwrap();
         let idle = dog.recv();
         if api.contains("idle stream") {
             assert_eq!(idle, expected, "{api}");
         } else {
             assert!(vendor_call(api).is_some_and(|(name, ..)| name == "sendMotorCmd"));
             let motor = MotorCommand::from(&motor_command(api).unwrap());
-            client.send_motor_command(&motor).await.unwrap();
+            client.send_motor_command(&motor).unwrap();
             assert_eq!(dog.next_different(&idle), expected, "{api}");
         }
         checked += 1;

@@ -8,7 +8,10 @@ use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
 use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
-use zsl::udp::{CallError, ClientOptions, Connection, ControlMode, HighLevel, LowLevel, MotorCommand, ReturnCode};
+use zsl::udp::{
+    CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, LowLevel, MotorCommand, Placement, Refusal,
+    ReturnCode,
+};
 use zsl_proto::rules::ArgumentError;
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
@@ -20,12 +23,12 @@ fn options_to(dog: SocketAddr) -> ClientOptions {
 }
 
 async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
-    let client = HighLevel::connect(options).await.unwrap();
+    let client = HighLevel::open(options).unwrap();
     assert!(client.wait_connected(WAIT).await, "state from the simulator");
     // The dog starts lying (51); the client's idle stream (mode 0) makes it passive at once.
     let mode = client.control_mode().unwrap();
     assert!(matches!(mode, ControlMode::LieDown | ControlMode::Passive), "the simulated dog lies: {mode:?}");
-    client.stand_up().await.unwrap();
+    client.stand_up().unwrap();
     assert!(client.wait_for_mode(ControlMode::Stand, WAIT).await.is_some());
     wait_until(|| sim.snapshot().dog.activity() == Activity::Standing).await;
     client
@@ -45,28 +48,28 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
     let start = client.position().unwrap();
 
-    client.move_velocity(0.5, 0.0, 0.0).await.unwrap();
+    client.move_velocity(0.5, 0.0, 0.0).unwrap();
     assert!(client.wait_for_mode(ControlMode::Move, WAIT).await.is_some());
-    let moving = client.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0] > 0.45).await;
+    let moving = client.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0] > 0.45).await;
     assert!(moving.is_some(), "the body reaches the commanded speed");
     let walking = client.position().unwrap()[0];
     assert!(
-        client.wait_for_state(WAIT, |s| s.body.position_m[0] > walking + 0.1).await.is_some(),
+        client.wait_for_state(WAIT, move |s| s.body.position_m[0] > walking + 0.1).await.is_some(),
         "the position integrates the walk"
     );
     assert_eq!(
-        client.lie_down().await.map_err(|e| e.return_code()),
+        client.lie_down().map_err(|e| e.return_code()),
         Err(ReturnCode::SwitchFailed),
         "lying down while walking is refused (robot is running)"
     );
-    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
-    assert!(client.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0].abs() < 0.05).await.is_some());
+    client.move_velocity(0.0, 0.0, 0.0).unwrap();
+    assert!(client.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0].abs() < 0.05).await.is_some());
     let walked = client.position().unwrap()[0] - start[0];
     assert!(walked > 0.1, "the dog moved forward: {walked} m");
     let sideways = client.position().unwrap()[1] - start[1];
     assert!(sideways.abs() < 0.01, "straight ahead: {sideways} m sideways");
 
-    client.lie_down().await.unwrap();
+    client.lie_down().unwrap();
     assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());
     wait_until(|| sim.snapshot().dog.activity() == Activity::Lying).await;
     let body = client.body().unwrap();
@@ -82,7 +85,7 @@ async fn arguments_are_checked_before_anything_is_sent() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
     let latched = client.wire_command();
-    let refused = |r: Result<(), CallError>| matches!(r, Err(CallError::Argument(_)));
+    let refused = |r: Result<Latched, CallError>| matches!(r, Err(CallError::Refused(Refusal::Argument(_))));
     for (vx, vy, wz) in [
         (0.04, 0.0, 0.0),
         (3.01, 0.0, 0.0),
@@ -93,23 +96,23 @@ async fn arguments_are_checked_before_anything_is_sent() {
         (0.0, f32::INFINITY, 0.0),
         (0.0, 0.0, f32::NEG_INFINITY),
     ] {
-        let result = client.move_velocity(vx, vy, wz).await;
+        let result = client.move_velocity(vx, vy, wz);
         assert!(refused(result), "move({vx}, {vy}, {wz}) is refused");
     }
     assert!(matches!(
-        client.move_velocity(f32::NAN, 0.0, 0.0).await,
-        Err(CallError::Argument(ArgumentError::NonFinite(_)))
+        client.move_velocity(f32::NAN, 0.0, 0.0),
+        Err(CallError::Refused(Refusal::Argument(ArgumentError::NonFinite(_))))
     ));
-    assert!(refused(client.attitude_control(0.0, 0.61, 0.0, 0.0).await));
-    assert!(refused(client.two_leg_stand(0.1, 0.0).await));
+    assert!(refused(client.attitude_control(0.0, 0.61, 0.0, 0.0)));
+    assert!(refused(client.two_leg_stand(0.1, 0.0)));
     assert_eq!(client.wire_command(), latched, "nothing was latched");
-    assert_eq!(client.move_velocity(f32::NAN, 0.0, 0.0).await.unwrap_err().return_code(), ReturnCode::SpeedTooLarge);
+    assert_eq!(client.move_velocity(f32::NAN, 0.0, 0.0).unwrap_err().return_code(), ReturnCode::SpeedTooLarge);
 
     // The band edges are inside; |v| ≤ 1e-6 is zero.
     for (vx, vy, wz) in [(0.05, 0.1, 0.02), (-3.0, -1.0, -3.0), (1e-6, 0.0, -1e-6)] {
-        client.move_velocity(vx, vy, wz).await.unwrap_or_else(|e| panic!("move({vx}, {vy}, {wz}): {e}"));
+        client.move_velocity(vx, vy, wz).unwrap_or_else(|e| panic!("move({vx}, {vy}, {wz}): {e}"));
     }
-    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
+    client.move_velocity(0.0, 0.0, 0.0).unwrap();
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -119,7 +122,7 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
     let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(watchdog)).await;
     let mut events = client.connection_events();
     assert_eq!(*events.borrow_and_update(), Connection::Connected);
-    client.move_velocity(0.5, 0.0, 0.3).await.unwrap();
+    client.move_velocity(0.5, 0.0, 0.3).unwrap();
 
     sim.inject(DogFault::Silence);
     tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
@@ -163,8 +166,7 @@ fn state(mode: u32) -> Vec<u8> {
 async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog() {
     let dog = UdpSocket::bind("127.0.0.1:0").unwrap();
     let spoofer = UdpSocket::bind("127.0.0.2:0").expect("127.0.0.2 is loopback on Linux");
-    let client = HighLevel::connect(options_to(dog.local_addr().unwrap()).with_watchdog(Duration::from_millis(300)))
-        .await
+    let client = HighLevel::open(options_to(dog.local_addr().unwrap()).with_watchdog(Duration::from_millis(300)))
         .unwrap();
     let to = client.local_addr();
     let mut events = client.connection_events();
@@ -188,7 +190,7 @@ async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog()
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
     let dog = UdpSocket::bind("127.0.0.1:0").unwrap();
-    let client = HighLevel::connect(options_to(dog.local_addr().unwrap())).await.unwrap();
+    let client = HighLevel::open(options_to(dog.local_addr().unwrap())).unwrap();
     let to = client.local_addr();
     dog.send_to(&[], to).unwrap();
     tokio::time::timeout(WAIT, client.connection_events().wait_for(|c| *c == Connection::Connected))
@@ -202,7 +204,7 @@ async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
     let mut short = vec![0xde, 0xad, 0xbe, 0xef];
     short.extend_from_slice(&1.0f32.to_le_bytes());
     dog.send_to(&short, to).unwrap();
-    let merged = client.wait_for_state(WAIT, |s| s.body.imu.quaternion_wxyz[0] == 1.0).await.unwrap();
+    let merged = client.wait_for_state(WAIT, move |s| s.body.imu.quaternion_wxyz[0] == 1.0).await.unwrap();
     assert_eq!(merged.body.mode, ControlMode::Move, "the rest of the state is kept");
     dog.send_to(&[0u8; 561], to).unwrap();
     wait_until(|| client.stats().link.decode_errors == 1).await; // longer than the state is an error
@@ -217,8 +219,8 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(Duration::from_millis(300))).await;
 
     sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
-    assert!(client.wait_for_state(WAIT, |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
-    assert!(matches!(client.jump().await, Err(CallError::SelfCheck(ReturnCode::MotorFault))));
+    assert!(client.wait_for_state(WAIT, move |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
+    assert!(matches!(client.jump(), Err(CallError::Refused(Refusal::SelfCheck(ReturnCode::MotorFault)))));
     // The stream forces passive.
     wait_until(|| client.wire_command().control_mode() == ControlMode::Passive).await;
     wait_until(|| sim.snapshot().dog.mode() == ControlMode::Passive).await;
@@ -234,9 +236,9 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     assert!(client.wait_connected(WAIT).await);
 
     sim.inject(DogFault::SdkMismatch);
-    assert!(client.wait_for_state(WAIT, |s| s.sdk_mismatch).await.is_some());
+    assert!(client.wait_for_state(WAIT, move |s| s.sdk_mismatch).await.is_some());
     wait_until(|| client.halted()).await; // the stream stops for good, like the vendor's
-    assert!(matches!(client.stand_up().await, Err(CallError::SdkMismatch)));
+    assert!(matches!(client.stand_up(), Err(CallError::SdkMismatch)));
     let sent = client.stats().link.sent;
     wait_until(|| sim.snapshot().high_level.commands == sent).await; // everything sent arrived
     // An absence, observed over a moment: nothing more is sent.
@@ -247,29 +249,29 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn high_level_and_low_level_at_once_on_different_local_ports() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
-    let high = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
+    let high = HighLevel::open(options_to(sim.high_level_addr())).unwrap();
     let low_options = ClientOptions { dog: sim.low_level_addr(), ..options_to(sim.low_level_addr()) };
-    let low = LowLevel::connect(low_options).await.unwrap();
+    let low = LowLevel::open(low_options).unwrap();
     assert_ne!(high.local_addr(), low.local_addr());
     assert!(high.wait_connected(WAIT).await);
-    assert!(low.wait_for_state(WAIT, |_| true).await.is_some());
+    assert!(low.wait_for_state(WAIT, move |_| true).await.is_some());
     assert!(low.has_motor_data());
 
-    let refused = low.send_motor_command(&MotorCommand::default()).await;
-    assert!(matches!(refused, Err(CallError::Argument(ArgumentError::Position { .. }))), "knee 0 is out of range");
+    let refused = low.send_motor_command(&MotorCommand::default());
+    assert!(matches!(refused, Err(CallError::Refused(Refusal::Argument(ArgumentError::Position { .. })))), "knee 0 is out of range");
 
     let stand = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
-    low.send_motor_command(&stand).await.unwrap();
+    low.send_motor_command(&stand).unwrap();
     let near = |legs: &[f32; 4], target: f32| legs.iter().all(|q| (q - target).abs() < 0.02);
-    let reached = low.wait_for_state(WAIT, |s| near(&s.motor.q_rad[1], 0.8) && near(&s.motor.q_rad[2], -1.5)).await;
+    let reached = low.wait_for_state(WAIT, move |s| near(&s.motor.q_rad[1], 0.8) && near(&s.motor.q_rad[2], -1.5)).await;
     assert!(reached.is_some(), "the PD joints reach the targets: {:?}", low.motor_state());
     assert!(
-        high.wait_for_state(WAIT, |s| (s.joints.position_rad.knee[0] + 1.5).abs() < 0.02).await.is_some(),
+        high.wait_for_state(WAIT, move |s| (s.joints.position_rad.knee[0] + 1.5).abs() < 0.02).await.is_some(),
         "the HighLevel state shows the same joints"
     );
     let mut nan = stand;
     nan.kp[0][0] = f32::NAN;
-    assert!(matches!(low.send_motor_command(&nan).await, Err(CallError::Argument(ArgumentError::NonFinite(_)))));
+    assert!(matches!(low.send_motor_command(&nan), Err(CallError::Refused(Refusal::Argument(ArgumentError::NonFinite(_))))));
     assert_eq!(MotorCommand::from(&low.wire_command().motor), stand);
 }
 
@@ -279,29 +281,29 @@ async fn a_zsl1w_crawls_and_its_wheels_turn() {
     let sim = DogSim::spawn(config).unwrap();
     let options = options_to(sim.high_level_addr()).with_model(zsl::udp::Model::Zsl1W);
     let client = standing_dog(&sim, options).await;
-    client.crawl(0.5, 0.0, 0.0).await.unwrap();
-    let rolling = client.wait_for_state(WAIT, |s| s.joints.position_rad.foot[0] > 1.0).await;
+    client.crawl(0.5, 0.0, 0.0).unwrap();
+    let rolling = client.wait_for_state(WAIT, move |s| s.joints.position_rad.foot[0] > 1.0).await;
     assert!(rolling.is_some(), "the foot (wheel) joints integrate the forward speed");
     assert_eq!(client.wire_command().action_code(), zsl::udp::Action::Crawl);
-    client.cancel_crawl().await.unwrap();
+    client.cancel_crawl().unwrap();
     assert_eq!(client.wire_command().action_code(), zsl::udp::Action::None);
-    client.move_velocity(0.0, 0.0, 0.0).await.unwrap();
+    client.move_velocity(0.0, 0.0, 0.0).unwrap();
     assert!(!client.state().unwrap().sdk_mismatch, "the right magic raises no mismatch");
 
-    let zsl1 = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
-    assert!(matches!(zsl1.crawl(0.5, 0.0, 0.0).await, Err(CallError::WrongModel { .. })));
+    let zsl1 = HighLevel::open(options_to(sim.high_level_addr())).unwrap();
+    assert!(matches!(zsl1.crawl(0.5, 0.0, 0.0), Err(CallError::Refused(Refusal::WrongModel { .. }))));
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
     let options = options_to(sim.low_level_addr()).with_watchdog(Duration::from_millis(300));
-    let low = LowLevel::connect(options).await.unwrap();
-    assert!(low.wait_for_state(WAIT, |_| true).await.is_some());
+    let low = LowLevel::open(options).unwrap();
+    assert!(low.wait_for_state(WAIT, move |_| true).await.is_some());
     let mut moving = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
     moving.qd_des_radps[1] = [0.5; 4];
     moving.tau_ff_nm[2] = [2.0; 4];
-    low.send_motor_command(&moving).await.unwrap();
+    low.send_motor_command(&moving).unwrap();
 
     sim.inject(DogFault::Silence);
     tokio::time::timeout(WAIT, low.connection_events().wait_for(|c| *c == Connection::Disconnected))
@@ -317,7 +319,7 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
         "hold kept"
     );
     sim.clear_faults();
-    assert!(low.wait_for_state(WAIT, |_| true).await.is_some(), "reconnects");
+    assert!(low.wait_for_state(WAIT, move |_| true).await.is_some(), "reconnects");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -326,14 +328,14 @@ async fn bad_options_and_placement_are_typed_errors() {
     let dog: SocketAddr = "127.0.0.1:9".parse().unwrap();
     let base = options_to(dog);
     let too_fast = ClientOptions { period: Duration::from_micros(10), ..base.clone() };
-    assert!(matches!(HighLevel::connect(too_fast).await, Err(ConnectError::Option { name: "period", .. })));
+    assert!(matches!(HighLevel::open(too_fast), Err(ConnectError::Option { name: "period", .. })));
     let short_watchdog = ClientOptions { watchdog: Duration::from_millis(1), ..base.clone() };
-    assert!(matches!(HighLevel::connect(short_watchdog).await, Err(ConnectError::Option { name: "watchdog", .. })));
-    let priority = ClientOptions { realtime_priority: Some(0), ..base.clone() };
-    assert!(matches!(LowLevel::connect(priority).await, Err(ConnectError::Option { name: "realtime_priority", .. })));
-    let nowhere = ClientOptions { cpu_affinity: Some(1 << 20), ..base };
-    match HighLevel::connect(nowhere).await {
-        Err(ConnectError::StreamThread(zsl::udp::RtError::CpuAffinity { cpu, .. })) => assert_eq!(cpu, 1 << 20),
+    assert!(matches!(HighLevel::open(short_watchdog), Err(ConnectError::Option { name: "watchdog", .. })));
+    let priority = ClientOptions { placement: Placement::realtime(0, None), ..base.clone() };
+    assert!(matches!(LowLevel::open(priority), Err(ConnectError::Thread(zsl::udp::RtError::RealtimePriority { .. }))));
+    let nowhere = ClientOptions { placement: Placement { cpu: Some(1 << 20), ..Placement::default() }, ..base };
+    match HighLevel::open(nowhere) {
+        Err(ConnectError::Thread(zsl::udp::RtError::CpuAffinity { cpu, .. })) => assert_eq!(cpu, 1 << 20),
         other => panic!("{other:?}"),
     }
 }
@@ -341,20 +343,20 @@ async fn bad_options_and_placement_are_typed_errors() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn close_frees_the_local_port_at_once() {
     let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
-    let high = HighLevel::connect(options_to(sim.high_level_addr())).await.unwrap();
+    let high = HighLevel::open(options_to(sim.high_level_addr())).unwrap();
     let port = high.local_addr().port();
     assert!(high.wait_connected(WAIT).await);
-    high.close().await;
+    high.close();
     let again = ClientOptions {
         dog: sim.high_level_addr(),
         ..ClientOptions::high_level([127, 0, 0, 1].into(), port, [127, 0, 0, 1].into())
     };
-    let high = HighLevel::connect(again).await.expect("the port of a closed client binds again");
+    let high = HighLevel::open(again).expect("the port of a closed client binds again");
     assert!(high.wait_connected(WAIT).await);
 
     let low_options = ClientOptions { dog: sim.low_level_addr(), ..options_to(sim.low_level_addr()) };
-    let low = LowLevel::connect(low_options).await.unwrap();
+    let low = LowLevel::open(low_options).unwrap();
     let port = low.local_addr().port();
-    low.close().await;
+    low.close();
     UdpSocket::bind(("127.0.0.1", port)).expect("the port of a closed LowLevel client binds again");
 }

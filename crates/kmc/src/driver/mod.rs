@@ -1,27 +1,33 @@
-//! `Driver`: the vendor's streaming host driver on two threads. The stream thread (robowire's
-//! runner, optionally `SCHED_FIFO` and pinned) runs `kmc-proto`'s sans-IO command stream and
-//! writes its frames on time; the receive thread reads what the chassis sends, queues it, and
-//! reopens the port after a disconnect. Commands go in and statistics come out without the
-//! stream thread ever waiting on a lock.
+//! `Driver`: the vendor's streaming host driver in robowire's device shape. The stream thread
+//! (robowire's runner, optionally `SCHED_FIFO` and pinned) runs `kmc-proto`'s sans-IO command
+//! stream and writes its frames on time; the receive thread (robowire-rt's one
+//! receive-with-watchdog loop) reads what the chassis sends, keeps the latest [`ChassisState`]
+//! with its odometry, queues the frames for the vendor's API, and reopens the port after a
+//! disconnect. Commands go in and statistics come out without the stream thread ever waiting on a
+//! lock.
 
 mod receive;
 mod stream;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::Ordering;
 use std::sync::mpsc as std_mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use kmc_proto::stream::{ALL_STATE_POLL_PERIOD, BATTERY_POLL_PERIOD, StreamConfig};
 use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, PcControl};
 use robowire_core::finite;
+use robowire_core::schedule::Watchdog;
+use robowire_core::DecoderCounters;
 use robowire_core::timing::LatenessSummary;
+use robowire_rt::Placement;
+use robowire_rt::device::{Device, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions};
-use robowire_serial::{Backoff, LinkCounters, SerialPortOptions};
-use tokio::sync::watch;
+use robowire_serial::{Backoff, LinkCounters, SerialLink, SerialPortOptions};
 
-use self::receive::Inbox;
+pub use self::receive::ChassisState;
+use self::receive::{ChassisLink, Inbox};
 use self::stream::{Request, StreamJob, StreamShared};
 use crate::KmcError;
 
@@ -46,17 +52,17 @@ pub struct DriverOptions {
     pub poll_battery: bool,
     /// Read all-state (ID 0x06) of motors 0 and 1 at [`ALL_STATE_POLL_HZ`]. Default off.
     pub poll_allstate: bool,
-    /// Without a `set_command` for this long the stream sends (0, 0). Default 300 ms.
+    /// Without a `set_command` for this long the stream sends (0, 0). Default 300 ms; changed
+    /// while running with [`Driver::set_command_timeout`].
     pub command_timeout: Duration,
-    /// (0, 0) frames sent on [`Driver::stop`]. Default 3; at least 1.
+    /// (0, 0) frames sent on [`Driver::close`]. Default 3; at least 1.
     pub stop_burst_count: u32,
-    /// `SCHED_FIFO` priority 1..=99 for the stream thread; `None` (the vendor's -1) keeps normal
-    /// scheduling. Default `None`.
-    pub realtime_priority: Option<u8>,
-    /// CPU to pin the stream thread to; `None` (the vendor's -1) does not pin. Default `None`.
-    pub cpu_affinity: Option<usize>,
-    /// Lock the process's memory (`mlockall`) when the stream starts. Default off.
-    pub lock_memory: bool,
+    /// Where the stream thread runs (the vendor's `realtime_priority` and `cpu_affinity`, -1
+    /// being `None`; and `mlockall`). Default: normal scheduling.
+    pub placement: Placement,
+    /// No frame from the chassis for this long: `Disconnected` (it answers the `0xB3` polls at
+    /// the speed rate). Default 500 ms.
+    pub state_timeout: Duration,
     /// Received frames kept for [`Driver::try_pop_message`]; on overflow the oldest is dropped
     /// and counted. Default 1024.
     pub max_queue: usize,
@@ -77,9 +83,8 @@ impl Default for DriverOptions {
             poll_allstate: false,
             command_timeout: Duration::from_millis(300),
             stop_burst_count: 3,
-            realtime_priority: None,
-            cpu_affinity: None,
-            lock_memory: false,
+            placement: Placement::default(),
+            state_timeout: Duration::from_millis(500),
             max_queue: 1024,
             reopen: Some(Backoff::default()),
             max_speed_mps: kmc_proto::DEFAULT_MAX_SPEED_MPS,
@@ -103,11 +108,11 @@ impl DriverOptions {
         if self.max_queue == 0 {
             return bad("max_queue", "the queue must hold at least one frame".into());
         }
-        if let Some(priority) = self.realtime_priority
-            && !(1..=99).contains(&priority)
-        {
-            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
+        check_command_timeout(self.command_timeout)?;
+        if self.state_timeout < Duration::from_millis(10) {
+            return bad("state_timeout", format!("{:?} is shorter than 10 ms", self.state_timeout));
         }
+        self.placement.validate()?;
         if let Err(e) = ChassisFrameDecoder::new().with_max_speed_mps(self.max_speed_mps) {
             return bad("max_speed_mps", e.to_string());
         }
@@ -115,15 +120,39 @@ impl DriverOptions {
     }
 }
 
-/// The state of the link to the chassis.
+/// The state of the serial port.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
 pub enum LinkState {
-    /// Not started, or stopped.
+    /// Closed.
     Stopped,
     /// Port open; the stream is running.
     Connected,
     /// The port vanished; reopening if [`DriverOptions::reopen`] is set.
     Disconnected,
+}
+
+impl LinkState {
+    fn from_u8(raw: u8) -> Self {
+        match raw {
+            1 => Self::Connected,
+            2 => Self::Disconnected,
+            _ => Self::Stopped,
+        }
+    }
+}
+
+/// Longest command timeout (1 h): a chassis never drives on a command older than this.
+pub const MAX_COMMAND_TIMEOUT: Duration = Duration::from_secs(3600);
+
+fn check_command_timeout(timeout: Duration) -> Result<(), KmcError> {
+    if timeout < Duration::from_millis(1) || timeout > MAX_COMMAND_TIMEOUT {
+        return Err(KmcError::Option {
+            name: "command_timeout",
+            reason: format!("{timeout:?} is outside 1 ms..={MAX_COMMAND_TIMEOUT:?}"),
+        });
+    }
+    Ok(())
 }
 
 /// What the driver did and saw.
@@ -151,8 +180,10 @@ pub struct DriverStats {
     pub missed_ticks: u64,
     /// Frames the stream thread could not write (the port was gone).
     pub write_errors: u64,
-    /// Disconnects seen.
+    /// Port disconnects seen.
     pub disconnects: u64,
+    /// Silences longer than the state timeout (and lost ports).
+    pub state_timeouts: u64,
     /// Lateness of `0xA5` sends against their absolute deadlines.
     pub control_lateness: LatenessSummary,
     /// Serial link counters: bytes, frames written, reopens, decoder skipped/rejected.
@@ -172,48 +203,32 @@ impl DriverOptions {
         }
     }
 
-    fn runner_options(&self) -> RunnerOptions {
-        RunnerOptions {
-            realtime_priority: self.realtime_priority,
-            cpu: self.cpu_affinity,
-            lock_memory: self.lock_memory,
-            ..RunnerOptions::named("kmc-stream")
-        }
-    }
-}
-
-#[derive(Debug)]
-struct Running {
-    stream: Runner<StreamJob>,
-    requests: std_mpsc::Sender<Request>,
-    stop_receiving: watch::Sender<bool>,
-    receiver: JoinHandle<()>,
 }
 
 /// Streams commands to a KMC chassis and collects its responses, like the vendor's host driver.
 ///
-/// [`start`](Self::start) opens the port and starts two threads. The stream thread sends, on
+/// [`open`](Self::open) opens the port and starts two threads. The stream thread sends, on
 /// absolute deadlines, the current command at `control_rate_hz` (or (0, 0) when no
-/// [`set_command`](Self::set_command) came within `command_timeout`), `0xB3` requests at
+/// [`set_command`](Self::set_command) came within the command timeout), `0xB3` requests at
 /// `vehicle_speed_rate_hz`, and the enabled polls; its waits end with a short spin, and it can
-/// run `SCHED_FIFO` on a pinned CPU. The receive thread queues the responses for
-/// [`try_pop_message`](Self::try_pop_message) and reopens a vanished port. [`stop`](Self::stop)
-/// (or dropping the driver) sends the stop burst.
+/// run `SCHED_FIFO` on a pinned CPU. The receive thread keeps the latest [`ChassisState`] (speed,
+/// battery, motors, odometry) with its arrival time, watches for silence, queues the responses for
+/// [`try_pop_message`](Self::try_pop_message), and reopens a vanished port.
+/// [`close`](Self::close) (or dropping the driver) sends the stop burst.
 ///
 /// ```no_run
 /// use std::time::Duration;
-/// use kmc::{Driver, DriverOptions};
+/// use kmc::{Device, Driver, DriverOptions};
 ///
-/// let mut driver = Driver::new("/dev/ttyUSB0", DriverOptions { poll_battery: true, ..Default::default() })?;
-/// driver.start()?;
+/// let driver = Driver::open("/dev/ttyUSB0", DriverOptions { poll_battery: true, ..Default::default() })?;
 /// for _ in 0..100 {
 ///     driver.set_command(0.5, 0.2)?; // 0.5 m/s, 0.2 rad/s: curvature 0.4 1/m
-///     while let Some(frame) = driver.try_pop_message() {
-///         println!("{frame:?}");
+///     if let Some(chassis) = driver.latest() {
+///         println!("{:?} m/s, x {:.2} m", chassis.state.speed_mps, chassis.state.odometry.x_m);
 ///     }
 ///     std::thread::sleep(Duration::from_millis(50));
 /// }
-/// driver.stop()?;
+/// driver.close()?; // the stop burst
 /// # Ok::<(), kmc::KmcError>(())
 /// ```
 #[derive(Debug)]
@@ -222,20 +237,43 @@ pub struct Driver {
     options: DriverOptions,
     inbox: Arc<Inbox>,
     stream: Arc<StreamShared>,
-    running: Option<Running>,
+    runner: Option<Runner<StreamJob>>,
+    requests: std_mpsc::Sender<Request>,
+    /// Dropped after the stop burst: the port closes with it.
+    receiving: Receiving<ChassisState>,
 }
 
 impl Driver {
-    /// A stopped driver for the chassis at `port`; checks the options.
-    pub fn new(port: impl AsRef<Path>, options: DriverOptions) -> Result<Self, KmcError> {
+    /// Opens the chassis at `port` and starts the receive thread and the stream thread (with the
+    /// placement applied to it). Returns once streaming, or with the reason it could not start.
+    pub fn open(port: impl AsRef<Path>, options: DriverOptions) -> Result<Self, KmcError> {
         options.validate()?;
-        Ok(Self {
-            port: port.as_ref().to_path_buf(),
-            inbox: Arc::new(Inbox::new(options.max_queue)),
-            stream: Arc::new(StreamShared::default()),
-            options,
-            running: None,
-        })
+        let port = port.as_ref().to_path_buf();
+        let inbox = Arc::new(Inbox::new(options.max_queue));
+        let stream = Arc::new(StreamShared::default());
+        let watchdog = Watchdog::new(robowire_rt::now(), options.state_timeout);
+        let (receiving, ()) = Receiving::spawn("kmc-receive", watchdog, {
+            let (port, options, inbox, stream) = (port.clone(), options.clone(), inbox.clone(), stream.clone());
+            move || async move {
+                let decoder = ChassisFrameDecoder::new()
+                    .with_max_speed_mps(options.max_speed_mps)
+                    .map_err(|e| KmcError::Option { name: "max_speed_mps", reason: e.to_string() })?;
+                let link = SerialLink::open(&port, &options.serial, decoder)?;
+                *robowire_rt::lock(&stream.writer) = Some(link.sync_writer()?);
+                inbox.set_link_state(LinkState::Connected);
+                let state = ChassisState::default();
+                Ok::<_, KmcError>((ChassisLink { link, reopen: options.reopen, inbox, stream, state }, ()))
+            }
+        })?;
+        let (requests, requests_rx) = std_mpsc::channel();
+        let job = StreamJob::new(robowire_rt::now(), options.stream_config(), stream.clone(), requests_rx);
+        let runner = Runner::spawn(RunnerOptions::placed("kmc-stream", options.placement), job)?;
+        Ok(Self { port, options, inbox, stream, runner: Some(runner), requests, receiving })
+    }
+
+    /// The port's path.
+    pub fn port(&self) -> &Path {
+        &self.port
     }
 
     /// The options in force.
@@ -243,79 +281,35 @@ impl Driver {
         &self.options
     }
 
-    /// Opens the port, starts the receive thread and the stream thread (with `cpu_affinity`,
-    /// `realtime_priority` and `lock_memory` applied to it). Returns once streaming, or with
-    /// the reason it could not start.
-    pub fn start(&mut self) -> Result<(), KmcError> {
-        if self.is_running() {
-            return Err(KmcError::AlreadyRunning);
-        }
-        if let Some(old) = self.running.take() {
-            // A run whose threads ended by themselves: collect them.
-            let _ = Self::shut_down(old);
-        }
-        let (stop_receiving, stop_rx) = watch::channel(false);
-        let (started_tx, started) = std_mpsc::sync_channel(1);
-        let receiver = std::thread::Builder::new()
-            .name("kmc-receive".into())
-            .spawn({
-                let (port, options, inbox, stream) =
-                    (self.port.clone(), self.options.clone(), self.inbox.clone(), self.stream.clone());
-                move || receive::run(port, options, inbox, stream, stop_rx, started_tx)
-            })
-            .map_err(KmcError::Thread)?;
-        let opened =
-            started.recv().unwrap_or_else(|_| Err(KmcError::Thread(std::io::Error::other("the receive thread died"))));
-        if let Err(e) = opened {
-            let _ = receiver.join();
-            return Err(e);
-        }
-        let (requests, requests_rx) = std_mpsc::channel();
-        let job = StreamJob::new(robowire_rt::now(), self.options.stream_config(), self.stream.clone(), requests_rx);
-        let stream = match Runner::spawn(self.options.runner_options(), job) {
-            Ok(stream) => stream,
-            Err(e) => {
-                let _ = stop_receiving.send(true);
-                let _ = receiver.join();
-                self.inbox.lock().link_state = LinkState::Stopped;
-                return Err(e.into());
-            }
-        };
-        self.running = Some(Running { stream, requests, stop_receiving, receiver });
-        Ok(())
+    /// Sends the stop burst (`stop_burst_count` × (0, 0)) and ends both threads; when this
+    /// returns the port is closed. Fails with the link error if the burst could not be sent
+    /// (the chassis then relies on its own watchdog). Dropping the driver does the same without
+    /// the error.
+    pub fn close(mut self) -> Result<(), KmcError> {
+        self.shut_down()
     }
 
-    /// Sends the stop burst (`stop_burst_count` × (0, 0)) and ends both threads. Idempotent.
-    /// Fails with the link error if the burst could not be sent (the chassis then relies on its
-    /// own watchdog).
-    pub fn stop(&mut self) -> Result<(), KmcError> {
-        let Some(running) = self.running.take() else { return Ok(()) };
-        let result = Self::shut_down(running);
-        self.inbox.lock().link_state = LinkState::Stopped;
-        result
-    }
-
-    /// Stop burst, then both threads end.
-    fn shut_down(running: Running) -> Result<(), KmcError> {
-        let asked = running.requests.send(Request::Stop).is_ok();
-        running.stream.waker().wake();
-        let job = if asked { running.stream.join() } else { running.stream.stop() };
-        let _ = running.stop_receiving.send(true);
-        let _ = running.receiver.join();
+    /// Stop burst, then the stream thread ends.
+    fn shut_down(&mut self) -> Result<(), KmcError> {
+        let Some(runner) = self.runner.take() else { return Ok(()) };
+        let asked = self.requests.send(Request::Stop).is_ok();
+        runner.waker().wake();
+        let job = if asked { runner.join() } else { runner.stop() };
+        self.inbox.set_link_state(LinkState::Stopped);
         match job {
             Some(job) => job.stop_result.map_err(KmcError::from),
             None => Err(KmcError::NotRunning),
         }
     }
 
-    /// Are the threads running?
+    /// Whether the stream thread runs (it ends only on close, or if it panicked).
     pub fn is_running(&self) -> bool {
-        self.running.as_ref().is_some_and(|r| !r.stream.is_finished() && !r.receiver.is_finished())
+        self.runner.as_ref().is_some_and(|r| !r.is_finished())
     }
 
-    /// The link's state.
+    /// The serial port's state.
     pub fn link_state(&self) -> LinkState {
-        self.inbox.lock().link_state
+        self.inbox.link_state()
     }
 
     /// Sets the command streamed from the next tick on: `velocity_mps` forward and
@@ -323,11 +317,16 @@ impl Driver {
     /// `curvature = omega / v` for |v| > 1 mm/s, else 0; the chassis cannot turn in place).
     /// NaN and infinities are refused and the previous command stays.
     pub fn set_command(&self, velocity_mps: f32, yaw_rate_radps: f32) -> Result<(), KmcError> {
+        self.latch(Self::command(velocity_mps, yaw_rate_radps)?);
+        Ok(())
+    }
+
+    /// The frame [`set_command`](Self::set_command) would latch, or why it refuses: to check
+    /// arguments before a port is even opened.
+    pub fn command(velocity_mps: f32, yaw_rate_radps: f32) -> Result<PcControl, KmcError> {
         let velocity_mps = finite("velocity_mps", velocity_mps)?;
         let yaw_rate_radps = finite("yaw_rate_radps", yaw_rate_radps)?;
-        let command = PcControl::from_yaw_rate(velocity_mps, yaw_rate_radps)?;
-        self.latch(command);
-        Ok(())
+        Ok(PcControl::from_yaw_rate(velocity_mps, yaw_rate_radps)?)
     }
 
     /// Sets the command as velocity and curvature directly.
@@ -340,24 +339,36 @@ impl Driver {
         Ok(())
     }
 
+    /// Sets the command timeout (1 ms..=1 h) from the next tick on: a caller with its own
+    /// deadman (a ROS 2 bridge) sets it to the deadman instead of refreshing the command.
+    pub fn set_command_timeout(&self, timeout: Duration) -> Result<(), KmcError> {
+        check_command_timeout(timeout)?;
+        let ns = u64::try_from(timeout.as_nanos()).unwrap_or(u64::MAX);
+        self.stream.command_timeout_ns.store(ns, Ordering::Release);
+        if let Some(runner) = &self.runner {
+            runner.waker().wake();
+        }
+        Ok(())
+    }
+
     fn latch(&self, command: PcControl) {
         self.stream.command.write(robowire_rt::now(), &command.into());
     }
 
     /// The oldest received frame, if any.
     pub fn try_pop_message(&self) -> Option<ChassisFrame> {
-        self.inbox.lock().queue.pop_front()
+        self.inbox.queue().pop_front()
     }
 
     /// The oldest received frame, waiting up to `timeout` for one.
     pub fn wait_pop_message(&self, timeout: Duration) -> Option<ChassisFrame> {
-        let received = self.inbox.lock();
-        let (mut received, _) = self
+        let queue = self.inbox.queue();
+        let (mut queue, _) = self
             .inbox
             .message_ready
-            .wait_timeout_while(received, timeout, |r| r.queue.is_empty())
+            .wait_timeout_while(queue, timeout, |q| q.is_empty())
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        received.queue.pop_front()
+        queue.pop_front()
     }
 
     /// Received frames until `deadline`: each as it arrives, ending at the deadline.
@@ -367,7 +378,7 @@ impl Driver {
     ///
     /// ```no_run
     /// # use std::time::{Duration, Instant};
-    /// # let driver = kmc::Driver::new("/dev/ttyUSB0", Default::default())?;
+    /// # let driver = kmc::Driver::open("/dev/ttyUSB0", Default::default())?;
     /// loop {
     ///     driver.set_command(0.5, 0.0)?;
     ///     for frame in driver.messages_until(Instant::now() + Duration::from_millis(50)) {
@@ -384,36 +395,61 @@ impl Driver {
         .take_while(move |_| std::time::Instant::now() <= deadline)
     }
 
+    /// Waits up to `timeout` for a chassis state that satisfies `accept` (the latest counts),
+    /// blocking the calling thread.
+    pub fn wait_state(
+        &self,
+        timeout: Duration,
+        accept: impl Fn(&ChassisState) -> bool + Send + Sync + 'static,
+    ) -> Option<ChassisState> {
+        self.receiving.wait_for_blocking(timeout, accept).map(|s| s.state)
+    }
+
     fn request(&self, frame: AfFrame) -> Result<(), KmcError> {
-        match &self.running {
-            Some(running) if !running.stream.is_finished() => {
-                running.requests.send(Request::Af(frame)).map_err(|_| KmcError::NotRunning)?;
-                running.stream.waker().wake();
+        match &self.runner {
+            Some(runner) if !runner.is_finished() => {
+                self.requests.send(Request::Af(frame)).map_err(|_| KmcError::NotRunning)?;
+                runner.waker().wake();
                 Ok(())
             }
             _ => Err(KmcError::NotRunning),
         }
     }
 
-    /// Sends one battery read to `motor_id` now; the answer arrives as a message.
+    /// Sends one battery read to `motor_id` now; the answer arrives as a message and in the state.
     pub fn request_battery_once(&self, motor_id: u8) -> Result<(), KmcError> {
         self.request(AfFrame::battery_read(motor_id))
     }
 
-    /// Sends one all-state read to `motor_id` now; the answer arrives as a message.
+    /// Sends one all-state read to `motor_id` now; the answer arrives as a message and in the
+    /// state.
     pub fn request_all_state_once(&self, motor_id: u8) -> Result<(), KmcError> {
         self.request(AfFrame::all_state_read(motor_id))
     }
+}
 
-    /// Counters and the stream's lateness. Never blocks the stream thread: its figures are
-    /// atomics, the lateness percentiles are computed here.
-    pub fn stats(&self) -> DriverStats {
-        let s = &self.stream;
-        let received = self.inbox.lock();
+impl Device for Driver {
+    type State = ChassisState;
+    type Stats = DriverStats;
+    type Error = KmcError;
+
+    fn receiving(&self) -> &Receiving<ChassisState> {
+        &self.receiving
+    }
+
+    /// Counters and the stream's lateness, from atomics: never blocks the stream thread.
+    fn stats(&self) -> DriverStats {
+        let (s, r) = (&self.stream, &self.inbox);
         let link = LinkCounters {
+            decoder: DecoderCounters {
+                frames: r.decoded_frames.get(),
+                skipped_bytes: r.skipped_bytes.get(),
+                rejected_candidates: r.rejected_candidates.get(),
+            },
+            bytes_read: r.bytes_read.get(),
             bytes_written: s.bytes_written.get(),
             frames_written: s.frames_written.get(),
-            ..received.link
+            reopens: r.reopens.get(),
         };
         DriverStats {
             control_frames_sent: s.control_frames.get(),
@@ -423,19 +459,24 @@ impl Driver {
             speed_requests_sent: s.speed_requests.get(),
             battery_requests_sent: s.battery_requests.get(),
             all_state_requests_sent: s.all_state_requests.get(),
-            frames_received: received.frames_received,
-            queue_dropped: received.queue_dropped,
+            frames_received: r.frames_received.get(),
+            queue_dropped: r.queue_dropped.get(),
             missed_ticks: s.missed_ticks.get(),
             write_errors: s.write_errors.get(),
-            disconnects: received.disconnects,
+            disconnects: r.disconnects.get(),
+            state_timeouts: self.receiving.stats().disconnects,
             control_lateness: s.lateness.summary(),
             link,
         }
+    }
+
+    fn close(self) -> Result<(), KmcError> {
+        Driver::close(self)
     }
 }
 
 impl Drop for Driver {
     fn drop(&mut self) {
-        let _ = self.stop();
+        let _ = self.shut_down();
     }
 }

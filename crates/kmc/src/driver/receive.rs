@@ -1,153 +1,184 @@
-//! The receive thread: a small tokio runtime reading the port through the serial link,
-//! queueing what the chassis sends, and reopening the port after a disconnect (then handing the
-//! stream thread a new writer). A normal thread: the only one that locks the received queue
-//! besides the user's.
+//! The receive side: the serial port as robowire-rt's receive loop drives it. Each frame the
+//! chassis sends updates the [`ChassisState`] (and its odometry) and joins the vendor's message
+//! queue; a vanished port is a lost link, reopened on the driver's backoff, the new writer handed
+//! to the stream thread.
 
 use std::collections::VecDeque;
-use std::path::PathBuf;
-use std::sync::mpsc as std_mpsc;
-use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
 
-use kmc_proto::{ChassisFrame, ChassisFrameDecoder};
-use robowire_serial::{LinkCounters, SerialLink};
-use tokio::sync::watch;
+use kmc_proto::{AllState, BatteryVoltage, ChassisFrame, ChassisFrameDecoder};
+use robowire_rt::Time;
+use robowire_rt::device::{Receive, Received};
+use robowire_rt::stats::Counter;
+use robowire_serial::{Backoff, LinkCounters, SerialLink};
 
+use super::LinkState;
 use super::stream::StreamShared;
-use super::{DriverOptions, LinkState};
-use crate::KmcError;
+use crate::odometry::PlanarOdometry;
 
-/// What the receive thread and the user's threads share.
-#[derive(Debug)]
-pub(super) struct Received {
-    pub(super) queue: VecDeque<ChassisFrame>,
-    pub(super) link_state: LinkState,
-    pub(super) frames_received: u64,
-    pub(super) queue_dropped: u64,
-    pub(super) disconnects: u64,
-    /// The link's read side: decoder counters, bytes read, reopens.
-    pub(super) link: LinkCounters,
+/// The chassis as the driver last heard it: the latest of each report, and the odometry.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ChassisState {
+    /// The latest `0xB3` speed report, m/s.
+    pub speed_mps: Option<f32>,
+    /// The latest battery report.
+    pub battery: Option<BatteryVoltage>,
+    /// The latest all-state report of motors 0 and 1.
+    pub motors: [Option<AllState>; 2],
+    /// x, y, heading from the speed reports and the commanded curvature, since the driver opened.
+    pub odometry: PlanarOdometry,
+    /// The report that made this state.
+    pub last_frame: Option<ChassisFrame>,
 }
 
+impl ChassisState {
+    fn on_frame(&mut self, at: Time, frame: ChassisFrame, curvature_per_m: f32) {
+        match frame {
+            ChassisFrame::VehicleSpeed(speed) => {
+                self.speed_mps = Some(speed.speed_mps);
+                let t_s = at.as_nanos() as f64 / 1e9;
+                self.odometry.on_speed(t_s, speed.speed_mps.into(), curvature_per_m.into());
+            }
+            ChassisFrame::BatteryVoltage(battery) => self.battery = Some(battery),
+            ChassisFrame::AllState(state) => {
+                if let Some(slot) = self.motors.get_mut(usize::from(state.motor_id)) {
+                    *slot = Some(state);
+                }
+            }
+            ChassisFrame::Af(_) => {}
+        }
+        self.last_frame = Some(frame);
+    }
+}
+
+/// The vendor's message queue and the receive side's counters, shared with the user's threads.
+/// Counters and the link state are atomics; only the queue has a lock (never the stream
+/// thread's).
 #[derive(Debug)]
 pub(super) struct Inbox {
-    state: Mutex<Received>,
+    queue: Mutex<VecDeque<ChassisFrame>>,
     pub(super) message_ready: Condvar,
+    max_queue: usize,
+    link_state: AtomicU8,
+    pub(super) frames_received: Counter,
+    pub(super) queue_dropped: Counter,
+    pub(super) disconnects: Counter,
+    pub(super) decoded_frames: Counter,
+    pub(super) skipped_bytes: Counter,
+    pub(super) rejected_candidates: Counter,
+    pub(super) bytes_read: Counter,
+    pub(super) reopens: Counter,
 }
 
 impl Inbox {
     pub(super) fn new(max_queue: usize) -> Self {
         Self {
-            state: Mutex::new(Received {
-                queue: VecDeque::with_capacity(max_queue.min(4096)),
-                link_state: LinkState::Stopped,
-                frames_received: 0,
-                queue_dropped: 0,
-                disconnects: 0,
-                link: LinkCounters::default(),
-            }),
+            queue: Mutex::new(VecDeque::with_capacity(max_queue.min(4096))),
             message_ready: Condvar::new(),
+            max_queue,
+            link_state: AtomicU8::new(LinkState::Stopped as u8),
+            frames_received: Counter::default(),
+            queue_dropped: Counter::default(),
+            disconnects: Counter::default(),
+            decoded_frames: Counter::default(),
+            skipped_bytes: Counter::default(),
+            rejected_candidates: Counter::default(),
+            bytes_read: Counter::default(),
+            reopens: Counter::default(),
         }
     }
 
-    pub(super) fn lock(&self) -> MutexGuard<'_, Received> {
-        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    pub(super) fn queue(&self) -> std::sync::MutexGuard<'_, VecDeque<ChassisFrame>> {
+        robowire_rt::lock(&self.queue)
+    }
+
+    pub(super) fn link_state(&self) -> LinkState {
+        LinkState::from_u8(self.link_state.load(Ordering::Acquire))
+    }
+
+    pub(super) fn set_link_state(&self, state: LinkState) {
+        self.link_state.store(state as u8, Ordering::Release);
+    }
+
+    /// The read side's counters, copied from the link.
+    fn mirror(&self, link: LinkCounters) {
+        self.decoded_frames.set(link.decoder.frames);
+        self.skipped_bytes.set(link.decoder.skipped_bytes);
+        self.rejected_candidates.set(link.decoder.rejected_candidates);
+        self.bytes_read.set(link.bytes_read);
+        self.reopens.set(link.reopens);
+    }
+
+    fn enqueue(&self, frame: ChassisFrame) {
+        self.frames_received.add(1);
+        let mut queue = self.queue();
+        if queue.len() >= self.max_queue {
+            queue.pop_front();
+            self.queue_dropped.add(1);
+        }
+        queue.push_back(frame);
+        drop(queue);
+        self.message_ready.notify_one();
     }
 }
 
-/// Opens the port, hands the stream thread its writer, reports the outcome on `started`, then
-/// receives until `stop` says so.
-pub(super) fn run(
-    port: PathBuf,
-    options: DriverOptions,
-    inbox: Arc<Inbox>,
-    stream: Arc<StreamShared>,
-    mut stop: watch::Receiver<bool>,
-    started: std_mpsc::SyncSender<Result<(), KmcError>>,
-) {
-    let setup = || -> Result<(tokio::runtime::Runtime, SerialLink<ChassisFrameDecoder>), KmcError> {
-        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(KmcError::Thread)?;
-        let decoder = ChassisFrameDecoder::new()
-            .with_max_speed_mps(options.max_speed_mps)
-            .map_err(|e| KmcError::Option { name: "max_speed_mps", reason: e.to_string() })?;
-        let link = {
-            let _entered = runtime.enter();
-            SerialLink::open(&port, &options.serial, decoder)?
-        };
-        *lock(&stream.writer) = Some(link.sync_writer()?);
-        Ok((runtime, link))
-    };
-    let (runtime, mut link) = match setup() {
-        Ok(ok) => ok,
-        Err(e) => {
-            let _ = started.send(Err(e));
-            return;
-        }
-    };
-    inbox.lock().link_state = LinkState::Connected;
-    let _ = started.send(Ok(()));
-    runtime.block_on(receive(&options, &inbox, &stream, &mut link, &mut stop));
-    // A writer the stream thread never took would keep the port open (and, exclusive, busy).
-    lock(&stream.writer).take();
+/// The port as the receive loop sees it.
+pub(super) struct ChassisLink {
+    pub(super) link: SerialLink<ChassisFrameDecoder>,
+    pub(super) reopen: Option<Backoff>,
+    pub(super) inbox: Arc<Inbox>,
+    pub(super) stream: Arc<StreamShared>,
+    pub(super) state: ChassisState,
 }
 
-async fn receive(
-    options: &DriverOptions,
-    inbox: &Inbox,
-    stream: &StreamShared,
-    link: &mut SerialLink<ChassisFrameDecoder>,
-    stop: &mut watch::Receiver<bool>,
-) {
-    loop {
-        if link.is_open() {
-            tokio::select! {
-                _ = stop.changed() => return,
-                frame = link.recv() => match frame {
-                    Ok(frame) => enqueue(inbox, frame, options.max_queue, link.counters()),
-                    Err(_) => on_disconnect(inbox, link),
-                },
-            }
-        } else if let Some(backoff) = options.reopen {
-            tokio::select! {
-                _ = stop.changed() => return,
-                reopened = link.reopen(&backoff) => if reopened.is_ok() {
-                    if let Ok(writer) = link.sync_writer() {
-                        *lock(&stream.writer) = Some(writer);
+impl Receive for ChassisLink {
+    type Item = ChassisFrame;
+    type State = ChassisState;
+
+    async fn receive(&mut self) -> Received<ChassisFrame> {
+        loop {
+            if self.link.is_open() {
+                let frame = self.link.recv().await;
+                self.inbox.mirror(self.link.counters());
+                return match frame {
+                    Ok(frame) => Received::Item(frame),
+                    Err(_) => {
+                        if self.inbox.link_state() != LinkState::Disconnected {
+                            self.inbox.set_link_state(LinkState::Disconnected);
+                            self.inbox.disconnects.add(1);
+                        }
+                        Received::Lost
                     }
-                    let mut received = inbox.lock();
-                    received.link_state = LinkState::Connected;
-                    received.link = link.counters();
-                },
+                };
             }
-        } else {
-            // No reopening: wait for stop.
-            let _ = stop.changed().await;
-            return;
+            let Some(backoff) = self.reopen else {
+                // Not reopening: the link stays down until the driver closes.
+                return std::future::pending().await;
+            };
+            if self.link.reopen(&backoff).await.is_err() {
+                // The backoff gave up: nothing more will arrive.
+                return Received::Closed;
+            }
+            if let Ok(writer) = self.link.sync_writer() {
+                *robowire_rt::lock(&self.stream.writer) = Some(writer);
+            }
+            self.inbox.mirror(self.link.counters());
+            self.inbox.set_link_state(LinkState::Connected);
         }
     }
-}
 
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(PoisonError::into_inner)
-}
-
-fn enqueue(inbox: &Inbox, frame: ChassisFrame, max_queue: usize, link: LinkCounters) {
-    let mut received = inbox.lock();
-    received.frames_received += 1;
-    received.link = link;
-    if received.queue.len() >= max_queue {
-        received.queue.pop_front();
-        received.queue_dropped += 1;
+    fn on_item(&mut self, now: Time, frame: ChassisFrame) -> Option<ChassisState> {
+        self.inbox.enqueue(frame);
+        let curvature = self.stream.command.read().map_or(0.0, |(_, c)| c.curvature_per_m.get());
+        self.state.on_frame(now, frame, curvature);
+        Some(self.state)
     }
-    received.queue.push_back(frame);
-    drop(received);
-    inbox.message_ready.notify_one();
 }
 
-fn on_disconnect(inbox: &Inbox, link: &SerialLink<ChassisFrameDecoder>) {
-    let mut received = inbox.lock();
-    if received.link_state != LinkState::Disconnected {
-        received.link_state = LinkState::Disconnected;
-        received.disconnects += 1;
+impl Drop for ChassisLink {
+    fn drop(&mut self) {
+        // A writer the stream thread never took would keep the port open (and, exclusive, busy).
+        robowire_rt::lock(&self.stream.writer).take();
     }
-    received.link = link.counters();
 }

@@ -3,8 +3,10 @@
 //! holds: commands come through a seqlock ([`Latest`]), requests through a channel it only
 //! `try_recv`s, the writer through a slot it only `try_lock`s, and statistics go out as atomics.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use kmc_proto::stream::{CommandStream, Due, StreamConfig, Transmit};
 use kmc_proto::{AfFrame, HostFrame, MAX_FRAME_LEN, ParamId, PcControl};
@@ -19,8 +21,8 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 #[derive(Debug, Clone, Copy, FromBytes, IntoBytes, KnownLayout, Immutable)]
 #[repr(C)]
 pub(super) struct CommandSlot {
-    velocity_mps: F32,
-    curvature_per_m: F32,
+    pub(super) velocity_mps: F32,
+    pub(super) curvature_per_m: F32,
 }
 
 impl From<PcControl> for CommandSlot {
@@ -41,6 +43,8 @@ pub(super) enum Request {
 pub(super) struct StreamShared {
     /// The latched command and when it was set.
     pub(super) command: Latest<CommandSlot>,
+    /// The command timeout, ns, as last set by the caller (0: the options' one).
+    pub(super) command_timeout_ns: AtomicU64,
     /// The writer of the port as it is now; the receive thread swaps it on (re)connect.
     pub(super) writer: Mutex<Option<SyncWriter>>,
     pub(super) lateness: SharedLateness<4096>,
@@ -65,6 +69,8 @@ pub(super) struct StreamJob {
     writer: Option<SyncWriter>,
     /// When the command this job last took was set (a new one has another time).
     command_set_at: Option<Time>,
+    /// The command timeout in force, ns.
+    command_timeout_ns: u64,
     /// The stop burst's outcome: the first write error, if any.
     pub(super) stop_result: Result<(), SerialError>,
 }
@@ -82,12 +88,19 @@ impl StreamJob {
             requests,
             writer: None,
             command_set_at: None,
+            command_timeout_ns: 0,
             stop_result: Ok(()),
         }
     }
 
-    /// Takes what the other threads handed over: requests, the command, a new writer.
+    /// Takes what the other threads handed over: requests, the command timeout, the command, a
+    /// new writer.
     fn take_inputs(&mut self, now: Time) {
+        let timeout_ns = self.shared.command_timeout_ns.load(Ordering::Acquire);
+        if timeout_ns != 0 && timeout_ns != self.command_timeout_ns {
+            self.command_timeout_ns = timeout_ns;
+            self.stream.set_command_timeout(Duration::from_nanos(timeout_ns));
+        }
         while let Ok(request) = self.requests.try_recv() {
             match request {
                 Request::Af(frame) => {

@@ -27,7 +27,6 @@ use robowire_core::cdr::CdrType;
 use robowire_core::schedule::{Periodic, Time};
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
-use robowire_dds::rpc::RpcServer;
 use robowire_dds::{DdsError, Participant, ParticipantOptions, Reader, StatsHandle, TopicStats, Writer};
 use robowire_rt::runner::{Job, Runner, RunnerOptions};
 use robowire_rt::stats::{Counter, SharedLateness, micros};
@@ -203,8 +202,8 @@ impl Go2Sim {
         let lowcmd = reader.stats_handle();
         let answers =
             config.answer_lowcmd.then(|| participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)).transpose()?;
-        let switcher = RpcServer::new(&participant, motion_switcher::SERVICE)?;
-        let sport = RpcServer::new(&participant, sport::SERVICE)?;
+        let switcher = services::service_server(&participant, motion_switcher::SERVICE)?;
+        let sport = services::service_server(&participant, sport::SERVICE)?;
         let (stop, stop_rx) = watch::channel(false);
         let services = std::thread::Builder::new()
             .name("go2-sim-services".into())
@@ -224,7 +223,7 @@ impl Go2Sim {
             last_step: None,
             sent: AtomicU32::new(0),
         };
-        let stream = Runner::spawn(RunnerOptions { cpu: config.cpu, ..RunnerOptions::named("go2-sim-state") }, job)?;
+        let stream = Runner::spawn(RunnerOptions::placed("go2-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }), job)?;
         Ok(Self {
             shared,
             stats,

@@ -5,7 +5,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use lowcmd_proto::LowState;
-use lowcmd_proto::api::{self, ApiRequest, motion_switcher, sport, status};
+use lowcmd_proto::api::{self, ApiRequest, ApiResponse, Response, motion_switcher, sport, status};
 use robowire_dds::Writer;
 use robowire_dds::rpc::RpcServer;
 use tokio::sync::watch;
@@ -17,8 +17,19 @@ pub(super) struct Endpoints {
     pub(super) lowcmd: LowCmdReader,
     /// Immediate answers to LowCmds, if asked for.
     pub(super) answers: Option<Writer<LowState>>,
-    pub(super) switcher: RpcServer,
-    pub(super) sport: RpcServer,
+    pub(super) switcher: ServiceServer,
+    pub(super) sport: ServiceServer,
+}
+
+/// A server of one of the robot's services (`rt/api/<service>/request` and `/response`).
+pub(super) type ServiceServer = RpcServer<ApiRequest, ApiResponse>;
+
+/// A server of `service`.
+pub(super) fn service_server(
+    participant: &robowire_dds::Participant,
+    service: &str,
+) -> Result<ServiceServer, robowire_dds::DdsError> {
+    RpcServer::new(participant, &api::request_topic(service).to_string(), &api::response_topic(service).to_string())
 }
 
 /// Runs until `stop` says so.
@@ -55,7 +66,7 @@ pub(super) fn run(
 
 /// Answers every request of one service with `answer`.
 async fn serve(
-    mut server: RpcServer,
+    mut server: ServiceServer,
     shared: &Mutex<Shared>,
     stats: &Stats,
     answer: fn(&mut Shared, &ApiRequest) -> (i32, String),
@@ -63,8 +74,10 @@ async fn serve(
     while let Ok(request) = server.next_request().await {
         let (code, data) = answer(&mut lock(shared), &request);
         stats.requests.add(1);
-        // A lost answer: the client writes its request again.
-        let _ = server.answer(&request.header, code, &data);
+        // A lost answer: the client writes its request again. No answer when none is asked for.
+        if !request.header.noreply {
+            let _ = server.answer(Response::to(&request.header, code, &data).into());
+        }
     }
 }
 

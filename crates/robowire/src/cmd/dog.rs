@@ -6,7 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
-use zsl::udp::{CallError, ClientOptions, ControlMode, HighLevel, Model, RobotState, StateDecoding};
+use robowire_devices::{Describe, zsl_state_line};
+use zsl::udp::{CallError, ClientOptions, ControlMode, Device, HighLevel, Latched, Model, StateDecoding};
 use zsl_proto::udp::{DEFAULT_LOCAL_PORT, HIGH_LEVEL_PORT};
 
 /// The robot model, as the command line spells it.
@@ -138,10 +139,7 @@ fn options(args: &DogArgs) -> ClientOptions {
     ClientOptions { dog: SocketAddr::new(args.dog_ip, args.dog_port), ..options }
 }
 
-fn duration(name: &str, seconds: f64) -> anyhow::Result<Duration> {
-    anyhow::ensure!(seconds.is_finite() && (0.0..=3600.0).contains(&seconds), "{name} must be 0–3600 s, got {seconds}");
-    Ok(Duration::from_secs_f64(seconds))
-}
+use crate::cmd::seconds as duration;
 
 async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
     let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire dog")?;
@@ -149,7 +147,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
     if let Some(recorder) = &recorder {
         options = options.with_tap(recorder.link("dog/high_level", robowire_record::Protocol::ZslHighLevel));
     }
-    let dog = HighLevel::connect(options).await.context("starting the HighLevel client")?;
+    let dog = HighLevel::open(options).context("starting the HighLevel client")?;
     let timeout = Duration::from_secs_f64(args.connect_timeout_s);
     if !dog.wait_connected(timeout).await {
         anyhow::bail!(
@@ -161,19 +159,19 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let outcome = match args.command {
-        DogCommand::Stand => call(&dog, "stand_up", dog.stand_up().await, Some(ControlMode::Stand)).await,
-        DogCommand::Lie => call(&dog, "lie_down", dog.lie_down().await, Some(ControlMode::LieDown)).await,
-        DogCommand::Passive => call(&dog, "passive", dog.passive().await, Some(ControlMode::Passive)).await,
+        DogCommand::Stand => call(&dog, "stand_up", dog.stand_up(), Some(ControlMode::Stand)).await,
+        DogCommand::Lie => call(&dog, "lie_down", dog.lie_down(), Some(ControlMode::LieDown)).await,
+        DogCommand::Passive => call(&dog, "passive", dog.passive(), Some(ControlMode::Passive)).await,
         DogCommand::Move { vx_mps, vy_mps, yaw_rate_radps, duration: seconds } => {
             let walk = duration("--duration", seconds)?;
             let start = dog.position();
-            let result = dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps).await;
+            let result = dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps);
             let ok = call(&dog, "move", result, Some(ControlMode::Move)).await;
             if ok {
                 watch_for(&dog, walk).await;
-                let stopped = dog.move_velocity(0.0, 0.0, 0.0).await;
+                let stopped = dog.move_velocity(0.0, 0.0, 0.0);
                 call(&dog, "move(0, 0, 0)", stopped, None).await;
-                dog.wait_for_state(Duration::from_secs(2), |s| {
+                dog.wait_for_state(Duration::from_secs(2), move |s| {
                     s.body.body_velocity_mps[0].abs() < 0.05 && s.body.body_velocity_mps[1].abs() < 0.05
                 })
                 .await;
@@ -183,64 +181,59 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             }
             ok
         }
-        DogCommand::Jump => trick(&dog, "jump", dog.jump().await).await,
-        DogCommand::FrontJump => trick(&dog, "front_jump", dog.front_jump().await).await,
-        DogCommand::Backflip => trick(&dog, "backflip", dog.backflip().await).await,
-        DogCommand::ShakeHand => trick(&dog, "shake_hand", dog.shake_hand().await).await,
+        DogCommand::Jump => trick(&dog, "jump", dog.jump()).await,
+        DogCommand::FrontJump => trick(&dog, "front_jump", dog.front_jump()).await,
+        DogCommand::Backflip => trick(&dog, "backflip", dog.backflip()).await,
+        DogCommand::ShakeHand => trick(&dog, "shake_hand", dog.shake_hand()).await,
         DogCommand::TwoLegStand { vx_mps, yaw_rate_radps } => {
-            let result = dog.two_leg_stand(vx_mps, yaw_rate_radps).await;
+            let result = dog.two_leg_stand(vx_mps, yaw_rate_radps);
             call(&dog, "two_leg_stand", result, Some(ControlMode::Action)).await
         }
         DogCommand::CancelTwoLegStand => {
-            call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand().await, None).await
+            call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand(), None).await
         }
         DogCommand::Attitude { roll_radps, pitch_radps, yaw_radps, height_mps, duration: seconds } => {
             let hold = duration("--duration", seconds)?;
-            let result = dog.attitude_control(roll_radps, pitch_radps, yaw_radps, height_mps).await;
+            let result = dog.attitude_control(roll_radps, pitch_radps, yaw_radps, height_mps);
             let ok = call(&dog, "attitude_control", result, Some(ControlMode::Action)).await;
             if ok {
                 watch_for(&dog, hold).await;
-                let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0).await;
+                let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0);
                 call(&dog, "attitude_control(0, 0, 0, 0)", zero, None).await;
             }
             ok
         }
         DogCommand::Status { json } => {
-            let state = dog.wire_state().context("the connection dropped before a state arrived")?;
+            let missing = "the connection dropped before a state arrived";
             if json {
                 // The datagram's JSON, as `robowire decode zsl --json` prints it.
-                println!("{}", serde_json::to_string_pretty(&state)?);
+                println!("{}", serde_json::to_string_pretty(&dog.status_json().context(missing)?)?);
             } else {
-                print_status(&(&state).into());
+                println!("{}", dog.status_text().context(missing)?);
             }
             true
         }
         DogCommand::Watch => {
-            crate::cmd::live::watch_until_ctrl_c(dog.connection_events(), || dog.state().map(|s| line(&s))).await?;
+            crate::cmd::live::watch_until_ctrl_c(dog.connection_events(), || dog.status_line()).await?;
             true
         }
     };
-    let stats = dog.stats();
-    eprintln!(
-        "link: sent {} received {} decode errors {} foreign dropped {} | short states {} header anomalies {} disconnects {}",
-        stats.link.sent,
-        stats.link.received,
-        stats.link.decode_errors,
-        stats.link.foreign_dropped,
-        stats.short_states,
-        stats.header_anomalies,
-        stats.disconnects
-    );
-    dog.close().await;
+    eprintln!("{}", dog.stats_line());
+    dog.close();
     crate::cmd::record::finish(recorder)?;
     Ok(if outcome { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-/// Prints a call's return code; waits for `mode` when given. `true` when the call was accepted.
-async fn call(dog: &HighLevel, name: &str, result: Result<(), CallError>, mode: Option<ControlMode>) -> bool {
+/// Prints a call's return code; waits for `mode` when given. `true` when the call went out.
+async fn call(dog: &HighLevel, name: &str, result: Result<Latched, CallError>, mode: Option<ControlMode>) -> bool {
     match result {
-        Ok(()) => {
-            println!("{name}: 0x0000 queued");
+        Ok(latched) => {
+            let code = latched.return_code;
+            if code.raw() == 0 {
+                println!("{name}: 0x0000 queued");
+            } else {
+                println!("{name}: 0x{:04x} sent, not acknowledged yet ({code:?})", code.raw());
+            }
             if let Some(mode) = mode {
                 match dog.wait_for_mode(mode, Duration::from_secs(2)).await {
                     Some(_) => println!("robot reports mode {} ({mode:?})", mode.raw()),
@@ -260,7 +253,7 @@ async fn call(dog: &HighLevel, name: &str, result: Result<(), CallError>, mode: 
     }
 }
 
-async fn trick(dog: &HighLevel, name: &str, result: Result<(), CallError>) -> bool {
+async fn trick(dog: &HighLevel, name: &str, result: Result<Latched, CallError>) -> bool {
     let ok = call(dog, name, result, Some(ControlMode::Action)).await;
     if ok {
         // Keep the client (and its stream) alive while the trick runs.
@@ -269,52 +262,16 @@ async fn trick(dog: &HighLevel, name: &str, result: Result<(), CallError>) -> bo
     ok
 }
 
-/// The robot's error word as text: `none`, or the code and its name.
-fn error_text(s: &RobotState) -> String {
-    s.body.error.map_or_else(|| "none".into(), |e| format!("0x{:04x} ({e:?})", e.raw()))
-}
 
-fn line(s: &RobotState) -> String {
-    let b = &s.body;
-    format!(
-        "mode {:>2} | pos {:+6.2} {:+6.2} {:+5.2} m | v {:+5.2} {:+5.2} m/s | yaw {:+5.2} rad | battery {:>3} % | error {}",
-        b.mode.raw(),
-        b.position_m[0],
-        b.position_m[1],
-        b.position_m[2],
-        b.body_velocity_mps[0],
-        b.body_velocity_mps[1],
-        b.imu.rpy_rad[2],
-        b.battery_percent,
-        error_text(s)
-    )
-}
 
 async fn watch_for(dog: &HighLevel, how_long: Duration) {
     let end = Instant::now() + how_long;
     while Instant::now() < end {
         tokio::time::sleep(Duration::from_millis(250).min(end.saturating_duration_since(Instant::now()))).await;
         match dog.state() {
-            Some(s) => println!("  {}", line(&s)),
+            Some(s) => println!("  {}", zsl_state_line(&s)),
             None => println!("  (no state: {:?})", dog.connection()),
         }
     }
 }
 
-fn print_status(s: &RobotState) {
-    let v = |a: &[f32]| a.iter().map(|x| format!("{x:+.3}")).collect::<Vec<_>>().join(" ");
-    let b = &s.body;
-    println!("mode           {} ({:?})", b.mode.raw(), b.mode);
-    println!("battery        {} %", b.battery_percent);
-    println!("error          {}", error_text(s));
-    println!("sdk mismatch   {}", if s.sdk_mismatch { "yes" } else { "no" });
-    println!("position m     {}", v(&b.position_m));
-    println!("body vel m/s   {}", v(&b.body_velocity_mps));
-    println!("rpy rad        {}", v(&b.imu.rpy_rad));
-    println!("quaternion     {}", v(&b.imu.quaternion_wxyz));
-    println!("gyro rad/s     {}", v(&b.imu.gyro_radps));
-    let joints = &s.joints.position_rad;
-    for (name, legs) in [("abad", joints.abad), ("hip", joints.hip), ("knee", joints.knee), ("foot", joints.foot)] {
-        println!("{name:<5} rad FR FL RR RL  {}", v(&legs));
-    }
-}

@@ -5,7 +5,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use go2::{Connection, Go2, JointCommand, LowLevel, LowLevelOptions, LowState, STAND_POSE_RAD};
+use go2::trajectory::JointTrajectory;
+use go2::{Connection, Device, Go2, LowLevel, LowLevelOptions};
+use robowire_devices::Describe;
 
 /// Where the robot is on DDS, shared by `go2`, `dds` and `sim go2`.
 #[derive(Debug, Clone, Args)]
@@ -63,21 +65,15 @@ enum Go2Command {
 
 /// Damping sent before exiting, after `stand` and by `damp`.
 const DAMP_FOR: Duration = Duration::from_millis(500);
-/// Stand gains of Unitree's example.
-const STAND_KP: f32 = 60.0;
-const STAND_KD: f32 = 5.0;
 
-fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
-    anyhow::ensure!(value.is_finite() && (0.0..=3600.0).contains(&value), "{name} must be 0–3600 s, got {value}");
-    Ok(Duration::from_secs_f64(value))
-}
+use crate::cmd::seconds;
 
 pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
     let connect = seconds("--connect-timeout-s", args.connect_timeout_s)?;
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
         let options = LowLevelOptions { participant: args.dds.participant(), ..LowLevelOptions::default() };
-        let robot = LowLevel::<Go2>::connect(options).await.context("joining DDS")?;
+        let robot = LowLevel::<Go2>::open(options).context("joining DDS")?;
         let state = robot.wait_state(connect, |_| true).await.with_context(|| {
             format!(
                 "no rt/lowstate within {:.1} s on domain {} ({}): is the robot on, and is this the interface \
@@ -92,7 +88,7 @@ pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
                 if json {
                     println!("{}", serde_json::to_string(&crate::cmd::decode::json_value(&state)?)?);
                 } else {
-                    print_status(&state);
+                    println!("{}", robot.status_text().context("no state")?);
                 }
                 ExitCode::SUCCESS
             }
@@ -119,18 +115,8 @@ pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
                 ExitCode::SUCCESS
             }
         };
-        let s = robot.stats();
-        eprintln!(
-            "lowcmd sent {} (damping {}) | lowstate received {} decode errors {} CRC errors {} lost by tick {} | send lateness p50 {} µs p99 {} µs",
-            s.commands_sent,
-            s.damping_sent,
-            s.lowstate.samples,
-            s.lowstate.decode_errors,
-            s.lowstate.checksum_errors,
-            s.lost_by_tick,
-            s.send_lateness.p50_us,
-            s.send_lateness.p99_us
-        );
+        eprintln!("{}", robot.stats_line());
+        robot.close();
         Ok(code)
     })
 }
@@ -143,22 +129,19 @@ async fn release(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Moves from the current pose to the stand pose over `duration`, holds for `hold`, damps.
+/// Moves from the current pose to the stand pose over `duration` (Unitree's stand trajectory),
+/// holds for `hold`, damps.
 async fn stand(robot: &LowLevel<Go2>, duration: Duration, hold: Duration) -> anyhow::Result<ExitCode> {
     release(robot).await?;
     let start = robot.joint_positions().context("no state")?;
-    let target: [f32; 12] = std::array::from_fn(|i| STAND_POSE_RAD[i % 3]);
+    let stand = JointTrajectory::stand_up(start, duration);
     println!("moving from {} to the stand pose over {:.1} s", pose(&start), duration.as_secs_f64());
     let began = Instant::now();
     let mut ticker = tokio::time::interval(Duration::from_millis(2));
     loop {
         ticker.tick().await;
         let elapsed = began.elapsed();
-        let fraction = if duration.is_zero() { 1.0 } else { (elapsed.as_secs_f32() / duration.as_secs_f32()).min(1.0) };
-        let joints: [JointCommand; 12] = std::array::from_fn(|i| {
-            JointCommand::hold(start[i] + (target[i] - start[i]) * fraction, STAND_KP, STAND_KD)
-        });
-        robot.set_joints(&joints).context("the stand command")?;
+        robot.set_joints(&stand.joints_at(elapsed)).context("the stand command")?;
         if elapsed >= duration + hold {
             break;
         }
@@ -168,7 +151,7 @@ async fn stand(robot: &LowLevel<Go2>, duration: Duration, hold: Duration) -> any
         }
     }
     let reached = robot.joint_positions().context("no state")?;
-    let worst = reached.iter().zip(target).map(|(q, t)| (q - t).abs()).fold(0.0f32, f32::max);
+    let worst = stand.largest_error_rad(&reached);
     println!("held the stand pose {:.1} s: {} (largest error {worst:.3} rad)", hold.as_secs_f64(), pose(&reached));
     robot.damp();
     tokio::time::sleep(DAMP_FOR).await;
@@ -180,42 +163,6 @@ fn pose(q: &[f32; 12]) -> String {
     q.chunks(3).map(|leg| format!("[{:+.2} {:+.2} {:+.2}]", leg[0], leg[1], leg[2])).collect::<Vec<_>>().join(" ")
 }
 
-fn line(state: &LowState) -> String {
-    let q: [f32; 12] = std::array::from_fn(|i| state.motor_state[i].q.get());
-    let rpy = state.imu_state.rpy.map(|v| v.get());
-    format!(
-        "tick {:>8} | q {} | rpy {:+.2} {:+.2} {:+.2} | {:.1} V {:.1} A soc {} %",
-        state.tick.get(),
-        pose(&q),
-        rpy[0],
-        rpy[1],
-        rpy[2],
-        state.power_v.get(),
-        state.power_a.get(),
-        state.bms_state.soc
-    )
-}
-
-fn print_status(state: &LowState) {
-    println!("{}", line(state));
-    for (i, name) in go2::GO2_JOINT_NAMES.iter().enumerate() {
-        let m = &state.motor_state[i];
-        println!(
-            "  {name:<9} q {:+.3} rad  dq {:+.3} rad/s  tau {:+.2} N·m  mode {}  {} °C",
-            m.q.get(),
-            m.dq.get(),
-            m.tau_est.get(),
-            m.mode,
-            m.temperature
-        );
-    }
-    let ff = state.foot_force.map(|f| f.get());
-    println!("  foot force FR FL RR RL: {ff:?}");
-}
-
 async fn watch(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
-    crate::cmd::live::watch_until_ctrl_c(robot.connection_events(), || {
-        robot.state().map(|s| format!("{} | age {} ms", line(&s.state), s.age.as_millis()))
-    })
-    .await
+    crate::cmd::live::watch_until_ctrl_c(robot.connection_events(), || robot.status_line()).await
 }

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use kmc::{BlockingUartClient, ChassisFrame, Driver, DriverOptions, SerialPortOptions};
+use kmc::{BlockingUartClient, ChassisFrame, Device, Driver, DriverOptions, SerialPortOptions};
 
 #[derive(Debug, Args)]
 pub(crate) struct KmcArgs {
@@ -85,10 +85,13 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
     }
     let options =
         DriverOptions { serial, poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..Default::default() };
-    let mut driver = Driver::new(port, options)?;
     // Validate before the port is even opened.
-    driver.set_command(args.velocity, args.yaw_rate).context("refusing to drive")?;
-    driver.start().with_context(|| format!("starting the driver on {}", port.display()))?;
+    Driver::command(args.velocity, args.yaw_rate).context("refusing to drive")?;
+    let stop_burst = options.stop_burst_count;
+    let driver = Driver::open(port, options).with_context(|| format!("starting the driver on {}", port.display()))?;
+    // The command stays fresh until the end; the driver stops the chassis if this process stalls.
+    driver.set_command_timeout(Duration::from_secs_f64(args.duration).max(Duration::from_millis(300)))?;
+    driver.set_command(args.velocity, args.yaw_rate)?;
     println!(
         "driving {:+.3} m/s at {:+.3} rad/s for {:.1} s on {}",
         args.velocity,
@@ -97,20 +100,16 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
         port.display()
     );
     let end = Instant::now() + Duration::from_secs_f64(args.duration);
-    while Instant::now() < end {
-        // Refresh well inside the Driver's 300 ms command timeout, printing what arrives.
-        driver.set_command(args.velocity, args.yaw_rate)?;
-        for frame in driver.messages_until((Instant::now() + Duration::from_millis(50)).min(end)) {
-            print_frame(&frame);
-        }
+    for frame in driver.messages_until(end) {
+        print_frame(&frame);
     }
-    driver.stop().context("sending the stop burst")?;
     let s = driver.stats();
+    driver.close().context("sending the stop burst")?;
     println!(
         "stopped. sent: control {} (timeout stops {}), stop burst {}, speed requests {}, battery {}, all-state {} | received {} | skipped bytes {}, rejected candidates {} | lateness p50 {} µs p99 {} µs",
         s.control_frames_sent,
         s.timeout_frames_sent,
-        s.stop_frames_sent,
+        stop_burst,
         s.speed_requests_sent,
         s.battery_requests_sent,
         s.all_state_requests_sent,

@@ -3,6 +3,7 @@
 pub(crate) mod dds;
 pub(crate) mod decode;
 pub(crate) mod demo;
+pub(crate) mod device;
 pub(crate) mod dog;
 pub(crate) mod encode;
 pub(crate) mod go2;
@@ -13,3 +14,9 @@ pub(crate) mod replay_device;
 pub(crate) mod ros2;
 pub(crate) mod shm;
 pub(crate) mod sim;
+
+/// A duration argument in seconds, 0–3600.
+pub(crate) fn seconds(name: &str, value: f64) -> anyhow::Result<std::time::Duration> {
+    anyhow::ensure!(value.is_finite() && (0.0..=3600.0).contains(&value), "{name} must be 0–3600 s, got {value}");
+    Ok(std::time::Duration::from_secs_f64(value))
+}

@@ -91,7 +91,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         let devices = robowire_ros2::run(options, stop, |devices| {
             for d in devices {
                 let ns = if d.namespace.is_empty() { "/" } else { &d.namespace };
-                eprintln!("ros2: {:?} as {ns} on domain {}", d.address, args.domain);
+                eprintln!("ros2: {} as {ns} on domain {}", d.address, args.domain);
             }
             eprintln!("ros2: ready ({armed})");
         })
@@ -103,7 +103,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
     let report: Vec<DeviceJson> = devices
         .iter()
         .map(|d| DeviceJson {
-            device: format!("{:?}", d.address),
+            device: d.address.to_string(),
             namespace: d.namespace.clone(),
             counters: d.counters(),
         })

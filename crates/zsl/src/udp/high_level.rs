@@ -3,86 +3,45 @@
 use std::sync::Mutex;
 use std::time::Duration;
 
-use zsl_proto::rules::{
-    ATTITUDE_RANGES, AckCounter, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running, mode_gate_passes,
-    move_ranges,
-};
+use robowire_rt::device::Device;
+use zsl_proto::gate::{HighLevelCall, gate};
+use zsl_proto::rules::AckCounter;
 use zsl_proto::stream::{Connection, HighLevelInterface};
-use zsl_proto::udp::{Action, ControlMode, HighLevelCommand, HighLevelState, Model, ReturnCode};
+use zsl_proto::udp::{ControlMode, HighLevelCommand, HighLevelState, ReturnCode};
 use zsl_proto::zerocopy::little_endian::F32;
 
-use super::session::{ClientStats, Running, Session, client_accessors};
+use super::session::{ClientStats, Session, client_accessors};
 use super::snapshot::{BodyState, Imu, LegJoints, RobotState};
-use super::{CallError, ClientOptions, ConnectError};
+use super::{CallError, ClientOptions, ConnectError, Latched};
 
-/// When the "robot is running" check refuses a call (spec §9.1 step 4).
-#[derive(Clone, Copy)]
-enum WhileRunning {
-    Allowed,
-    RefusedInMode18Or21,
-    Refused,
-    RefusedUnlessMode21,
-}
-
-/// The calls that keep an acknowledgement counter (spec §9.1 step 7).
-#[derive(Clone, Copy)]
-enum Call {
-    StandUp,
-    LieDown,
-    Passive,
-    Move,
-    Jump,
-    FrontJump,
-    Backflip,
-    ShakeHand,
-    TwoLegStand,
-    Attitude,
-    Crawl,
-    Climb,
-}
-
-impl Call {
-    const COUNT: usize = 12;
-
-    fn checks(self) -> (bool, WhileRunning) {
-        use WhileRunning::*;
-        match self {
-            Self::StandUp | Self::LieDown => (false, RefusedInMode18Or21),
-            Self::Passive => (false, Allowed),
-            Self::ShakeHand => (false, Refused),
-            Self::Jump | Self::FrontJump | Self::Backflip => (true, Refused),
-            Self::TwoLegStand | Self::Attitude => (true, RefusedUnlessMode21),
-            Self::Move | Self::Crawl | Self::Climb => (true, Allowed),
-        }
-    }
-}
-
-/// The ZSL-1 HighLevel client (the vendor's `HighLevel`). Needs a tokio runtime with the time
-/// and I/O drivers for the receive task; the stream runs on its own thread. Both stop on drop.
+/// The ZSL-1 HighLevel client (the vendor's `HighLevel`): a stream thread sends the latched
+/// command every 2 ms, a receive thread keeps the latest state and the watchdog. No runtime
+/// needed: calls only latch a command and return. Closing (or dropping) sends the stop burst.
 ///
-/// Every motion call validates first (the vendor's checks in the vendor's order, plus NaN and
-/// infinities), then latches the command, which the stream thread sends at once. `Ok(())` is
-/// the vendor's 0, "queued": whether the robot obeys shows in [`control_mode`](Self::control_mode).
+/// Every motion call goes through the vendor's checks first (`zsl_proto::gate`: the vendor's
+/// order, plus NaN and infinities); a refused call changes nothing. A call that passes latches
+/// its command, which the stream thread sends at once: `Ok(Latched)` says so, with the vendor's
+/// return code and whether the robot already reports the mode the call asks for (whether it
+/// obeys shows in [`control_mode`](Self::control_mode)).
 ///
 /// ```no_run
-/// # async fn demo() -> Result<(), Box<dyn std::error::Error>> {
 /// use zsl::udp::{ClientOptions, HighLevel};
-/// let dog = HighLevel::connect(ClientOptions::default()).await?; // 0.0.0.0:43988 → 192.168.234.1
-/// dog.wait_connected(std::time::Duration::from_secs(3)).await;
-/// dog.stand_up().await?;
-/// dog.move_velocity(0.5, 0.0, 0.0).await?;
-/// # Ok(()) }
+/// let dog = HighLevel::open(ClientOptions::default())?; // 0.0.0.0:43988 → 192.168.234.1
+/// dog.stand_up()?;
+/// dog.move_velocity(0.5, 0.0, 0.0)?;
+/// dog.close();
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub struct HighLevel {
-    running: Running<HighLevelInterface>,
-    acks: Mutex<[AckCounter; Call::COUNT]>,
+    session: Session<HighLevelInterface>,
+    acks: Mutex<[AckCounter; HighLevelCall::ACKNOWLEDGED]>,
 }
 
 impl std::fmt::Debug for HighLevel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("HighLevel")
-            .field("local", &self.session().local_addr())
-            .field("dog", &self.session().options.dog)
+            .field("local", &self.session.local_addr())
+            .field("dog", &self.session.options.dog)
             .field("connection", &self.connection())
             .finish_non_exhaustive()
     }
@@ -94,7 +53,7 @@ macro_rules! getters {
         ///
         /// `None` before the first state and after a watchdog timeout.
         pub fn $name(&self) -> Option<$ty> {
-            self.session().read(|$s| $e)
+            self.session.read(|$s| $e)
         }
     )*};
 }
@@ -107,179 +66,116 @@ impl HighLevel {
     /// Binds `options.local` and starts streaming the idle command to `options.dog` at once
     /// (the vendor's `initRobot`). A bind failure names the address and lists this host's
     /// IPv4 addresses.
-    pub async fn connect(options: ClientOptions) -> Result<Self, ConnectError> {
-        Ok(Self { running: Running::start(options).await?, acks: Mutex::new([AckCounter::default(); Call::COUNT]) })
+    pub fn open(options: ClientOptions) -> Result<Self, ConnectError> {
+        Ok(Self {
+            session: Session::open(options, "zsl-high")?,
+            acks: Mutex::new([AckCounter::default(); HighLevelCall::ACKNOWLEDGED]),
+        })
     }
 
-    /// Stops streaming and closes the socket: when this returns, the local port can be bound
-    /// again. (Dropping the client stops it too, but its socket closes a moment later, on the
-    /// runtime's thread.)
-    pub async fn close(self) {
-        self.running.shut_down().await;
-    }
-
-    fn session(&self) -> &Session<HighLevelInterface> {
-        &self.running.session
-    }
-
-    /// The vendor's checks (spec §9.1, in its order), then latch, send, acknowledge.
-    async fn call(
-        &self,
-        call: Call,
-        command: impl FnOnce(Model) -> Result<HighLevelCommand, ArgumentError>,
-    ) -> Result<(), CallError> {
-        // Without state the vendor reads zeros (mode 0, error 0); so does robowire's rule check.
-        let state = self.session().read(|s| *s).unwrap_or_default();
-        if let Some(error) = state.error() {
-            return Err(CallError::SelfCheck(error));
-        }
-        let mode = state.mode();
-        let (gated, while_running) = call.checks();
-        if gated && !mode_gate_passes(mode) {
-            return Err(CallError::LyingDown(mode));
-        }
-        if matches!(call, Call::Move) && self.session().latched().action_code() == Action::TwoLegStand {
-            return Err(CallError::TwoLegStandActive);
-        }
-        let running = is_running(state.body_velocity[0].get(), state.body_velocity[1].get(), state.gyro[2].get());
-        let refused = match while_running {
-            WhileRunning::Allowed => false,
-            WhileRunning::RefusedInMode18Or21 => matches!(mode, ControlMode::Move | ControlMode::Action),
-            WhileRunning::Refused => true,
-            WhileRunning::RefusedUnlessMode21 => mode != ControlMode::Action,
+    /// The vendor's checks on `call` (`zsl_proto::gate`), then latch and acknowledge.
+    pub fn call(&self, call: HighLevelCall) -> Result<Latched, CallError> {
+        // Without state the vendor reads zeros (mode 0, error 0); so does the gate.
+        let state = self.session.read(|s| *s).unwrap_or_default();
+        let command = gate(call, &state, &self.session.latched(), self.session.options.model)?;
+        self.session.submit(command)?;
+        let (target, reported) = (command.control_mode(), state.mode());
+        let return_code = match call.ack_slot() {
+            Some(slot) => robowire_rt::lock(&self.acks)[slot].on_call(reported, target),
+            None => ReturnCode::Queued,
         };
-        if running && refused {
-            return Err(CallError::Running(mode));
-        }
-        if matches!(call, Call::Attitude) && state.rpy[0].get().abs() > 1.0 {
-            return Err(CallError::Unbalanced(state.rpy[0].get()));
-        }
-        let command = command(self.session().options.model)?;
-        self.session().submit(command)?;
-        let target = command.control_mode();
-        let acknowledged = self.acks.lock().map(|mut acks| acks[call as usize].on_call(mode, target));
-        match acknowledged {
-            Ok(ReturnCode::SwitchFailed) => Err(CallError::NotAcknowledged { target, reported: mode }),
-            _ => Ok(()),
-        }
-    }
-
-    fn require(&self, call: &'static str, needs: Model) -> Result<(), CallError> {
-        let model = self.session().options.model;
-        if model == needs { Ok(()) } else { Err(CallError::WrongModel { call, needs, model }) }
+        Ok(Latched { target, reported, return_code })
     }
 
     /// `standUp()`: mode 1.
-    pub async fn stand_up(&self) -> Result<(), CallError> {
-        self.call(Call::StandUp, |_| Ok(HighLevelCommand::stand_up())).await
+    pub fn stand_up(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::StandUp)
     }
 
     /// `lieDown()`: mode 51 (joints locked).
-    pub async fn lie_down(&self) -> Result<(), CallError> {
-        self.call(Call::LieDown, |_| Ok(HighLevelCommand::lie_down())).await
+    pub fn lie_down(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::LieDown)
     }
 
     /// `passive()`: mode 0 (motors damped). Refused only by a non-zero error word.
-    pub async fn passive(&self) -> Result<(), CallError> {
-        self.call(Call::Passive, |_| Ok(HighLevelCommand::passive())).await
+    pub fn passive(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Passive)
     }
 
     /// `move(vx, vy, yaw_rate)`: walk at `vx_mps` forward, `vy_mps` left, `yaw_rate_radps`.
     /// Each |value| must be 0 (within 1e-6) or in its band: vx 0.05–3.0 m/s (ZSL-1W 3.7),
     /// vy 0.1–1.0 m/s, yaw rate 0.02–3.0 rad/s (ZSL-1W 0.1–3.0). Latched until replaced:
     /// `move_velocity(0.0, 0.0, 0.0)` stops.
-    pub async fn move_velocity(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
-        self.walk(Call::Move, HighLevelCommand::move_velocity, [vx_mps, vy_mps, yaw_rate_radps]).await
-    }
-
-    /// `move`, `crawl`, `climb`: the `move` ranges of the model, then the call's datagram.
-    async fn walk(
-        &self,
-        call: Call,
-        build: fn(f32, f32, f32) -> HighLevelCommand,
-        args: [f32; 3],
-    ) -> Result<(), CallError> {
-        self.call(call, |model| {
-            let [vx, vy, wz] = check_all(&move_ranges(model), args)?;
-            Ok(build(vx, vy, wz))
-        })
-        .await
+    pub fn move_velocity(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Move { vx_mps, vy_mps, yaw_rate_radps })
     }
 
     /// `jump()`: mode 21, action 5 (sent in 6 datagrams, then cleared).
-    pub async fn jump(&self) -> Result<(), CallError> {
-        self.call(Call::Jump, |_| Ok(HighLevelCommand::jump())).await
+    pub fn jump(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Jump)
     }
 
     /// `frontJump()`: mode 21, action 6.
-    pub async fn front_jump(&self) -> Result<(), CallError> {
-        self.call(Call::FrontJump, |_| Ok(HighLevelCommand::front_jump())).await
+    pub fn front_jump(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::FrontJump)
     }
 
     /// `backflip()`: mode 21, action 2.
-    pub async fn backflip(&self) -> Result<(), CallError> {
-        self.call(Call::Backflip, |_| Ok(HighLevelCommand::backflip())).await
+    pub fn backflip(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Backflip)
     }
 
     /// `shakeHand()`: mode 1, action 11.
-    pub async fn shake_hand(&self) -> Result<(), CallError> {
-        self.call(Call::ShakeHand, |_| Ok(HighLevelCommand::shake_hand())).await
+    pub fn shake_hand(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::ShakeHand)
     }
 
     /// `twoLegStand(vx, yaw_rate)`: stand on the hind legs (sticky until cancelled) and move at
     /// |vx| 0 or 0.2–0.5 m/s, |yaw rate| 0 or 0.2–1.0 rad/s.
-    pub async fn two_leg_stand(&self, vx_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
-        self.call(Call::TwoLegStand, |_| {
-            let [vx, wz] = check_all(&TWO_LEG_STAND_RANGES, [vx_mps, yaw_rate_radps])?;
-            Ok(HighLevelCommand::two_leg_stand(vx, wz))
-        })
-        .await
+    pub fn two_leg_stand(&self, vx_mps: f32, yaw_rate_radps: f32) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::TwoLegStand { vx_mps, yaw_rate_radps })
     }
 
     /// `cancelTwoLegStand()`: mode 21, action 0, flag 0. No checks, like the vendor's.
-    pub async fn cancel_two_leg_stand(&self) -> Result<(), CallError> {
-        self.session().submit(HighLevelCommand::cancel_two_leg_stand())
+    pub fn cancel_two_leg_stand(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::CancelTwoLegStand)
     }
 
     /// `attitudeControl(roll, pitch, yaw, height)`: body attitude rates, each |v| ≤ 0.6
     /// (rad/s, rad/s, rad/s, m/s; the vendor docs say 0.5).
-    pub async fn attitude_control(
+    pub fn attitude_control(
         &self,
         roll_rate_radps: f32,
         pitch_rate_radps: f32,
         yaw_rate_radps: f32,
         height_rate_mps: f32,
-    ) -> Result<(), CallError> {
-        self.call(Call::Attitude, |_| {
-            let [r, p, y, h] =
-                check_all(&ATTITUDE_RANGES, [roll_rate_radps, pitch_rate_radps, yaw_rate_radps, height_rate_mps])?;
-            Ok(HighLevelCommand::attitude(r, p, y, h))
+    ) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Attitude {
+            roll_radps: roll_rate_radps,
+            pitch_radps: pitch_rate_radps,
+            yaw_radps: yaw_rate_radps,
+            height_mps: height_rate_mps,
         })
-        .await
     }
 
     /// ZSL-1W `crawl(vx, vy, yaw_rate)`: mode 18, action 17 (sticky); `move` ranges.
-    pub async fn crawl(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
-        self.require("crawl", Model::Zsl1W)?;
-        self.walk(Call::Crawl, HighLevelCommand::crawl, [vx_mps, vy_mps, yaw_rate_radps]).await
+    pub fn crawl(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Crawl { vx_mps, vy_mps, yaw_rate_radps })
     }
 
     /// ZSL-1W `climb(vx, vy, yaw_rate)`: mode 18, action 16 (sticky); `move` ranges.
-    pub async fn climb(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), CallError> {
-        self.require("climb", Model::Zsl1W)?;
-        self.walk(Call::Climb, HighLevelCommand::climb, [vx_mps, vy_mps, yaw_rate_radps]).await
+    pub fn climb(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::Climb { vx_mps, vy_mps, yaw_rate_radps })
     }
 
     /// ZSL-1W `cancelCrawl()`: mode 18, action 0, flag 0.
-    pub async fn cancel_crawl(&self) -> Result<(), CallError> {
-        self.require("cancel_crawl", Model::Zsl1W)?;
-        self.session().submit(HighLevelCommand::cancel_crawl_or_climb())
+    pub fn cancel_crawl(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::CancelCrawlOrClimb)
     }
 
     /// ZSL-1W `cancelClimb()`: the same datagram as `cancelCrawl()`.
-    pub async fn cancel_climb(&self) -> Result<(), CallError> {
-        self.require("cancel_climb", Model::Zsl1W)?;
-        self.session().submit(HighLevelCommand::cancel_crawl_or_climb())
+    pub fn cancel_climb(&self) -> Result<Latched, CallError> {
+        self.call(HighLevelCall::CancelCrawlOrClimb)
     }
 
     getters! {
@@ -335,15 +231,15 @@ impl HighLevel {
         joints -> LegJoints = |s| s.into();
     }
 
-    client_accessors!(HighLevelState, RobotState, HighLevelCommand);
-
-    /// Waits until the robot reports `mode`, up to `timeout`.
+    /// Waits until the robot reports `mode`, up to `timeout` (any executor).
     pub async fn wait_for_mode(&self, mode: ControlMode, timeout: Duration) -> Option<RobotState> {
-        self.wait_for_state(timeout, |s| s.body.mode == mode).await
+        self.wait_for_state(timeout, move |s| s.body.mode == mode).await
     }
 
     /// The robot raised "SDK mismatch" and the stream stopped for good.
     pub fn halted(&self) -> bool {
-        self.session().halted()
+        self.session.halted()
     }
 }
+
+client_accessors!(HighLevel, HighLevelInterface, HighLevelState, RobotState, HighLevelCommand);

@@ -22,11 +22,13 @@ mod session;
 mod snapshot;
 mod stream;
 
-pub use error::{CallError, ConnectError};
+pub use error::{CallError, ConnectError, Latched};
 pub use high_level::HighLevel;
 pub use low_level::LowLevel;
 pub use options::{ClientOptions, MIN_PERIOD};
-pub use robowire_rt::RtError;
+pub use robowire_rt::device::{Device, Stamped};
+pub use robowire_rt::{Placement, RtError};
+pub use zsl_proto::gate::{HighLevelCall, Refusal};
 pub use session::ClientStats;
 pub use snapshot::{BodyState, Imu, JointArrays, LegJoints, LowLevelState, MotorCommand, MotorState, RobotState};
 pub use zsl_proto::codec::StateDecoding;

@@ -3,7 +3,7 @@
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::time::Duration;
 
-use robowire_rt::runner::RunnerOptions;
+use robowire_rt::Placement;
 use zsl_proto::codec::StateDecoding;
 use zsl_proto::stream::{COMMAND_PERIOD, WATCHDOG_TIMEOUT};
 use zsl_proto::udp::{DEFAULT_LOCAL_PORT, HIGH_LEVEL_PORT, LOW_LEVEL_PORT, Model};
@@ -20,18 +20,16 @@ pub struct ClientOptions {
     pub dog: SocketAddr,
     /// Model: ZSL-1 commands carry magic `0x5AA5`, ZSL-1W `0x5AA6`.
     pub model: Model,
-    /// How state is decoded. Default lenient, like the vendor (see [`StateDecoding`]).
+    /// How state is decoded (see [`StateDecoding`]). HighLevel: lenient by default, as the
+    /// vendor's HighLevel client merges short states; LowLevel: strict (a motor command must
+    /// never be computed from half a state).
     pub state_decoding: StateDecoding,
     /// Command period. Default 2 ms (the vendor's cadence).
     pub period: Duration,
     /// Silence after which the connection is lost. Default 3 s (the vendor's).
     pub watchdog: Duration,
-    /// `SCHED_FIFO` priority 1..=99 for the stream thread; `None` keeps normal scheduling.
-    pub realtime_priority: Option<u8>,
-    /// CPU to pin the stream thread to; `None` does not pin.
-    pub cpu_affinity: Option<usize>,
-    /// Lock the process's memory (`mlockall`) when the stream starts.
-    pub lock_memory: bool,
+    /// Where the stream thread runs (priority, CPU, memory lock). Default: normal scheduling.
+    pub placement: Placement,
     /// Hand every datagram sent and received to a recorder (`robowire-record`). Default `None`.
     pub tap: Option<robowire_tap::Tap>,
 }
@@ -43,29 +41,27 @@ impl ClientOptions {
     /// The robot's address on its own network.
     pub const DEFAULT_DOG_IP: Ipv4Addr = Ipv4Addr::new(192, 168, 234, 1);
 
-    fn new(local_ip: IpAddr, local_port: u16, dog_ip: IpAddr, dog_port: u16) -> Self {
+    fn new(local_ip: IpAddr, local_port: u16, dog_ip: IpAddr, dog_port: u16, state_decoding: StateDecoding) -> Self {
         Self {
             local: SocketAddr::new(local_ip, local_port),
             dog: SocketAddr::new(dog_ip, dog_port),
             model: Model::Zsl1,
-            state_decoding: StateDecoding::Lenient,
+            state_decoding,
             period: COMMAND_PERIOD,
             watchdog: WATCHDOG_TIMEOUT,
-            realtime_priority: None,
-            cpu_affinity: None,
-            lock_memory: false,
+            placement: Placement::default(),
             tap: None,
         }
     }
 
-    /// HighLevel: commands to `dog_ip:43997`.
+    /// HighLevel: commands to `dog_ip:43997`; state decoded leniently, like the vendor.
     pub fn high_level(local_ip: IpAddr, local_port: u16, dog_ip: IpAddr) -> Self {
-        Self::new(local_ip, local_port, dog_ip, HIGH_LEVEL_PORT)
+        Self::new(local_ip, local_port, dog_ip, HIGH_LEVEL_PORT, StateDecoding::Lenient)
     }
 
-    /// LowLevel: commands to `dog_ip:43900`.
+    /// LowLevel: commands to `dog_ip:43900`; state decoded strictly.
     pub fn low_level(local_ip: IpAddr, local_port: u16, dog_ip: IpAddr) -> Self {
-        Self::new(local_ip, local_port, dog_ip, LOW_LEVEL_PORT)
+        Self::new(local_ip, local_port, dog_ip, LOW_LEVEL_PORT, StateDecoding::Strict)
     }
 
     /// The same options, every datagram handed to `tap`.
@@ -94,8 +90,7 @@ impl ClientOptions {
 
     /// Runs the stream thread `SCHED_FIFO` at `priority` (1..=99), pinned to `cpu` if given.
     pub fn with_realtime(mut self, priority: u8, cpu: Option<usize>) -> Self {
-        self.realtime_priority = Some(priority);
-        self.cpu_affinity = cpu;
+        self.placement = Placement::realtime(priority, cpu);
         self
     }
 
@@ -107,21 +102,8 @@ impl ClientOptions {
         if self.watchdog <= self.period {
             return bad("watchdog", format!("{:?} is not longer than the period {:?}", self.watchdog, self.period));
         }
-        if let Some(priority) = self.realtime_priority
-            && !(1..=99).contains(&priority)
-        {
-            return bad("realtime_priority", format!("{priority} is outside SCHED_FIFO's 1..=99"));
-        }
+        self.placement.validate()?;
         Ok(())
-    }
-
-    pub(super) fn runner_options(&self) -> RunnerOptions {
-        RunnerOptions {
-            realtime_priority: self.realtime_priority,
-            cpu: self.cpu_affinity,
-            lock_memory: self.lock_memory,
-            ..RunnerOptions::named("zsl-stream")
-        }
     }
 }
 

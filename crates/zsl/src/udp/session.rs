@@ -1,11 +1,11 @@
-//! The session with the robot that HighLevel and LowLevel share, on two threads of control.
+//! The session with the robot that HighLevel and LowLevel share, on two threads.
 //!
 //! - The **stream thread** (robowire's runner) owns `zsl-proto`'s sans-IO [`CommandStream`]:
 //!   it sends the latched command the moment a call changes it and every 2 ms on absolute
 //!   deadlines ([`stream`](super::stream)).
-//! - The **receive task** (tokio) decodes state, feeds `zsl-proto`'s [`Watchdog`], publishes
-//!   state and connection events to the user, and tells the stream about states and
-//!   disconnects.
+//! - The **receive thread** (robowire-rt's one receive-with-watchdog loop) decodes state, feeds
+//!   the watchdog, publishes stamped states and connection events, and tells the stream about
+//!   states and disconnects.
 //!
 //! Nothing the stream thread reads is behind a lock another thread holds: calls and states
 //! reach it through seqlocks ([`Latest`]), disconnects through an atomic, and what it sent
@@ -14,17 +14,15 @@
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
-use std::time::Duration;
 
 use robowire_core::timing::LatenessSummary;
-use robowire_rt::runner::{Runner, Waker};
-use robowire_rt::stats::{Counter, SharedLateness, micros};
+use robowire_rt::device::{Receive, Received, Receiving, Stamped};
+use robowire_rt::runner::{Runner, RunnerOptions, Waker};
+use robowire_rt::stats::{Counter, SharedLateness};
 use robowire_rt::{Latest, Time};
 use robowire_udp::{LinkStats, Peer, StatsHandle, UdpError, UdpLink, UdpReceiver};
-use tokio::sync::watch;
-use tokio::task::JoinHandle;
 use zsl_proto::codec::{ClientCodec, StateReceived};
-use zsl_proto::stream::{CommandStream, Connection, Event, Interface, Watchdog};
+use zsl_proto::stream::{CommandStream, Connection, Interface, Watchdog};
 use zsl_proto::zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use super::stream::{Input, StreamJob, in_order};
@@ -33,23 +31,24 @@ use super::{CallError, ClientOptions, ConnectError};
 /// An [`Interface`] whose datagrams can cross threads through a seqlock.
 pub(super) trait Wire:
     Interface<
-        Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
-        State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+        Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send,
+        State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send + Sync,
         Memory: Send,
         Observed: Send,
     > + Send
+    + Sync
     + 'static
 {
 }
 
 impl<I> Wire for I where
     I: Interface<
-            Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
-            State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug,
+            Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send,
+            State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send + Sync,
             Memory: Send,
             Observed: Send,
-            Observed: Send,
         > + Send
+        + Sync
         + 'static
 {
 }
@@ -86,11 +85,11 @@ pub struct ClientStats {
     pub state_gap: LatenessSummary,
 }
 
-/// What the stream thread reads and writes; every field lock-free for it.
-pub(super) struct StreamShared<I: Interface> {
+/// What the stream thread, the receive thread and the caller share; every field lock-free.
+pub(super) struct Shared<I: Interface> {
     /// The latest call's command (calls write, the stream takes).
     pub(super) calls: Latest<I::Command>,
-    /// The latest state, for the per-datagram rules (the receive task writes).
+    /// The latest state, for the per-datagram rules (the receive thread writes).
     pub(super) states: Latest<I::State>,
     /// When the watchdog last expired, ns on the monotonic clock (0: never).
     pub(super) disconnected_at: AtomicU64,
@@ -98,114 +97,137 @@ pub(super) struct StreamShared<I: Interface> {
     pub(super) streamed: Latest<I::Command>,
     /// The robot's SDK-mismatch flag stopped the stream for good.
     pub(super) halted: AtomicBool,
+    /// Wakes the stream thread when a call or a disconnect arrives (set once the thread runs).
+    pub(super) waker: OnceLock<Waker>,
     pub(super) lateness: SharedLateness<4096>,
     pub(super) calls_sent: Counter,
     pub(super) refreshes_sent: Counter,
     pub(super) missed_ticks: Counter,
-}
-
-/// What the receive task counts.
-#[derive(Debug, Default)]
-struct StateCounters {
-    states: Counter,
+    accepted: Counter,
     short_states: Counter,
     header_anomalies: Counter,
-    disconnects: Counter,
-    reconnects: Counter,
-    gaps: SharedLateness<1024>,
 }
 
-pub(super) struct Session<I: Interface> {
-    pub(super) stream: StreamShared<I>,
-    /// Wakes the stream thread when a call arrives (set once the thread runs).
-    waker: OnceLock<Waker>,
-    state: watch::Sender<Option<I::State>>,
-    connection: watch::Sender<Connection>,
-    counters: StateCounters,
+impl<I: Wire> Shared<I> {
+    fn new() -> Self {
+        Self {
+            calls: Latest::new(),
+            states: Latest::new(),
+            disconnected_at: AtomicU64::new(0),
+            streamed: Latest::new(),
+            halted: AtomicBool::new(false),
+            waker: OnceLock::new(),
+            lateness: SharedLateness::new(),
+            calls_sent: Counter::default(),
+            refreshes_sent: Counter::default(),
+            missed_ticks: Counter::default(),
+            accepted: Counter::default(),
+            short_states: Counter::default(),
+            header_anomalies: Counter::default(),
+        }
+    }
+
+    fn wake(&self) {
+        if let Some(waker) = self.waker.get() {
+            waker.wake();
+        }
+    }
+}
+
+/// The receive side of the link, as robowire-rt's receive loop drives it (spec decisions 2, 3,
+/// 6): accepted states feed the watchdog, the stream's per-datagram rules and the user; a
+/// timeout stops the latched motion.
+struct StateLink<I: Wire> {
+    receiver: UdpReceiver<Codec<I>>,
+    shared: Arc<Shared<I>>,
+}
+
+impl<I: Wire> Receive for StateLink<I> {
+    type Item = StateReceived<I::State>;
+    type State = I::State;
+
+    async fn receive(&mut self) -> Received<Self::Item> {
+        match self.receiver.recv().await {
+            Ok(received) => Received::Item(received),
+            // Counted by the link; a datagram that does not decode does not feed the watchdog.
+            Err(UdpError::Decode(_)) => Received::Rejected,
+            // A socket error (counted by the link): back off instead of spinning on it.
+            Err(_) => Received::Failed,
+        }
+    }
+
+    fn on_item(&mut self, now: Time, received: Self::Item) -> Option<I::State> {
+        let shared = &self.shared;
+        shared.accepted.add(1);
+        if received.update.short {
+            shared.short_states.add(1);
+        }
+        // A 0-byte datagram only feeds the watchdog: zeros never pose as a state.
+        if received.update.len == 0 {
+            return None;
+        }
+        if !received.update.header_ok {
+            shared.header_anomalies.add(1);
+        }
+        shared.states.write(now, &received.state);
+        Some(received.state)
+    }
+
+    /// The stream stops the latched motion; the decoder forgets the last state.
+    fn on_disconnected(&mut self, now: Time) {
+        self.receiver.codec_mut().reset();
+        self.shared.disconnected_at.store(now.as_nanos(), Ordering::Release);
+        self.shared.wake();
+    }
+}
+
+/// A running session: the receive thread, the stream thread and what they share. Dropping it
+/// stops both after the stop burst (the latched motion stopped, sent three times).
+pub(super) struct Session<I: Wire> {
+    shared: Arc<Shared<I>>,
+    receiving: Receiving<I::State>,
+    stream: Option<Runner<StreamJob<I>>>,
     link: StatsHandle,
     local: SocketAddr,
     pub(super) options: ClientOptions,
 }
 
-/// A running session: the shared state, the stream thread and the receive task, both stopped
-/// on drop.
-pub(super) struct Running<I: Wire> {
-    pub(super) session: Arc<Session<I>>,
-    stream: Option<Runner<StreamJob<I>>>,
-    receive: JoinHandle<()>,
-}
-
-impl<I: Wire> Drop for Running<I> {
-    fn drop(&mut self) {
-        self.receive.abort();
-        if let Some(stream) = self.stream.take() {
-            stream.stop();
-        }
-    }
-}
-
-impl<I: Wire> Running<I> {
-    /// Stops the receive task and the stream and waits until both have let go of the socket.
-    pub(super) async fn shut_down(mut self) {
-        self.receive.abort();
-        let _ = (&mut self.receive).await;
-        if let Some(stream) = self.stream.take() {
-            drop(stream.stop());
-        }
-    }
-
-    /// Binds, starts the stream (idle command at once, like the vendor) and the receive task.
-    pub(super) async fn start(options: ClientOptions) -> Result<Self, ConnectError> {
-        options.validate()?;
-        let codec = Codec::<I>::new(options.model, options.state_decoding);
-        // The robot's sending port is not documented (spec §2): accept state from any port of its
-        // IP, nothing from anyone else.
-        let mut link = UdpLink::bind(options.local, Peer::AnyPortOf(options.dog), codec).await?;
-        link.set_tap(options.tap.clone());
-        let local = link.local_addr().map_err(UdpError::from)?;
-        let stats = link.stats_handle();
-        let (sender, receiver) = link.into_split();
-        let session = Arc::new(Session {
-            stream: StreamShared {
-                calls: Latest::new(),
-                states: Latest::new(),
-                disconnected_at: AtomicU64::new(0),
-                streamed: Latest::new(),
-                halted: AtomicBool::new(false),
-                lateness: SharedLateness::new(),
-                calls_sent: Counter::default(),
-                refreshes_sent: Counter::default(),
-                missed_ticks: Counter::default(),
-            },
-            waker: OnceLock::new(),
-            state: watch::Sender::new(None),
-            connection: watch::Sender::new(Connection::Waiting),
-            counters: StateCounters::default(),
-            link: stats,
-            local,
-            options,
-        });
-        let now = robowire_rt::now();
-        let watchdog = Watchdog::new(now, session.options.watchdog);
-        let job = StreamJob::new(CommandStream::new(now, session.options.period), sender, session.clone());
-        let stream = Runner::spawn(session.options.runner_options(), job)?;
-        let _ = session.waker.set(stream.waker());
-        let receive = tokio::spawn(receive(session.clone(), receiver, watchdog));
-        Ok(Self { session, stream: Some(stream), receive })
-    }
-}
-
 impl<I: Wire> Session<I> {
-    /// Latches `command`; the stream thread sends it at once. `Ok` means queued (the vendor's
-    /// 0); a failed send is counted in the link's statistics and retried by the refresh.
+    /// Binds, starts the receive thread and the stream (idle command at once, like the vendor).
+    pub(super) fn open(options: ClientOptions, name: &str) -> Result<Self, ConnectError> {
+        options.validate()?;
+        let shared = Arc::new(Shared::<I>::new());
+        let now = robowire_rt::now();
+        let watchdog = Watchdog::new(now, options.watchdog);
+        let (receiving, (sender, local, link)) = Receiving::spawn(&format!("{name}-receive"), watchdog, {
+            let (options, shared) = (options.clone(), shared.clone());
+            move || async move {
+                let codec = Codec::<I>::new(options.model, options.state_decoding);
+                // The robot's sending port is not documented (spec §2): accept state from any port
+                // of its IP, nothing from anyone else.
+                let mut link = UdpLink::bind(options.local, Peer::AnyPortOf(options.dog), codec).await?;
+                link.set_tap(options.tap.clone());
+                let local = link.local_addr().map_err(UdpError::from)?;
+                let stats = link.stats_handle();
+                let (sender, receiver) = link.into_split();
+                Ok::<_, ConnectError>((StateLink { receiver, shared }, (sender, local, stats)))
+            }
+        })?;
+        let job = StreamJob::new(CommandStream::new(now, options.period), sender, shared.clone());
+        let stream = Runner::spawn(RunnerOptions::placed(format!("{name}-stream"), options.placement), job)?;
+        let _ = shared.waker.set(stream.waker());
+        Ok(Self { shared, receiving, stream: Some(stream), link, local, options })
+    }
+
+
+    /// Latches `command`; the stream thread sends it at once. A failed send is counted in the
+    /// link's statistics and retried by the refresh.
     pub(super) fn submit(&self, command: I::Command) -> Result<(), CallError> {
         if self.halted() {
             return Err(CallError::SdkMismatch);
         }
-        self.stream.calls.write(robowire_rt::now(), &command);
-        if let Some(waker) = self.waker.get() {
-            waker.wake();
-        }
+        self.shared.calls.write(robowire_rt::now(), &command);
+        self.shared.wake();
         Ok(())
     }
 
@@ -213,7 +235,7 @@ impl<I: Wire> Session<I> {
     /// taken yet applied (a call latches, a disconnect stops the motion): what goes out next,
     /// the per-datagram rules aside.
     pub(super) fn latched(&self) -> I::Command {
-        let shared = &self.stream;
+        let shared = &self.shared;
         let (sent_at, mut latched) = shared.streamed.read().unwrap_or((Time::ZERO, I::Command::default()));
         let call = shared.calls.read().filter(|(at, _)| *at > sent_at);
         let disconnected_at = Time::from_nanos(shared.disconnected_at.load(Ordering::Acquire));
@@ -229,15 +251,11 @@ impl<I: Wire> Session<I> {
 
     /// Whether the stream halted on the robot's SDK-mismatch flag.
     pub(super) fn halted(&self) -> bool {
-        self.stream.halted.load(Ordering::Acquire)
+        self.shared.halted.load(Ordering::Acquire)
     }
 
-    pub(super) fn connection(&self) -> Connection {
-        *self.connection.borrow()
-    }
-
-    pub(super) fn connection_events(&self) -> watch::Receiver<Connection> {
-        self.connection.subscribe()
+    pub(super) fn receiving(&self) -> &Receiving<I::State> {
+        &self.receiving
     }
 
     pub(super) fn local_addr(&self) -> SocketAddr {
@@ -245,188 +263,128 @@ impl<I: Wire> Session<I> {
     }
 
     pub(super) fn stats(&self) -> ClientStats {
-        let (c, s) = (&self.counters, &self.stream);
+        let s = &self.shared;
+        let feed = self.receiving.stats();
         ClientStats {
             link: self.link.get(),
             calls_sent: s.calls_sent.get(),
             refreshes_sent: s.refreshes_sent.get(),
             missed_ticks: s.missed_ticks.get(),
-            states: c.states.get(),
-            short_states: c.short_states.get(),
-            header_anomalies: c.header_anomalies.get(),
-            disconnects: c.disconnects.get(),
-            reconnects: c.reconnects.get(),
+            states: s.accepted.get(),
+            short_states: s.short_states.get(),
+            header_anomalies: s.header_anomalies.get(),
+            disconnects: feed.disconnects,
+            reconnects: feed.reconnects,
             stream_lateness: s.lateness.summary(),
-            state_gap: c.gaps.summary(),
+            state_gap: feed.state_gap,
         }
     }
 
-    /// The state, or `None` before the first state and after a timeout.
+    /// The latest state while connected: `None` before the first state and after a watchdog
+    /// timeout (until state returns).
     pub(super) fn read<T>(&self, f: impl FnOnce(&I::State) -> T) -> Option<T> {
-        self.state.borrow().as_ref().map(f)
+        if self.receiving.connection() != Connection::Connected {
+            return None;
+        }
+        self.receiving.latest().map(|s: Stamped<I::State>| f(&s.state))
     }
+}
 
-    /// Waits until a state satisfies `accept`, up to `timeout`.
-    pub(super) fn state_updates(&self) -> watch::Receiver<Option<I::State>> {
-        self.state.subscribe()
-    }
-
-    pub(super) async fn wait_for(&self, timeout: Duration, accept: impl Fn(&I::State) -> bool) -> Option<I::State> {
-        let mut rx = self.state.subscribe();
-        let wait = rx.wait_for(|s| s.as_ref().is_some_and(&accept));
-        match tokio::time::timeout(timeout, wait).await {
-            Ok(Ok(state)) => *state,
-            _ => None,
+/// The stop burst from the stream's last command; then the receive thread ends as the
+/// `Receiving` field drops, and with it the last half of the socket.
+impl<I: Wire> Drop for Session<I> {
+    fn drop(&mut self) {
+        if let Some(stream) = self.stream.take()
+            && let Some(mut job) = stream.stop()
+        {
+            job.send_stop_burst();
         }
     }
 }
 
-/// The tokio instant of a monotonic-clock time.
-fn tokio_instant(at: Time) -> tokio::time::Instant {
-    tokio::time::Instant::now() + at.saturating_duration_since(robowire_rt::now())
-}
-
-/// Receives state and runs the watchdog (spec decisions 2, 3, 6).
-async fn receive<I: Wire>(session: Arc<Session<I>>, mut receiver: UdpReceiver<Codec<I>>, mut watchdog: Watchdog) {
-    let mut last_state: Option<Time> = None;
-    loop {
-        let expires = watchdog.poll_timeout();
-        let timeout = async {
-            match expires {
-                Some(at) => tokio::time::sleep_until(tokio_instant(at)).await,
-                None => std::future::pending().await,
-            }
-        };
-        tokio::select! {
-            received = receiver.recv() => match received {
-                Ok(received) => {
-                    let now = robowire_rt::now();
-                    let event = watchdog.feed(now);
-                    if let Some(last) = last_state.replace(now) {
-                        session.counters.gaps.record(micros(now.saturating_duration_since(last)));
-                    }
-                    // The connection first: whoever wakes on the state sees it connected.
-                    if event.is_some() {
-                        on_connected(&session, &watchdog);
-                    }
-                    on_state(&session, &received, now);
-                }
-                // Counted by the link; a datagram that does not decode does not feed the watchdog.
-                Err(UdpError::Decode(_)) => {}
-                // A socket error (counted by the link as a receive error): back off briefly
-                // instead of spinning on a broken socket.
-                Err(_) => tokio::time::sleep(RECEIVE_ERROR_BACKOFF).await,
-            },
-            () = timeout => {
-                let now = robowire_rt::now();
-                if watchdog.poll_event(now) == Some(Event::Disconnected) {
-                    receiver.codec_mut().reset();
-                    on_disconnected(&session, &watchdog, now);
-                }
-            }
-        }
-    }
-}
-
-fn on_state<I: Wire>(session: &Session<I>, received: &StateReceived<I::State>, now: Time) {
-    let c = &session.counters;
-    c.states.add(1);
-    if received.update.short {
-        c.short_states.add(1);
-    }
-    if received.update.len > 0 {
-        if !received.update.header_ok {
-            c.header_anomalies.add(1);
-        }
-        // A 0-byte datagram only feeds the watchdog: zeros never pose as a state.
-        session.stream.states.write(now, &received.state);
-        session.state.send_replace(Some(received.state));
-    }
-}
-
-fn on_connected<I: Wire>(session: &Session<I>, watchdog: &Watchdog) {
-    session.counters.reconnects.set(watchdog.counters().reconnects);
-    session.connection.send_replace(watchdog.connection());
-}
-
-/// The watchdog expired: the stream stops the latched motion, the user sees no state.
-fn on_disconnected<I: Wire>(session: &Session<I>, watchdog: &Watchdog, now: Time) {
-    session.stream.disconnected_at.store(now.as_nanos(), Ordering::Release);
-    if let Some(waker) = session.waker.get() {
-        waker.wake();
-    }
-    session.counters.disconnects.set(watchdog.counters().disconnects);
-    session.state.send_replace(None);
-    session.connection.send_replace(Connection::Disconnected);
-}
-
-/// After a socket error on receive, wait this long before the next receive.
-const RECEIVE_ERROR_BACKOFF: Duration = Duration::from_millis(10);
-
-/// The accessors HighLevel and LowLevel share, over `self.session()`.
+/// The accessors and the device shape HighLevel and LowLevel share, over `self.session`.
 macro_rules! client_accessors {
-    ($wire_state:ty, $state:ty, $wire_command:ty) => {
-        /// The state, typed (`None` before the first state and after a watchdog timeout).
-        pub fn state(&self) -> Option<$state> {
-            self.session().read(|s| s.into())
+    ($client:ty, $interface:ty, $wire_state:ty, $state:ty, $wire_command:ty) => {
+        impl $client {
+            /// The state, typed (`None` before the first state and after a watchdog timeout).
+            pub fn state(&self) -> Option<$state> {
+                self.session.read(|s| s.into())
+            }
+
+            /// The state datagram as received, in the vendor's layout (`zsl_proto::udp`), for
+            /// logging and inspection (`None` before the first state and after a timeout).
+            pub fn wire_state(&self) -> Option<$wire_state> {
+                self.session.read(|s| *s)
+            }
+
+            /// `checkConnect()`: state arrived within the watchdog timeout.
+            pub fn check_connection(&self) -> bool {
+                self.connection() == Connection::Connected
+            }
+
+            /// Waits until a state satisfies `accept`, up to `timeout` (any executor).
+            pub async fn wait_for_state(
+                &self,
+                timeout: std::time::Duration,
+                accept: impl Fn(&$state) -> bool + Send + Sync + 'static,
+            ) -> Option<$state> {
+                let state = self.session.receiving().wait_for(timeout, move |s| accept(&s.into())).await?;
+                Some((&state.state).into())
+            }
+
+            /// Every state datagram from now on, in order, stamped with its arrival (for a
+            /// reader that must see each one; [`Device::states`] coalesces).
+            pub fn every_state(&self) -> tokio::sync::broadcast::Receiver<robowire_rt::device::Stamped<$wire_state>> {
+                self.session.receiving().every_state()
+            }
+
+            /// Waits for state, up to `timeout`; whether the client is connected.
+            pub async fn wait_connected(&self, timeout: std::time::Duration) -> bool {
+                self.session.receiving().wait_for(timeout, |_| true).await.is_some()
+            }
+
+            /// The command datagram being streamed, in the vendor's layout (`zsl_proto::udp`): the
+            /// last one sent, or a call's that goes out next.
+            pub fn wire_command(&self) -> $wire_command {
+                self.session.latched()
+            }
+
+            /// The bound local address.
+            pub fn local_addr(&self) -> std::net::SocketAddr {
+                self.session.local_addr()
+            }
+
+            /// The options in force.
+            pub fn options(&self) -> &ClientOptions {
+                &self.session.options
+            }
+
+            /// Sends the stop burst (the latched motion stopped), ends both threads and closes the
+            /// socket: when this returns, the local port can be bound again. Dropping the client
+            /// does the same.
+            pub fn close(self) {
+                drop(self);
+            }
         }
 
-        /// The state datagram as received, in the vendor's layout (`zsl_proto::udp`), for
-        /// logging and inspection (`None` before the first state and after a timeout).
-        pub fn wire_state(&self) -> Option<$wire_state> {
-            self.session().read(|s| *s)
-        }
+        impl Device for $client {
+            type State = $wire_state;
+            type Stats = ClientStats;
+            type Error = std::convert::Infallible;
 
-        /// `checkConnect()`: state arrived within the watchdog timeout.
-        pub fn check_connection(&self) -> bool {
-            self.connection() == Connection::Connected
-        }
+            fn receiving(&self) -> &robowire_rt::device::Receiving<$wire_state> {
+                self.session.receiving()
+            }
 
-        /// The connection now.
-        pub fn connection(&self) -> Connection {
-            self.session().connection()
-        }
+            /// Counters: link, calls and refreshes, state anomalies, disconnects, stream lateness.
+            fn stats(&self) -> ClientStats {
+                self.session.stats()
+            }
 
-        /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
-        pub fn connection_events(&self) -> tokio::sync::watch::Receiver<Connection> {
-            self.session().connection_events()
-        }
-
-        /// Waits until a state satisfies `accept`, up to `timeout`.
-        pub async fn wait_for_state(
-            &self,
-            timeout: std::time::Duration,
-            accept: impl Fn(&$state) -> bool,
-        ) -> Option<$state> {
-            let state = self.session().wait_for(timeout, |s| accept(&s.into())).await?;
-            Some((&state).into())
-        }
-
-        /// Every state as it arrives: `changed()` resolves at each state datagram (and with
-        /// `None` at a watchdog timeout); read it with `borrow_and_update()`.
-        pub fn state_updates(&self) -> tokio::sync::watch::Receiver<Option<$wire_state>> {
-            self.session().state_updates()
-        }
-
-        /// Waits for state, up to `timeout`; whether the client is connected.
-        pub async fn wait_connected(&self, timeout: std::time::Duration) -> bool {
-            self.session().wait_for(timeout, |_| true).await.is_some()
-        }
-
-        /// The command datagram being streamed, in the vendor's layout (`zsl_proto::udp`): the
-        /// last one sent, or a call's that goes out next.
-        pub fn wire_command(&self) -> $wire_command {
-            self.session().latched()
-        }
-
-        /// Counters: link, calls and refreshes, state anomalies, disconnects, stream lateness.
-        pub fn stats(&self) -> ClientStats {
-            self.session().stats()
-        }
-
-        /// The bound local address.
-        pub fn local_addr(&self) -> std::net::SocketAddr {
-            self.session().local_addr()
+            fn close(self) -> Result<(), std::convert::Infallible> {
+                drop(self);
+                Ok(())
+            }
         }
     };
 }

@@ -12,12 +12,15 @@ use robowire_rt::stats::micros;
 use robowire_udp::UdpSender;
 use zsl_proto::stream::{Cause, CommandStream};
 
-use super::session::{Codec, Session, Wire};
+use super::session::{Codec, Shared, Wire};
+
+/// Datagrams of the stop burst sent when a client closes.
+pub(super) const STOP_BURST: usize = 3;
 
 pub(super) struct StreamJob<I: Wire> {
     stream: CommandStream<I>,
     sender: UdpSender<Codec<I>>,
-    session: Arc<Session<I>>,
+    shared: Arc<Shared<I>>,
     /// Stamps of the inputs already taken.
     call_seen: Option<Time>,
     state_seen: Option<Time>,
@@ -41,8 +44,21 @@ pub(super) fn in_order<C>(call: Option<(Time, C)>, disconnect: Option<Time>) -> 
 }
 
 impl<I: Wire> StreamJob<I> {
-    pub(super) fn new(stream: CommandStream<I>, sender: UdpSender<Codec<I>>, session: Arc<Session<I>>) -> Self {
-        Self { stream, sender, session, call_seen: None, state_seen: None, disconnect_seen: 0 }
+    pub(super) fn new(stream: CommandStream<I>, sender: UdpSender<Codec<I>>, shared: Arc<Shared<I>>) -> Self {
+        Self { stream, sender, shared, call_seen: None, state_seen: None, disconnect_seen: 0 }
+    }
+
+    /// The client's last word: the latched command with its motion stopped, [`STOP_BURST`] times
+    /// (unless the robot halted the stream). Failed sends are counted by the link.
+    pub(super) fn send_stop_burst(&mut self) {
+        if self.stream.is_halted() {
+            return;
+        }
+        let mut stop = *self.stream.latched();
+        I::stop_motion(&mut stop);
+        for _ in 0..STOP_BURST {
+            let _ = self.sender.send_now(&stop);
+        }
     }
 
     /// Takes what the other threads handed over since the last run; returns when (anything
@@ -50,7 +66,7 @@ impl<I: Wire> StreamJob<I> {
     /// is ignored.
     fn take_inputs(&mut self) -> Time {
         let taken_at = robowire_rt::now();
-        let shared = &self.session.stream;
+        let shared = &self.shared;
         let call = shared.calls.read_newer(self.call_seen);
         if let Some((at, _)) = call {
             self.call_seen = Some(at);
@@ -82,7 +98,7 @@ impl<I: Wire> Job for StreamJob<I> {
 
     fn run(&mut self, now: Time) {
         let taken_at = self.take_inputs();
-        let shared = &self.session.stream;
+        let shared = &self.shared;
         while let Some(transmit) = self.stream.poll_transmit(now) {
             // A failed send is counted by the link; the next refresh sends again.
             let _ = self.sender.send_now(&transmit.command);

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use robowire_sim::dog::{DogFault, DogSim, DogSimConfig, STANDING_HEIGHT_M};
-use zsl::udp::{Action, CallError, ClientOptions, Connection, ControlMode, HighLevel, ReturnCode};
+use zsl::udp::{Action, CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, ReturnCode};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
@@ -21,8 +21,9 @@ const TICK: Duration = Duration::from_millis(20);
 struct Calls(Vec<(String, u32)>);
 
 impl Calls {
-    fn record(&mut self, name: &str, result: &Result<(), CallError>) {
-        self.0.push((name.to_string(), result.as_ref().map_or_else(|e| e.return_code().raw(), |()| 0)));
+    fn record(&mut self, name: &str, result: &Result<Latched, CallError>) {
+        let code = result.as_ref().map_or_else(|e| e.return_code(), |latched| latched.return_code);
+        self.0.push((name.to_string(), code.raw()));
     }
 }
 
@@ -36,7 +37,7 @@ fn banded(v: f32, min: f32, max: f32) -> f32 {
 }
 
 async fn settle(dog: &HighLevel) -> bool {
-    dog.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0].abs() < 0.03 && s.body.imu.gyro_radps[2].abs() < 0.03)
+    dog.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0].abs() < 0.03 && s.body.imu.gyro_radps[2].abs() < 0.03)
         .await
         .is_some()
 }
@@ -56,16 +57,17 @@ async fn walk(dog: &HighLevel, distance_m: f32, calls: &mut Calls) -> anyhow::Re
         if vx == 0.0 && speed.abs() < 0.03 {
             break;
         }
-        let result = dog.move_velocity(vx, 0.0, 0.0).await;
+        let result = dog.move_velocity(vx, 0.0, 0.0);
         if result.is_err() {
             calls.record("move", &result);
             result?;
         }
         tokio::time::sleep(TICK).await;
     }
-    let result = dog.move_velocity(0.0, 0.0, 0.0).await;
+    let result = dog.move_velocity(0.0, 0.0, 0.0);
     calls.record("move(0, 0, 0)", &result);
-    Ok(result?)
+    result?;
+    Ok(())
 }
 
 /// Turns to `heading_rad`, closed loop on the reported yaw and yaw rate.
@@ -78,14 +80,15 @@ async fn turn_to(dog: &HighLevel, heading_rad: f32) -> anyhow::Result<()> {
         if wz == 0.0 && s.body.imu.gyro_radps[2].abs() < 0.03 {
             break;
         }
-        dog.move_velocity(0.0, 0.0, wz).await?;
+        dog.move_velocity(0.0, 0.0, wz)?;
         tokio::time::sleep(TICK).await;
     }
-    Ok(dog.move_velocity(0.0, 0.0, 0.0).await?)
+    dog.move_velocity(0.0, 0.0, 0.0)?;
+    Ok(())
 }
 
 async fn stand(dog: &HighLevel, calls: &mut Calls, name: &str) -> anyhow::Result<bool> {
-    let result = dog.stand_up().await;
+    let result = dog.stand_up();
     calls.record(name, &result);
     result?;
     let up =
@@ -126,7 +129,7 @@ async fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
         ..ClientOptions::high_level(Ipv4Addr::LOCALHOST.into(), 0, Ipv4Addr::LOCALHOST.into())
     }
     .with_watchdog(watchdog);
-    let dog = HighLevel::connect(options).await?;
+    let dog = HighLevel::open(options)?;
     out.line(format_args!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr()));
     tokio::select! {
         report = steps(&sim, &dog, watchdog, duration_s, out) => report,
@@ -199,15 +202,15 @@ async fn steps(
     report.observed.push(format!("back within {:.0} mm", closure_m * 1e3));
 
     // Attitude: roll one way for 0.4 s, back, zero rates.
-    let result = dog.attitude_control(0.5, 0.0, 0.0, 0.0).await;
+    let result = dog.attitude_control(0.5, 0.0, 0.0, 0.0);
     calls.record("attitude_control(0.5, 0, 0, 0)", &result);
     tokio::time::sleep(Duration::from_millis(400)).await;
     let rolled = dog.rpy().map_or(0.0, |r| r[0]);
-    let result_back = dog.attitude_control(-0.5, 0.0, 0.0, 0.0).await;
+    let result_back = dog.attitude_control(-0.5, 0.0, 0.0, 0.0);
     calls.record("attitude_control(-0.5, 0, 0, 0)", &result_back);
     tokio::time::sleep(Duration::from_millis(400)).await;
     let back = dog.rpy().map_or(1.0, |r| r[0]);
-    let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0).await;
+    let zero = dog.attitude_control(0.0, 0.0, 0.0, 0.0);
     calls.record("attitude_control(0, 0, 0, 0)", &zero);
     out.line(format_args!(
         "  attitude roll +0.5 rad/s for 0.4 s -> {rolled:+.2} rad, back -> {back:+.2} rad {}",
@@ -223,10 +226,10 @@ async fn steps(
 
     // A trick: jump, back to standing.
     let tricks_before = sim.snapshot().dog.tricks_done();
-    let result = dog.jump().await;
+    let result = dog.jump();
     calls.record("jump", &result);
-    let airborne = dog.wait_for_state(WAIT, |s| s.body.position_m[2] > STANDING_HEIGHT_M + 0.05).await.is_some();
-    let landed = dog.wait_for_state(WAIT, |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
+    let airborne = dog.wait_for_state(WAIT, move |s| s.body.position_m[2] > STANDING_HEIGHT_M + 0.05).await.is_some();
+    let landed = dog.wait_for_state(WAIT, move |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
     let action_cleared = dog.wire_command().action_code() == Action::None;
     let tricks = sim.snapshot().dog.tricks_done() - tricks_before;
     out.line(format_args!(
@@ -243,11 +246,11 @@ async fn steps(
 
     // Fault: a motor fault in the error word refuses calls with the robot's word.
     sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
-    dog.wait_for_state(WAIT, |s| s.body.error.is_some()).await;
-    let refused = dog.stand_up().await;
+    dog.wait_for_state(WAIT, move |s| s.body.error.is_some()).await;
+    let refused = dog.stand_up();
     calls.record("stand_up during motor fault", &refused);
     sim.clear_faults();
-    dog.wait_for_state(WAIT, |s| s.body.error.is_none()).await;
+    dog.wait_for_state(WAIT, move |s| s.body.error.is_none()).await;
     let code = refused.as_ref().err().map(CallError::return_code);
     out.line(format_args!(
         "  fault    error word 0x3011 -> stand_up returns {code:?}; the stream forced passive {}",
@@ -261,12 +264,12 @@ async fn steps(
 
     // Fault: the dog falls silent while walking; the client stops the walk and reconnects.
     stand(dog, &mut calls, "stand_up").await?;
-    let result = dog.move_velocity(0.4, 0.0, 0.0).await;
+    let result = dog.move_velocity(0.4, 0.0, 0.0);
     calls.record("move(0.4, 0, 0)", &result);
     if let Err(e) = &result {
         out.line(format_args!("  move(0.4, 0, 0) refused: {e}"));
     }
-    dog.wait_for_state(WAIT, |s| s.body.body_velocity_mps[0] > 0.35).await;
+    dog.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0] > 0.35).await;
     let mut events = dog.connection_events();
     events.borrow_and_update();
     sim.inject(DogFault::Silence);
@@ -300,9 +303,9 @@ async fn steps(
     ));
 
     // Lie down.
-    let result = dog.lie_down().await;
+    let result = dog.lie_down();
     calls.record("lie_down", &result);
-    let lying = dog.wait_for_state(WAIT, |s| s.body.position_m[2] < 0.12).await.is_some();
+    let lying = dog.wait_for_state(WAIT, move |s| s.body.position_m[2] < 0.12).await.is_some();
     out.line(format_args!(
         "  lie      lie_down -> mode {:?} {}",
         dog.control_mode().unwrap_or(ControlMode::Passive),

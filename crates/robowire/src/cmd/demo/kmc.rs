@@ -4,7 +4,7 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use kmc::{ChassisFrame, Driver, DriverOptions};
+use kmc::{ChassisFrame, Device, Driver, DriverOptions};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_core::timing::LatenessRing;
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
@@ -42,8 +42,7 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
         options.vehicle_speed_rate_hz
     ));
     let control_rate_hz = options.control_rate_hz;
-    let mut driver = Driver::new(sim.path(), options)?;
-    driver.start()?;
+    let driver = Driver::open(sim.path(), options)?;
     let started = Instant::now();
     let phase_time = Duration::from_secs_f64(duration_s / PHASES.len() as f64).max(MIN_PHASE);
     let mut report = DeviceReport::new("kmc");
@@ -146,26 +145,23 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
     driver.set_command(0.2, 0.0)?;
     std::thread::sleep(Duration::from_millis(50));
     let before_stop = sim.received().len();
-    driver.stop().context("stopping the driver")?;
-    let elapsed = started.elapsed();
-    // Everything the driver wrote reaches the chassis (or 2 s pass).
     let stats = driver.stats();
-    let written = stats.control_frames_sent + stats.stop_frames_sent;
+    driver.close().context("closing the driver")?;
+    let elapsed = started.elapsed();
+    // The burst is the sentinel: once three (0, 0) end the line after the command, everything
+    // the driver wrote has arrived (or 2 s pass).
+    let burst_at_end = |received: &[robowire_sim::kmc::Received]| {
+        let controls: Vec<_> = received.iter().skip(before_stop).filter(|r| matches!(r.frame, HostFrame::PcControl(_))).collect();
+        controls.iter().rev().take_while(|r| r.frame == HostFrame::PcControl(PcControl::STOP)).count()
+    };
     let waited = Instant::now();
-    while sim.stats().control_frames < written && waited.elapsed() < Duration::from_secs(2) {
+    while burst_at_end(&sim.received()) < 3 && waited.elapsed() < Duration::from_secs(2) {
         std::thread::sleep(Duration::from_millis(1));
     }
     let received = sim.received();
-    let after_stop: Vec<_> =
-        received.iter().skip(before_stop).filter(|r| matches!(r.frame, HostFrame::PcControl(_))).collect();
-    let burst = after_stop.iter().rev().take_while(|r| r.frame == HostFrame::PcControl(PcControl::STOP)).count();
-    let stats = driver.stats();
-    out.line(format_args!("  stop     driver.stop() -> {} × (0, 0) at the end of the stream", burst));
-    report.checks.push(Check::new(
-        "stop: burst of 3 × (0, 0)",
-        stats.stop_frames_sent == 3 && burst >= 3,
-        format!("{burst} stop frames"),
-    ));
+    let burst = burst_at_end(&received);
+    out.line(format_args!("  stop     driver.close() -> {} × (0, 0) at the end of the stream", burst));
+    report.checks.push(Check::new("stop: burst of 3 × (0, 0)", burst >= 3, format!("{burst} stop frames")));
     report.checks.push(Check::new(
         "battery and all-state polls answered",
         battery_volts.is_some() && all_state_seen.iter().all(|&n| n > 0),
@@ -204,7 +200,7 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
         format!("{rate:.1} Hz"),
     ));
 
-    report.commanded.push("silence 600 ms, then stop()".into());
+    report.commanded.push("silence 600 ms, then close()".into());
     report.observed.push(format!(
         "(0, 0) after {} ms, {burst} × stop",
         timeout_stop.map_or("never".into(), |d| d.as_millis().to_string())

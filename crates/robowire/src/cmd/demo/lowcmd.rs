@@ -7,7 +7,8 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use go2::{Go2, LowCmd, LowLevel, LowLevelOptions, MotorCmd, STAND_POSE_RAD};
+use go2::trajectory::{JointTrajectory, STAND_KD, STAND_KP};
+use go2::{Device, Go2, LowCmd, LowLevel, LowLevelOptions, MotorCmd};
 use robowire_core::timing::LatenessRing;
 use robowire_dds::ParticipantOptions;
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
@@ -15,8 +16,6 @@ use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
 
-const KP: f32 = 60.0;
-const KD: f32 = 5.0;
 /// Every this many LowStates one goes out with a flipped bit, during the fault phase.
 const FLIP_EVERY: u32 = 25;
 
@@ -36,7 +35,7 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
 fn command(pose: &[f32; 12], tag: u32) -> LowCmd {
     let mut cmd = LowCmd::default();
     for (m, q) in cmd.motor_cmd.iter_mut().zip(pose) {
-        *m = MotorCmd::servo(*q, 0.0, KP, KD, 0.0);
+        *m = MotorCmd::servo(*q, 0.0, STAND_KP, STAND_KD, 0.0);
     }
     cmd.reserve = tag.into();
     cmd
@@ -48,8 +47,7 @@ fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
         let lo = ParticipantOptions::new(0, Some("lo"));
         let sim = Go2Sim::spawn(Go2SimConfig { participant: lo.clone(), ..Go2SimConfig::default() })
             .context("starting the Go2 simulator")?;
-        let robot = LowLevel::<Go2>::connect(LowLevelOptions { participant: lo, ..LowLevelOptions::default() })
-            .await
+        let robot = LowLevel::<Go2>::open(LowLevelOptions { participant: lo, ..LowLevelOptions::default() })
             .context("the Go2 client")?;
         let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
         out.line(format_args!("simulator and client on DDS domain 0, interface lo; LowState tick {}", first.tick.get()));
@@ -72,7 +70,7 @@ fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
         // Stand up, then hold with bit flips on the wire for a while.
         let move_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
         let hold_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
-        let target: [f32; 12] = std::array::from_fn(|i| STAND_POSE_RAD[i % 3]);
+        let stand = JointTrajectory::stand_up(start, move_time);
         let mut echo: LatenessRing<4096> = LatenessRing::new();
         let mut pending: VecDeque<(u32, Instant)> = VecDeque::new();
         let mut progress = Progress::new("lowcmd", out);
@@ -85,12 +83,10 @@ fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
             if elapsed >= move_time + hold_time {
                 break;
             }
-            let fraction = (elapsed.as_secs_f32() / move_time.as_secs_f32()).min(1.0);
-            let pose: [f32; 12] = std::array::from_fn(|i| start[i] + (target[i] - start[i]) * fraction);
             tag += 1;
-            robot.set_command(command(&pose, tag))?;
+            robot.set_command(command(&stand.positions_at(elapsed), tag))?;
             pending.push_back((tag, Instant::now()));
-            if let Some(state) = robot.state() {
+            if let Some(state) = robot.latest() {
                 let seen = state.state.reserve.get();
                 while pending.front().is_some_and(|(t, _)| *t <= seen) {
                     if let Some((t, at)) = pending.pop_front()
@@ -119,7 +115,7 @@ fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
             }
         }
         let reached = robot.joint_positions().context("no state")?;
-        let worst = reached.iter().zip(target).map(|(q, t)| (q - t).abs()).fold(0.0f32, f32::max);
+        let worst = stand.largest_error_rad(&reached);
         robot.damp();
         tokio::time::sleep(Duration::from_millis(100)).await;
         let (stats, snapshot) = (robot.stats(), sim.snapshot());
@@ -151,7 +147,7 @@ fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
         let mut report = DeviceReport::new("lowcmd");
         report.commanded = vec![
             "ReleaseMode (motion_switcher)".into(),
-            format!("12 joints up, {:.1} s, kp {KP} kd {KD}", move_time.as_secs_f64()),
+            format!("12 joints up, {:.1} s, kp {STAND_KP} kd {STAND_KD}", move_time.as_secs_f64()),
             format!("hold {:.1} s, then damp", hold_time.as_secs_f64()),
         ];
         report.observed = vec![

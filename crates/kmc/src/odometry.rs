@@ -1,5 +1,6 @@
-//! Planar odometry from a chassis's speed reports and its commanded curvature (the KMC reports
-//! only its speed): x, y, heading integrated on caller time.
+//! Planar odometry from the chassis's speed reports and its commanded curvature (the KMC reports
+//! only its speed): x, y, heading integrated on caller time. The [`Driver`](crate::Driver) keeps
+//! one in its [`ChassisState`](crate::ChassisState).
 
 /// Pose in the `odom` frame: x, y (m), heading (rad), and the last velocities.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

@@ -1,0 +1,123 @@
+//! Unitree's services over `rt/api/<service>/request` and `/response` (spec `unitree-dds.md`):
+//! the request/answer protocol as a [`Service`] of `robowire-dds`, request ids as Unitree's SDKs
+//! make them, and the calls robowire makes (`motion_switcher` CheckMode and ReleaseMode, `sport`
+//! StandDown).
+
+use std::sync::atomic::{AtomicI64, Ordering};
+use std::time::Duration;
+
+use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, status};
+use robowire_dds::rpc::{RpcClient, Service};
+use robowire_dds::{DdsError, Participant};
+
+use crate::Go2Error;
+
+/// Unitree's request/answer protocol: `unitree_api` `Request_`/`Response_`, paired by
+/// `identity.id`.
+#[derive(Debug)]
+pub struct UnitreeApi;
+
+impl Service for UnitreeApi {
+    type Request = ApiRequest;
+    type Answer = ApiResponse;
+
+    fn request_id(request: &ApiRequest) -> i64 {
+        request.header.id
+    }
+
+    fn answer_id(answer: &ApiResponse) -> i64 {
+        answer.id
+    }
+}
+
+/// A client of one of the robot's services. Create it on a tokio runtime (its answers are read
+/// by a task there); call it on that runtime. [`LowLevel`](crate::LowLevel) makes its own; this
+/// is for a program on its own participant.
+#[derive(Debug)]
+pub struct ServiceClient {
+    service: &'static str,
+    rpc: RpcClient<UnitreeApi>,
+    next_id: AtomicI64,
+}
+
+impl ServiceClient {
+    /// A client of `service` (`motion_switcher`, `sport`, …).
+    pub fn new(participant: &Participant, service: &'static str) -> Result<Self, DdsError> {
+        let rpc = RpcClient::new(
+            participant,
+            &api::request_topic(service).to_string(),
+            &api::response_topic(service).to_string(),
+        )?;
+        // Request ids as Unitree's SDKs make them: the clock in ns, unique per call.
+        let first_id = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .ok()
+            .and_then(|t| i64::try_from(t.as_nanos()).ok())
+            .unwrap_or(1);
+        Ok(Self { service, rpc, next_id: AtomicI64::new(first_id) })
+    }
+
+    /// Calls `api_id` with `parameter` (JSON by convention) and waits up to `timeout` for its
+    /// answer. An answer with an error code is [`Go2Error::Refused`]; one for another API id is
+    /// [`Go2Error::Unexpected`].
+    pub async fn call(&self, api_id: i64, parameter: &str, timeout: Duration) -> Result<ApiResponse, Go2Error> {
+        let id = self.next_id.fetch_add(1, Ordering::Relaxed);
+        let request =
+            ApiRequest { header: RequestHeader::call(id, api_id), parameter: parameter.into(), binary: Vec::new() };
+        let service = self.service;
+        let answer = self.rpc.call(request, timeout).await.map_err(|source| Go2Error::Service { service, api_id, source })?;
+        if answer.api_id != api_id {
+            return Err(Go2Error::Unexpected { service, data: format!("an answer for api {}", answer.api_id) });
+        }
+        if answer.code != status::OK {
+            return Err(Go2Error::Refused { service, api_id, code: answer.code });
+        }
+        Ok(answer)
+    }
+}
+
+/// The robot's `motion_switcher` and `sport` services, as the low-level client uses them.
+#[derive(Debug)]
+pub(crate) struct Services {
+    switcher: ServiceClient,
+    sport: ServiceClient,
+    timeout: Duration,
+}
+
+impl Services {
+    pub(crate) fn new(participant: &Participant, timeout: Duration) -> Result<Self, DdsError> {
+        Ok(Self {
+            switcher: ServiceClient::new(participant, api::motion_switcher::SERVICE)?,
+            sport: ServiceClient::new(participant, api::sport::SERVICE)?,
+            timeout,
+        })
+    }
+
+    /// The sport mode owning the motors (empty: none), as CheckMode reports it.
+    pub(crate) async fn sport_mode(&self) -> Result<String, Go2Error> {
+        let answer = self.switcher.call(api::motion_switcher::CHECK_MODE, "{}", self.timeout).await?;
+        api::motion_switcher::mode_name(&answer.data)
+            .map(str::to_owned)
+            .ok_or(Go2Error::Unexpected { service: api::motion_switcher::SERVICE, data: answer.data })
+    }
+
+    /// Releases the sport mode the way Unitree's low-level example does: CheckMode; while a mode
+    /// owns the motors, sport StandDown, motion_switcher ReleaseMode, CheckMode again. Returns the
+    /// ReleaseMode calls it took.
+    pub(crate) async fn release_sport_mode(&self) -> Result<u32, Go2Error> {
+        const MAX_ATTEMPTS: u32 = 10;
+        let mut attempts = 0;
+        loop {
+            let mode = self.sport_mode().await?;
+            if mode.is_empty() {
+                return Ok(attempts);
+            }
+            if attempts == MAX_ATTEMPTS {
+                return Err(Go2Error::NotReleased { mode, attempts });
+            }
+            self.sport.call(api::sport::STAND_DOWN, "{}", self.timeout).await?;
+            self.switcher.call(api::motion_switcher::RELEASE_MODE, "{}", self.timeout).await?;
+            attempts += 1;
+        }
+    }
+}

@@ -1,0 +1,189 @@
+//! Device addresses: one syntax for every device, `KIND:WHERE`.
+
+use std::fmt;
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+/// A device, as every robowire command and library names it.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum DeviceAddress {
+    /// `kmc:/dev/ttyUSB0`: a KMC chassis on a serial port.
+    Kmc(PathBuf),
+    /// `zsl1:192.168.234.1`: a ZSL-1's HighLevel interface over UDP.
+    Zsl1(IpAddr),
+    /// `zsl1w:192.168.234.1`: a ZSL-1W's HighLevel interface over UDP.
+    Zsl1w(IpAddr),
+    /// `go2:eth0`: a Unitree Go2's low-level interface on the DDS domain of that interface.
+    Go2(String),
+    /// `hg:eth0`: a Unitree HG robot's (G1, H1-2) low-level interface on that interface.
+    Hg(String),
+    /// `sim:kmc|zsl1|zsl1w|go2`: an in-process simulator and a client of it.
+    Sim(SimKind),
+}
+
+/// The simulators an address can start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SimKind {
+    /// A KMC chassis on a pseudo-terminal.
+    Kmc,
+    /// A ZSL-1 on loopback UDP.
+    Zsl1,
+    /// A ZSL-1W on loopback UDP.
+    Zsl1w,
+    /// A Go2 on DDS.
+    Go2,
+}
+
+/// What kind of device an address names, whatever its link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DeviceKind {
+    /// A KMC wheeled chassis.
+    Kmc,
+    /// A ZSL-1 quadruped.
+    Zsl1,
+    /// A ZSL-1W wheel-legged quadruped.
+    Zsl1w,
+    /// A Unitree Go2.
+    Go2,
+    /// A Unitree HG robot (G1, H1-2).
+    Hg,
+}
+
+impl DeviceKind {
+    /// Its name in addresses: `kmc`, `zsl1`, `zsl1w`, `go2`, `hg`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Kmc => "kmc",
+            Self::Zsl1 => "zsl1",
+            Self::Zsl1w => "zsl1w",
+            Self::Go2 => "go2",
+            Self::Hg => "hg",
+        }
+    }
+}
+
+/// The addresses every error message shows as examples.
+pub const ADDRESS_EXAMPLES: &str =
+    "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, sim:kmc|zsl1|zsl1w|go2";
+
+/// Why an address was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("device address {address:?}: {reason} (addresses look like {ADDRESS_EXAMPLES})")]
+pub struct AddressError {
+    /// The address given.
+    pub address: String,
+    /// What is wrong with it.
+    pub reason: &'static str,
+}
+
+impl FromStr for DeviceAddress {
+    type Err = AddressError;
+
+    fn from_str(address: &str) -> Result<Self, AddressError> {
+        let refuse = |reason| AddressError { address: address.into(), reason };
+        let (kind, rest) = address.split_once(':').ok_or_else(|| refuse("no kind: write KIND:WHERE"))?;
+        if rest.is_empty() {
+            return Err(refuse("nothing after the kind"));
+        }
+        let ip = || rest.parse::<IpAddr>().map_err(|_| refuse("not an IP address"));
+        let interface = || {
+            if rest.len() > 15 || rest.contains(['/', ' ', '\0']) {
+                Err(refuse("not a network interface name"))
+            } else {
+                Ok(rest.to_owned())
+            }
+        };
+        match kind {
+            "kmc" => Ok(Self::Kmc(rest.into())),
+            "zsl1" => Ok(Self::Zsl1(ip()?)),
+            "zsl1w" => Ok(Self::Zsl1w(ip()?)),
+            "go2" => Ok(Self::Go2(interface()?)),
+            "hg" => Ok(Self::Hg(interface()?)),
+            "sim" => Ok(Self::Sim(match rest {
+                "kmc" => SimKind::Kmc,
+                "zsl1" => SimKind::Zsl1,
+                "zsl1w" => SimKind::Zsl1w,
+                "go2" => SimKind::Go2,
+                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2)")),
+            })),
+            _ => Err(refuse("unknown kind")),
+        }
+    }
+}
+
+impl fmt::Display for DeviceAddress {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Kmc(path) => write!(f, "kmc:{}", path.display()),
+            Self::Zsl1(ip) => write!(f, "zsl1:{ip}"),
+            Self::Zsl1w(ip) => write!(f, "zsl1w:{ip}"),
+            Self::Go2(interface) => write!(f, "go2:{interface}"),
+            Self::Hg(interface) => write!(f, "hg:{interface}"),
+            Self::Sim(kind) => write!(f, "sim:{}", kind.device().name()),
+        }
+    }
+}
+
+impl SimKind {
+    /// The device it simulates.
+    pub fn device(self) -> DeviceKind {
+        match self {
+            Self::Kmc => DeviceKind::Kmc,
+            Self::Zsl1 => DeviceKind::Zsl1,
+            Self::Zsl1w => DeviceKind::Zsl1w,
+            Self::Go2 => DeviceKind::Go2,
+        }
+    }
+}
+
+impl DeviceAddress {
+    /// The kind of device it names.
+    pub fn kind(&self) -> DeviceKind {
+        match self {
+            Self::Kmc(_) => DeviceKind::Kmc,
+            Self::Zsl1(_) => DeviceKind::Zsl1,
+            Self::Zsl1w(_) => DeviceKind::Zsl1w,
+            Self::Go2(_) => DeviceKind::Go2,
+            Self::Hg(_) => DeviceKind::Hg,
+            Self::Sim(sim) => sim.device(),
+        }
+    }
+
+    /// Whether it names an in-process simulator.
+    pub fn is_simulated(&self) -> bool {
+        matches!(self, Self::Sim(_))
+    }
+
+    /// Whether its link is DDS (on one machine, DDS discovery needs multicast on loopback).
+    pub fn uses_dds(&self) -> bool {
+        matches!(self.kind(), DeviceKind::Go2 | DeviceKind::Hg)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kind_parses_prints_back_and_bad_addresses_say_why() {
+        for text in ["kmc:/dev/ttyUSB0", "zsl1:192.168.234.1", "zsl1w:10.0.0.2", "go2:eth0", "hg:enp3s0", "sim:zsl1"] {
+            let address: DeviceAddress = text.parse().unwrap();
+            assert_eq!(address.to_string(), text);
+        }
+        assert_eq!("zsl1w:192.168.234.1".parse::<DeviceAddress>().unwrap().kind(), DeviceKind::Zsl1w);
+        assert!("sim:go2".parse::<DeviceAddress>().unwrap().uses_dds());
+        for (bad, reason) in [
+            ("kmc", "no kind: write KIND:WHERE"),
+            ("kmc:", "nothing after the kind"),
+            ("zsl1:robot", "not an IP address"),
+            ("go2:a/b", "not a network interface name"),
+            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2)"),
+            ("tank:1", "unknown kind"),
+        ] {
+            let e = bad.parse::<DeviceAddress>().unwrap_err();
+            assert_eq!((e.address.as_str(), e.reason), (bad, reason));
+            assert!(e.to_string().contains("kmc:/dev/ttyUSB0"), "the message shows what an address looks like");
+        }
+    }
+}

@@ -1,0 +1,335 @@
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+
+mod address;
+mod kmc;
+mod link;
+mod observation;
+#[cfg(feature = "sim")]
+mod sim;
+mod unitree;
+mod zsl;
+
+use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::time::Duration;
+
+pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
+pub use link::{Describe, StateChanges};
+pub use observation::{
+    BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough,
+};
+pub use robowire_rt::device::Connection;
+#[cfg(feature = "sim")]
+pub use sim::Simulator;
+pub use zsl::state_line as zsl_state_line;
+
+use link::Link;
+use serde_json::Value;
+use tokio::sync::watch;
+
+/// How [`open`] reaches a device, beyond its address.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OpenOptions {
+    /// DDS domain of `go2:`, `hg:` and `sim:go2` (Unitree's robots: 0).
+    pub domain: u16,
+    /// Network interface of `sim:go2`'s simulator and client (`None`: `lo`).
+    pub sim_interface: Option<String>,
+    /// Local address of `zsl1:`/`zsl1w:` clients: where the robot sends its state (its
+    /// `target_ip`/`target_port`, port 43988 by default).
+    pub zsl_local: SocketAddr,
+    /// `kmc:` polls the battery (1 Hz) and the motors' all-state (10 Hz).
+    pub kmc_polls: bool,
+}
+
+impl Default for OpenOptions {
+    fn default() -> Self {
+        Self {
+            domain: 0,
+            sim_interface: None,
+            zsl_local: SocketAddr::new(IpAddr::V4(Ipv4Addr::UNSPECIFIED), zsl_proto::udp::DEFAULT_LOCAL_PORT),
+            kmc_polls: true,
+        }
+    }
+}
+
+/// Why a device could not be opened or did not do what it was asked; the facade's error is the
+/// source.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeviceError {
+    /// The address is not one.
+    #[error(transparent)]
+    Address(#[from] AddressError),
+    /// The KMC chassis.
+    #[error("KMC chassis")]
+    Kmc(#[from] ::kmc::KmcError),
+    /// A ZSL-1 could not be reached.
+    #[error("ZSL-1 client")]
+    ZslConnect(#[from] ::zsl::udp::ConnectError),
+    /// A ZSL-1 call did not go out.
+    #[error("ZSL-1 call")]
+    ZslCall(#[from] ::zsl::udp::CallError),
+    /// A Unitree robot's client.
+    #[error("Unitree low-level client")]
+    Unitree(#[from] go2::Go2Error),
+    /// A simulator could not start.
+    #[error("the simulator of {address}")]
+    Simulator {
+        /// The address.
+        address: DeviceAddress,
+        /// Why.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// A `sim:` address in a build without the `sim` feature.
+    #[error("{address}: this build has no simulators (the `sim` feature of robowire-devices is off)")]
+    NoSimulators {
+        /// The address.
+        address: DeviceAddress,
+    },
+    /// The device has no such action.
+    #[error("no service {service:?} on this device")]
+    NoSuchService {
+        /// The name asked for.
+        service: String,
+    },
+    /// The device cannot do this (a Go2 is not driven by a velocity).
+    #[error("this device does not support {what}")]
+    Unsupported {
+        /// What was asked.
+        what: &'static str,
+    },
+}
+
+/// An error and its sources on one line, each once: `ZSL-1 call: refused in mode LieDown: …`.
+pub fn error_chain(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let cause_text = cause.to_string();
+        if !text.contains(&cause_text) {
+            text.push_str(": ");
+            text.push_str(&cause_text);
+        }
+        source = cause.source();
+    }
+    text
+}
+
+/// A device opened by address, in the one shape every app drives: state, connection, status, a
+/// neutral [`Observation`], drive, services, close. Typed access to the facade underneath for
+/// what is the device's own ([`kmc`](Self::kmc), [`zsl`](Self::zsl), [`go2`](Self::go2),
+/// [`hg`](Self::hg)). Dropping it does the device's safe thing and closes it (then stops its
+/// simulator, if any).
+pub struct AnyDevice {
+    address: DeviceAddress,
+    link: Box<dyn Link>,
+    /// Dropped after the link: the client says its last word to a live simulator.
+    #[cfg(feature = "sim")]
+    simulator: Option<Simulator>,
+}
+
+impl std::fmt::Debug for AnyDevice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AnyDevice").field("address", &self.address).finish_non_exhaustive()
+    }
+}
+
+/// Opens the device at `address`: its client, and for `sim:` addresses its simulator first.
+/// DDS devices on one machine need multicast on loopback (see `robowire-dds`).
+///
+/// ```
+/// use robowire_devices::{DeviceAddress, open, OpenOptions};
+/// let address: DeviceAddress = "kmc:/dev/robowire-no-such-port".parse()?;
+/// let error = open(&address, &OpenOptions::default()).unwrap_err();
+/// assert!(format!("{error:#}").contains("KMC chassis"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+    let link: Box<dyn Link> = match address {
+        DeviceAddress::Kmc(path) => Box::new(::kmc::Driver::open(path, kmc_options(options))?),
+        DeviceAddress::Zsl1(ip) | DeviceAddress::Zsl1w(ip) => {
+            let model = if matches!(address, DeviceAddress::Zsl1w(_)) { ::zsl::udp::Model::Zsl1W } else { ::zsl::udp::Model::Zsl1 };
+            let client = ::zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), *ip)
+                .with_model(model);
+            Box::new(::zsl::udp::HighLevel::open(client)?)
+        }
+        DeviceAddress::Go2(interface) => {
+            Box::new(go2::LowLevel::<go2::Go2>::open(go2::LowLevelOptions::on(Some(interface), options.domain))?)
+        }
+        DeviceAddress::Hg(interface) => {
+            Box::new(go2::LowLevel::<go2::Hg>::open(go2::LowLevelOptions::on(Some(interface), options.domain))?)
+        }
+        DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
+    };
+    Ok(AnyDevice {
+        address: address.clone(),
+        link,
+        #[cfg(feature = "sim")]
+        simulator: None,
+    })
+}
+
+fn kmc_options(options: &OpenOptions) -> ::kmc::DriverOptions {
+    ::kmc::DriverOptions { poll_battery: options.kmc_polls, poll_allstate: options.kmc_polls, ..Default::default() }
+}
+
+#[cfg(feature = "sim")]
+fn open_simulated(address: &DeviceAddress, kind: SimKind, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+    let (simulator, link) = sim::open(address, kind, options)?;
+    Ok(AnyDevice { address: address.clone(), link, simulator: Some(simulator) })
+}
+
+#[cfg(not(feature = "sim"))]
+fn open_simulated(address: &DeviceAddress, _: SimKind, _: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+    Err(DeviceError::NoSimulators { address: address.clone() })
+}
+
+impl AnyDevice {
+    fn link(&self) -> &dyn Link {
+        self.link.as_ref()
+    }
+
+    /// The address it was opened by.
+    pub fn address(&self) -> &DeviceAddress {
+        &self.address
+    }
+
+    /// What kind of device it is.
+    pub fn kind(&self) -> DeviceKind {
+        self.address.kind()
+    }
+
+    /// The connection as the device's watchdog sees it.
+    pub fn connection(&self) -> Connection {
+        *self.link().connection_events().borrow()
+    }
+
+    /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
+    pub fn connection_events(&self) -> watch::Receiver<Connection> {
+        self.link().connection_events()
+    }
+
+    /// Wakes at every new state.
+    pub fn state_changes(&self) -> StateChanges {
+        self.link().changes()
+    }
+
+    /// How long ago the latest state arrived (`None` before the first).
+    pub fn state_age(&self) -> Option<Duration> {
+        self.link().age()
+    }
+
+    /// Waits up to `timeout` for a first state (needs a tokio runtime with its timer);
+    /// whether one arrived.
+    pub async fn wait_state(&self, timeout: Duration) -> bool {
+        let mut changes = self.state_changes();
+        if self.state_age().is_some() {
+            return true;
+        }
+        tokio::time::timeout(timeout, async {
+            while self.state_age().is_none() {
+                if !changes.changed().await {
+                    return false;
+                }
+            }
+            true
+        })
+        .await
+        .unwrap_or(false)
+    }
+
+    /// The latest state as JSON: the fields of the device's own status command
+    /// (`robowire dog status --json`, `robowire go2 status --json`).
+    pub fn status_json(&self) -> Option<Value> {
+        self.link().status_json()
+    }
+
+    /// The latest state as a few lines of text.
+    pub fn status_text(&self) -> Option<String> {
+        self.link().status_text()
+    }
+
+    /// The latest state as one line, with its age.
+    pub fn status_line(&self) -> Option<String> {
+        self.link().status_line()
+    }
+
+    /// The client's counters as one line.
+    pub fn stats_line(&self) -> String {
+        self.link().stats_line()
+    }
+
+    /// The latest state, device-neutral (`None` before the first).
+    pub fn observe(&self) -> Option<Observation> {
+        self.link().observe()
+    }
+
+    /// Whether it is driven by a velocity ([`drive`](Self::drive)).
+    pub fn can_drive(&self) -> bool {
+        self.link().can_drive()
+    }
+
+    /// Drives a mobile base: forward m/s, left m/s, yaw rate rad/s, checked by the device's own
+    /// rules before anything is sent.
+    pub fn drive(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), DeviceError> {
+        self.link().drive(vx_mps, vy_mps, yaw_rate_radps)
+    }
+
+    /// Stops a commanded motion (zero velocity where the device is driven by one).
+    pub fn stop_motion(&self) -> Result<(), DeviceError> {
+        self.link().stop_motion()
+    }
+
+    /// A drive command not refreshed within `timeout` stops the device (where it has such a
+    /// timeout: the KMC chassis; a ZSL-1 keeps its command until its watchdog).
+    pub fn set_drive_timeout(&self, timeout: Duration) -> Result<(), DeviceError> {
+        self.link().set_drive_timeout(timeout)
+    }
+
+    /// Its named actions (`stand_up`, `lie_down`, `passive` on a ZSL-1).
+    pub fn services(&self) -> &'static [&'static str] {
+        self.link().services()
+    }
+
+    /// Runs the named action; what the device said.
+    pub fn call(&self, service: &str) -> Result<String, DeviceError> {
+        self.link().call(service)
+    }
+
+    /// The KMC driver, if this is a chassis.
+    pub fn kmc(&self) -> Option<&::kmc::Driver> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The ZSL-1 HighLevel client, if this is a ZSL-1 or ZSL-1W.
+    pub fn zsl(&self) -> Option<&::zsl::udp::HighLevel> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The Go2 low-level client, if this is a Go2.
+    pub fn go2(&self) -> Option<&go2::LowLevel<go2::Go2>> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The HG low-level client, if this is an HG robot.
+    pub fn hg(&self) -> Option<&go2::LowLevel<go2::Hg>> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The simulator behind a `sim:` address.
+    #[cfg(feature = "sim")]
+    pub fn simulator(&self) -> Option<&Simulator> {
+        self.simulator.as_ref()
+    }
+
+    /// Does the device's safe thing (stop burst, stop, damping) and closes it; then stops its
+    /// simulator. When this returns, its port or socket can be opened again.
+    pub fn close(self) -> Result<(), DeviceError> {
+        // The link first; the simulator (dropped at the end of this scope) hears its last word.
+        let closed = self.link.close();
+        #[cfg(feature = "sim")]
+        drop(self.simulator);
+        closed
+    }
+}

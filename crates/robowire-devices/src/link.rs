@@ -1,0 +1,101 @@
+//! What every device kind implements for [`AnyDevice`](crate::AnyDevice): one trait, one
+//! implementation per facade (`kmc.rs`, `zsl.rs`, `unitree.rs`).
+
+use std::any::Any;
+use std::future::Future;
+use std::pin::Pin;
+use std::time::Duration;
+
+use robowire_rt::device::{Connection, Stamped};
+use serde_json::Value;
+use tokio::sync::watch;
+
+use crate::{DeviceError, Observation};
+
+/// How a device's state reads, for people and for JSON: implemented by every facade
+/// (`kmc::Driver`, `zsl::udp::HighLevel`, `go2::LowLevel<Go2>`, `go2::LowLevel<Hg>`), so that a
+/// command working on a facade prints what `robowire status` prints.
+pub trait Describe {
+    /// The latest state as JSON (the fields of the device's own status command).
+    fn status_json(&self) -> Option<Value>;
+    /// The latest state as a few lines of text.
+    fn status_text(&self) -> Option<String>;
+    /// The latest state as one line (for a live view), with its age.
+    fn status_line(&self) -> Option<String>;
+    /// The client's counters as one line.
+    fn stats_line(&self) -> String;
+}
+
+/// A device's link, whatever its kind.
+pub(crate) trait Link: Describe + Send + Sync + 'static {
+    /// Connection events.
+    fn connection_events(&self) -> watch::Receiver<Connection>;
+    /// Wakes at every new state.
+    fn changes(&self) -> StateChanges;
+    /// How long ago the latest state arrived (`None` before the first).
+    fn age(&self) -> Option<Duration>;
+    /// The latest state, device-neutral.
+    fn observe(&self) -> Option<Observation>;
+    /// Drives a mobile base: forward m/s, left m/s, yaw rate rad/s.
+    fn drive(&self, _vx_mps: f32, _vy_mps: f32, _yaw_rate_radps: f32) -> Result<(), DeviceError> {
+        Err(DeviceError::Unsupported { what: "driving with a velocity" })
+    }
+    /// Whether [`drive`](Self::drive) is supported.
+    fn can_drive(&self) -> bool {
+        false
+    }
+    /// Stops a commanded motion (a bridge's deadman): zero velocity; nothing where nothing was
+    /// commanded by velocity.
+    fn stop_motion(&self) -> Result<(), DeviceError> {
+        Ok(())
+    }
+    /// A command that is not refreshed goes stale after `timeout` (where the device has such a
+    /// timeout; elsewhere the device's own watchdog stays).
+    fn set_drive_timeout(&self, _timeout: Duration) -> Result<(), DeviceError> {
+        Ok(())
+    }
+    /// The device's named actions (`stand_up`, …).
+    fn services(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Runs the named action; what the device said.
+    fn call(&self, service: &str) -> Result<String, DeviceError> {
+        Err(DeviceError::NoSuchService { service: service.into() })
+    }
+    /// The facade, for typed access.
+    fn as_any(&self) -> &dyn Any;
+    /// The device's safe thing, then closed.
+    fn close(self: Box<Self>) -> Result<(), DeviceError>;
+}
+
+/// Something that resolves when a new state arrived: `false` once the device is gone.
+pub(crate) trait Changed: Send {
+    fn changed(&mut self) -> Pin<Box<dyn Future<Output = bool> + Send + '_>>;
+}
+
+impl<S: Send + Sync> Changed for watch::Receiver<Option<Stamped<S>>> {
+    fn changed(&mut self) -> Pin<Box<dyn Future<Output = bool> + Send + '_>> {
+        Box::pin(async move { watch::Receiver::changed(self).await.is_ok() })
+    }
+}
+
+/// Wakes at every new state of a device (coalescing: a slow reader sees the newest).
+pub struct StateChanges(pub(crate) Box<dyn Changed>);
+
+impl std::fmt::Debug for StateChanges {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StateChanges").finish_non_exhaustive()
+    }
+}
+
+impl StateChanges {
+    /// Resolves at the next state; `false` once the device is gone.
+    pub async fn changed(&mut self) -> bool {
+        self.0.changed().await
+    }
+}
+
+/// `[a, b, c]` as `+0.123 +0.456 +0.789`.
+pub(crate) fn floats(values: &[f32]) -> String {
+    values.iter().map(|x| format!("{x:+.3}")).collect::<Vec<_>>().join(" ")
+}

@@ -1,0 +1,55 @@
+//! `sim:` addresses: the simulator first, then the same client a real device gets.
+
+use robowire_sim::dog::{DogSim, DogSimConfig};
+use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+
+use crate::link::Link;
+use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
+
+/// The simulator behind a `sim:` address, for what only a simulator does (faults, snapshots).
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Simulator {
+    /// A KMC chassis on a pseudo-terminal.
+    Kmc(ChassisSim),
+    /// A ZSL-1 / ZSL-1W on loopback UDP.
+    Dog(DogSim),
+    /// A Go2 on DDS.
+    Go2(Go2Sim),
+}
+
+pub(crate) fn open(
+    address: &DeviceAddress,
+    kind: SimKind,
+    options: &OpenOptions,
+) -> Result<(Simulator, Box<dyn Link>), DeviceError> {
+    let failed = |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator {
+        address: address.clone(),
+        source,
+    };
+    Ok(match kind {
+        SimKind::Kmc => {
+            let sim = ChassisSim::spawn(ChassisSimConfig::default()).map_err(|e| failed(e.into()))?;
+            let driver = kmc::Driver::open(sim.path(), crate::kmc_options(options))?;
+            (Simulator::Kmc(sim), Box::new(driver))
+        }
+        SimKind::Zsl1 | SimKind::Zsl1w => {
+            let model = if kind == SimKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
+            let sim = DogSim::spawn(DogSimConfig { model, ..DogSimConfig::loopback() }).map_err(|e| failed(e.into()))?;
+            let dog = sim.high_level_addr();
+            let client = zsl::udp::ClientOptions { dog, ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) }
+                .with_model(model);
+            let link = zsl::udp::HighLevel::open(client)?;
+            (Simulator::Dog(sim), Box::new(link))
+        }
+        SimKind::Go2 => {
+            let interface = options.sim_interface.as_deref().unwrap_or("lo");
+            let participant = go2::ParticipantOptions::new(options.domain, Some(interface));
+            let sim = Go2Sim::spawn(Go2SimConfig { participant: participant.clone(), ..Go2SimConfig::default() })
+                .map_err(|e| failed(e.into()))?;
+            let client = go2::LowLevel::<go2::Go2>::open(go2::LowLevelOptions { participant, ..Default::default() })?;
+            (Simulator::Go2(sim), Box::new(client))
+        }
+    })
+}

@@ -1,0 +1,194 @@
+//! A Unitree robot's low-level interface over DDS (Go2, HG): joints, IMU, battery and the
+//! LowState itself from `rt/lowstate`. It is commanded joint by joint, not by a velocity: it is
+//! not driven, and has no services here (releasing the sport mode is the `go2` facade's).
+
+use std::time::Duration;
+
+use go2::{Device, Go2, Hg, HgLowState, LowLevel, LowState, Robot};
+use lowcmd_proto::F32;
+use robowire_core::cdr::CdrType;
+use serde_json::Value;
+use tokio::sync::watch;
+
+use crate::link::{Describe, Link, StateChanges, floats};
+use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
+use crate::{DeviceError, Observation};
+
+/// What differs between the Unitree families for a device view.
+pub(crate) trait Family: Robot<State: serde::Serialize> {
+    /// The state as a few lines.
+    fn text(state: &Self::State) -> String;
+    /// The state as one line.
+    fn line(state: &Self::State) -> String;
+    /// The state, device-neutral (without the passthrough).
+    fn observe(state: &Self::State) -> Observation;
+}
+
+fn pose(q: &[f32]) -> String {
+    q.chunks(3).map(|leg| format!("[{}]", floats(leg))).collect::<Vec<_>>().join(" ")
+}
+
+fn imu(quaternion: [F32; 4], gyroscope: [F32; 3], accelerometer: [F32; 3]) -> ImuReading {
+    ImuReading {
+        orientation_xyzw: xyzw(quaternion.map(|v| v.get())),
+        gyro_radps: wide(gyroscope.map(|v| v.get())),
+        acc_mps2: wide(accelerometer.map(|v| v.get())),
+    }
+}
+
+impl Family for Go2 {
+    fn text(state: &LowState) -> String {
+        let mut lines = vec![Self::line(state)];
+        for (i, name) in go2::GO2_JOINT_NAMES.iter().enumerate() {
+            let m = &state.motor_state[i];
+            lines.push(format!(
+                "  {name:<9} q {:+.3} rad  dq {:+.3} rad/s  tau {:+.2} N·m  mode {}  {} °C",
+                m.q.get(),
+                m.dq.get(),
+                m.tau_est.get(),
+                m.mode,
+                m.temperature
+            ));
+        }
+        lines.push(format!("  foot force FR FL RR RL: {:?}", state.foot_force.map(|f| f.get())));
+        lines.join("\n")
+    }
+
+    fn line(state: &LowState) -> String {
+        let q: [f32; 12] = std::array::from_fn(|i| state.motor_state[i].q.get());
+        let rpy = state.imu_state.rpy.map(|v| v.get());
+        format!(
+            "tick {:>8} | q {} | rpy {} | {:.1} V {:.1} A soc {} %",
+            state.tick.get(),
+            pose(&q),
+            floats(&rpy),
+            state.power_v.get(),
+            state.power_a.get(),
+            state.bms_state.soc
+        )
+    }
+
+    fn observe(state: &LowState) -> Observation {
+        let motors = &state.motor_state[..12];
+        let s = &state.imu_state;
+        let bms = &state.bms_state;
+        Observation {
+            joints: Some(JointReadings {
+                names: go2::GO2_JOINT_NAMES.iter().map(|n| format!("{n}_joint")).collect(),
+                position_rad: motors.iter().map(|m| f64::from(m.q.get())).collect(),
+                velocity_radps: motors.iter().map(|m| f64::from(m.dq.get())).collect(),
+                effort_nm: motors.iter().map(|m| f64::from(m.tau_est.get())).collect(),
+            }),
+            imu: Some(imu(s.quaternion, s.gyroscope, s.accelerometer)),
+            battery: Some(BatteryReading {
+                voltage_v: Some(state.power_v.get()),
+                current_a: Some(state.power_a.get()),
+                charge_fraction: Some(f32::from(bms.soc) / 100.0),
+                cells_v: bms.cell_vol.iter().map(|mv| f32::from(mv.get()) / 1000.0).collect(),
+            }),
+            ..Observation::default()
+        }
+    }
+}
+
+impl Family for Hg {
+    fn text(state: &HgLowState) -> String {
+        let q: Vec<f32> = state.motor_state.iter().map(|m| m.q.get()).collect();
+        format!("{}\n  q rad (35 slots): {}", Self::line(state), floats(&q))
+    }
+
+    fn line(state: &HgLowState) -> String {
+        let rpy = state.imu_state.rpy.map(|v| v.get());
+        format!(
+            "tick {:>8} | mode_pr {} mode_machine {} | rpy {}",
+            state.tick.get(),
+            state.mode_pr,
+            state.mode_machine,
+            floats(&rpy)
+        )
+    }
+
+    /// The 35 motor slots as `motor_0` … (the HG family has no joint-name table here).
+    fn observe(state: &HgLowState) -> Observation {
+        let motors = &state.motor_state;
+        let s = &state.imu_state;
+        Observation {
+            joints: Some(JointReadings {
+                names: (0..motors.len()).map(|i| format!("motor_{i}")).collect(),
+                position_rad: motors.iter().map(|m| f64::from(m.q.get())).collect(),
+                velocity_radps: motors.iter().map(|m| f64::from(m.dq.get())).collect(),
+                effort_nm: motors.iter().map(|m| f64::from(m.tau_est.get())).collect(),
+            }),
+            imu: Some(imu(s.quaternion, s.gyroscope, s.accelerometer)),
+            ..Observation::default()
+        }
+    }
+}
+
+impl<R: Family> Describe for LowLevel<R> {
+
+    /// The LowState with the IDL field names (as `robowire decode lowstate --json`).
+    fn status_json(&self) -> Option<Value> {
+        serde_json::to_value(self.latest()?.state).ok()
+    }
+
+    fn status_text(&self) -> Option<String> {
+        Some(R::text(&self.latest()?.state))
+    }
+
+    fn status_line(&self) -> Option<String> {
+        let stamped = self.latest()?;
+        Some(format!("{} | age {} ms", R::line(&stamped.state), stamped.age().as_millis()))
+    }
+
+    fn stats_line(&self) -> String {
+        let s = self.stats();
+        format!(
+            "lowcmd sent {} (damping {}) | lowstate received {} decode errors {} CRC errors {} lost by tick {} | \
+             send lateness p50 {} µs p99 {} µs",
+            s.commands_sent,
+            s.damping_sent,
+            s.lowstate.samples,
+            s.lowstate.decode_errors,
+            s.lowstate.checksum_errors,
+            s.lost_by_tick,
+            s.send_lateness.p50_us,
+            s.send_lateness.p99_us
+        )
+    }
+}
+
+impl<R: Family> Link for LowLevel<R> {
+    fn connection_events(&self) -> watch::Receiver<go2::Connection> {
+        Device::connection_events(self)
+    }
+
+    fn changes(&self) -> StateChanges {
+        StateChanges(Box::new(self.states()))
+    }
+
+    fn age(&self) -> Option<Duration> {
+        self.latest().map(|s| s.age())
+    }
+
+    fn observe(&self) -> Option<Observation> {
+        let state = self.latest()?.state;
+        let mut observation = R::observe(&state);
+        let mut body = vec![0u8; state.body_len()];
+        if let Ok(n) = state.encode_body(&mut body) {
+            body.truncate(n);
+            observation.passthrough = Some(Passthrough { topic: "lowstate", type_name: R::State::TYPE_NAME, body });
+        }
+        Some(observation)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    /// Damping (if anything was sent), then closed.
+    fn close(self: Box<Self>) -> Result<(), DeviceError> {
+        LowLevel::close(*self);
+        Ok(())
+    }
+}

@@ -1,0 +1,94 @@
+//! `robowire status ADDRESS` and `robowire watch ADDRESS`: any device, by address.
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
+
+/// A device and how to reach it.
+#[derive(Debug, Args)]
+pub(crate) struct DeviceArgs {
+    /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, or
+    /// sim:kmc|zsl1|zsl1w|go2 for a simulator started here.
+    address: DeviceAddress,
+    /// DDS domain (go2:, hg:, sim:go2).
+    #[arg(long, default_value_t = 0)]
+    domain: u16,
+    /// Seconds to wait for the device's first state.
+    #[arg(long, default_value_t = 5.0)]
+    connect_timeout_s: f64,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct StatusArgs {
+    #[command(flatten)]
+    device: DeviceArgs,
+    /// One state as JSON (the same fields as the device's own status command).
+    #[arg(long)]
+    json: bool,
+}
+
+impl DeviceArgs {
+    /// Opens the device and waits for its first state.
+    async fn open(&self) -> anyhow::Result<AnyDevice> {
+        let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
+        let options = OpenOptions { domain: self.domain, ..OpenOptions::default() };
+        let address = &self.address;
+        let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
+        if !device.wait_state(timeout).await {
+            anyhow::bail!(
+                "no state from {address} within {:.1} s: {}",
+                timeout.as_secs_f64(),
+                what_to_check(address)
+            );
+        }
+        Ok(device)
+    }
+}
+
+/// What to check when a device is silent.
+fn what_to_check(address: &DeviceAddress) -> &'static str {
+    match address {
+        DeviceAddress::Kmc(_) => "is the chassis powered and this its serial port?",
+        DeviceAddress::Zsl1(_) | DeviceAddress::Zsl1w(_) => {
+            "is the robot on, and is its target_ip/target_port (sdk_config.yaml) this host's address, port 43988?"
+        }
+        DeviceAddress::Go2(_) | DeviceAddress::Hg(_) => {
+            "is the robot on, and is this the interface of its network (192.168.123.x)?"
+        }
+        DeviceAddress::Sim(_) => "the simulator did not start sending",
+    }
+}
+
+fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
+    Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
+}
+
+/// `robowire status ADDRESS`: one state.
+pub(crate) fn status(args: &StatusArgs) -> anyhow::Result<ExitCode> {
+    runtime()?.block_on(async {
+        let device = args.device.open().await?;
+        if args.json {
+            let state = device.status_json().context("no state")?;
+            println!("{}", serde_json::to_string_pretty(&state)?);
+        } else {
+            println!("{}", device.status_text().context("no state")?);
+        }
+        eprintln!("{}", device.stats_line());
+        device.close().context("closing the device")?;
+        Ok(ExitCode::SUCCESS)
+    })
+}
+
+/// `robowire watch ADDRESS`: the state ten times a second and every connection change, until
+/// Ctrl-C.
+pub(crate) fn watch(args: &DeviceArgs) -> anyhow::Result<ExitCode> {
+    runtime()?.block_on(async {
+        let device = args.open().await?;
+        crate::cmd::live::watch_until_ctrl_c(device.connection_events(), || device.status_line()).await?;
+        eprintln!("{}", device.stats_line());
+        device.close().context("closing the device")?;
+        Ok(ExitCode::SUCCESS)
+    })
+}
