@@ -14,7 +14,7 @@ use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, Reader, StatsHandle, TopicStats};
 use robowire_rt::Time;
-use robowire_rt::device::{Device, Receive, Received, Receiving, Stamped};
+use robowire_rt::device::{Device, Receive, Received, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 use robowire_rt::stats::Counter;
 use robowire_core::schedule::Watchdog;
@@ -263,11 +263,6 @@ where
         accept: impl Fn(&R::State) -> bool + Send + Sync + 'static,
     ) -> Option<R::State> {
         self.receiving.wait_for(timeout, accept).await.map(|s| s.state)
-    }
-
-    /// Every state from now on, in order, stamped with its arrival.
-    pub fn every_state(&self) -> tokio::sync::broadcast::Receiver<Stamped<R::State>> {
-        self.receiving.every_state()
     }
 
     /// The options in force.

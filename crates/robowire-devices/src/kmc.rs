@@ -7,7 +7,7 @@ use kmc::{ChassisState, Device, Driver};
 use serde_json::{Value, json};
 use tokio::sync::watch;
 
-use crate::link::{Describe, Link, StateChanges};
+use crate::link::{Describe, Link, Observations, StateChanges};
 use crate::observation::{BatteryReading, MotorReport, Odometry, yaw_quaternion};
 use crate::{DeviceError, Observation};
 
@@ -43,6 +43,29 @@ fn motor_report(motor: &kmc::AllState) -> MotorReport {
             value("error_code", motor.error_code.to_string()),
         ],
     }
+}
+
+/// What the frame that made `state` reported: odometry with a speed report, the battery with a
+/// battery report, a motor's health with an all-state report.
+fn observation(state: &ChassisState) -> Observation {
+    let mut observation = Observation::default();
+    match state.last_frame {
+        Some(kmc::ChassisFrame::VehicleSpeed(_)) => {
+            let o = &state.odometry;
+            observation.odometry = Some(Odometry {
+                position_m: [o.x_m, o.y_m, 0.0],
+                orientation_xyzw: yaw_quaternion(o.heading_rad),
+                linear_mps: [o.speed_mps, 0.0, 0.0],
+                angular_radps: [0.0, 0.0, o.yaw_rate_radps],
+            });
+        }
+        Some(kmc::ChassisFrame::BatteryVoltage(battery)) => {
+            observation.battery = Some(BatteryReading { voltage_v: Some(battery.volts), ..BatteryReading::default() });
+        }
+        Some(kmc::ChassisFrame::AllState(motor)) => observation.motors.push(motor_report(&motor)),
+        Some(kmc::ChassisFrame::Af(_)) | None => {}
+    }
+    observation
 }
 
 impl Describe for Driver {
@@ -129,25 +152,11 @@ impl Link for Driver {
     }
 
     fn observe(&self) -> Option<Observation> {
-        let state = self.latest()?.state;
-        let mut observation = Observation::default();
-        match state.last_frame {
-            Some(kmc::ChassisFrame::VehicleSpeed(_)) => {
-                let o = &state.odometry;
-                observation.odometry = Some(Odometry {
-                    position_m: [o.x_m, o.y_m, 0.0],
-                    orientation_xyzw: yaw_quaternion(o.heading_rad),
-                    linear_mps: [o.speed_mps, 0.0, 0.0],
-                    angular_radps: [0.0, 0.0, o.yaw_rate_radps],
-                });
-            }
-            Some(kmc::ChassisFrame::BatteryVoltage(battery)) => {
-                observation.battery = Some(BatteryReading { voltage_v: Some(battery.volts), ..BatteryReading::default() });
-            }
-            Some(kmc::ChassisFrame::AllState(motor)) => observation.motors.push(motor_report(&motor)),
-            Some(kmc::ChassisFrame::Af(_)) | None => {}
-        }
-        Some(observation)
+        Some(observation(&self.latest()?.state))
+    }
+
+    fn observations(&self) -> Observations {
+        Observations::new(self.every_state(), observation)
     }
 
     /// The chassis drives forward and turns; it cannot move sideways (`vy` is ignored).

@@ -14,7 +14,7 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::time::Duration;
 
 pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
-pub use link::{Describe, StateChanges};
+pub use link::{Describe, Observations, StateChanges};
 pub use observation::{
     BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough,
 };
@@ -263,6 +263,11 @@ impl AnyDevice {
     /// The latest state, device-neutral (`None` before the first).
     pub fn observe(&self) -> Option<Observation> {
         self.link().observe()
+    }
+
+    /// Every state from now on, in order, device-neutral (a bridge publishes each).
+    pub fn observations(&self) -> Observations {
+        self.link().observations()
     }
 
     /// Whether it is driven by a velocity ([`drive`](Self::drive)).

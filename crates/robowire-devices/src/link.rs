@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use robowire_rt::device::{Connection, Stamped};
 use serde_json::Value;
-use tokio::sync::watch;
+use tokio::sync::{broadcast, watch};
 
 use crate::{DeviceError, Observation};
 
@@ -32,6 +32,8 @@ pub(crate) trait Link: Describe + Send + Sync + 'static {
     fn connection_events(&self) -> watch::Receiver<Connection>;
     /// Wakes at every new state.
     fn changes(&self) -> StateChanges;
+    /// Every state from now on, device-neutral.
+    fn observations(&self) -> Observations;
     /// How long ago the latest state arrived (`None` before the first).
     fn age(&self) -> Option<Duration>;
     /// The latest state, device-neutral.
@@ -92,6 +94,75 @@ impl StateChanges {
     /// Resolves at the next state; `false` once the device is gone.
     pub async fn changed(&mut self) -> bool {
         self.0.changed().await
+    }
+}
+
+/// Every state of a device, in order, as [`Observation`]s.
+pub struct Observations {
+    states: Box<dyn NextObservation>,
+    missed: u64,
+}
+
+impl std::fmt::Debug for Observations {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Observations").field("missed", &self.missed).finish_non_exhaustive()
+    }
+}
+
+/// What [`Observations`] reads: a device's every-state channel and how its states read.
+trait NextObservation: Send {
+    fn next(&mut self) -> Pin<Box<dyn Future<Output = Next> + Send + '_>>;
+}
+
+/// One step of an every-state channel.
+enum Next {
+    State(Observation),
+    Missed(u64),
+    Closed,
+}
+
+struct Every<S, F> {
+    states: broadcast::Receiver<Stamped<S>>,
+    observe: F,
+}
+
+impl<S: Clone + Send + 'static, F: Fn(&S) -> Observation + Send> NextObservation for Every<S, F> {
+    fn next(&mut self) -> Pin<Box<dyn Future<Output = Next> + Send + '_>> {
+        Box::pin(async move {
+            match self.states.recv().await {
+                Ok(stamped) => Next::State((self.observe)(&stamped.state)),
+                Err(broadcast::error::RecvError::Lagged(n)) => Next::Missed(n),
+                Err(broadcast::error::RecvError::Closed) => Next::Closed,
+            }
+        })
+    }
+}
+
+impl Observations {
+    /// Every state of `states`, read by `observe`.
+    pub(crate) fn new<S: Clone + Send + 'static>(
+        states: broadcast::Receiver<Stamped<S>>,
+        observe: impl Fn(&S) -> Observation + Send + 'static,
+    ) -> Self {
+        Self { states: Box::new(Every { states, observe }), missed: 0 }
+    }
+
+    /// The next state; `None` once the device is gone. A reader that fell more than the
+    /// channel's capacity behind skips to the oldest state still there (counted in
+    /// [`missed`](Self::missed)).
+    pub async fn next(&mut self) -> Option<Observation> {
+        loop {
+            match self.states.next().await {
+                Next::State(observation) => return Some(observation),
+                Next::Missed(n) => self.missed += n,
+                Next::Closed => return None,
+            }
+        }
+    }
+
+    /// States skipped because the reader fell behind.
+    pub fn missed(&self) -> u64 {
+        self.missed
     }
 }
 

@@ -10,7 +10,7 @@ use robowire_core::cdr::CdrType;
 use serde_json::Value;
 use tokio::sync::watch;
 
-use crate::link::{Describe, Link, StateChanges, floats};
+use crate::link::{Describe, Link, Observations, StateChanges, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
 use crate::{DeviceError, Observation};
 
@@ -125,6 +125,17 @@ impl Family for Hg {
     }
 }
 
+/// The state, device-neutral, with the LowState itself to pass through.
+fn observation<R: Family>(state: &R::State) -> Observation {
+    let mut observation = R::observe(state);
+    let mut body = vec![0u8; state.body_len()];
+    if let Ok(n) = state.encode_body(&mut body) {
+        body.truncate(n);
+        observation.passthrough = Some(Passthrough { topic: "lowstate", type_name: R::State::TYPE_NAME, body });
+    }
+    observation
+}
+
 impl<R: Family> Describe for LowLevel<R> {
 
     /// The LowState with the IDL field names (as `robowire decode lowstate --json`).
@@ -172,14 +183,11 @@ impl<R: Family> Link for LowLevel<R> {
     }
 
     fn observe(&self) -> Option<Observation> {
-        let state = self.latest()?.state;
-        let mut observation = R::observe(&state);
-        let mut body = vec![0u8; state.body_len()];
-        if let Ok(n) = state.encode_body(&mut body) {
-            body.truncate(n);
-            observation.passthrough = Some(Passthrough { topic: "lowstate", type_name: R::State::TYPE_NAME, body });
-        }
-        Some(observation)
+        Some(observation::<R>(&self.latest()?.state))
+    }
+
+    fn observations(&self) -> Observations {
+        Observations::new(self.every_state(), observation::<R>)
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

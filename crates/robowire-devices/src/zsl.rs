@@ -7,7 +7,7 @@ use serde_json::Value;
 use tokio::sync::watch;
 use zsl::udp::{Device, HighLevel, Model, RobotState};
 
-use crate::link::{Describe, Link, StateChanges, floats};
+use crate::link::{Describe, Link, Observations, StateChanges, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Odometry, wide, xyzw};
 use crate::{DeviceError, Observation};
 
@@ -154,6 +154,11 @@ impl Link for HighLevel {
 
     fn observe(&self) -> Option<Observation> {
         Some(observation(&(&self.latest()?.state).into(), self.options().model))
+    }
+
+    fn observations(&self) -> Observations {
+        let model = self.options().model;
+        Observations::new(self.every_state(), move |state| observation(&state.into(), model))
     }
 
     fn drive(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), DeviceError> {

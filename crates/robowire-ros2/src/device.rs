@@ -98,20 +98,16 @@ pub(crate) async fn run(
         .map(|name| TriggerService::new(node.participant, &ns, name))
         .collect::<Result<_, _>>()?;
     let mut guard = CmdVel::new(&node.options);
-    let mut changes = device.state_changes();
+    let mut observations = device.observations();
     tokio::pin!(stop);
     loop {
         let deadman = guard.guard.deadline().map(tokio::time::Instant::from_std);
         tokio::select! {
             () = &mut stop => return Ok(()),
-            changed = changes.changed() => {
-                if !changed {
-                    return Ok(());
-                }
-                if let Some(observation) = device.observe() {
-                    let published = publish(&node, &mut topics, &observation, stamp_now())?;
-                    report.published(published);
-                }
+            observation = observations.next() => {
+                let Some(observation) = observation else { return Ok(()) };
+                let published = publish(&node, &mut topics, &observation, stamp_now())?;
+                report.published(published);
             }
             sample = async { cmd_vel.as_mut()?.recv().await.ok() }, if cmd_vel.is_some() => {
                 let Some(sample) = sample else { return Ok(()) };

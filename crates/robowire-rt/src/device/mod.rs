@@ -10,7 +10,7 @@ mod receive;
 pub use feed::{EVERY_STATE_CAPACITY, FeedStats, Stamped, StateFeed};
 pub use receive::{Receive, Received, Receiving};
 pub use robowire_core::schedule::Connection;
-use tokio::sync::watch;
+use tokio::sync::{broadcast, watch};
 
 /// What every device facade offers, whatever its link. The latched commands are each device's
 /// own (they say what the robot can do); the way it is opened, observed and closed is this.
@@ -40,9 +40,15 @@ pub trait Device {
         self.receiving().latest()
     }
 
-    /// The latest state as it changes.
+    /// The latest state as it changes (a `watch`: a slow reader sees the newest).
     fn states(&self) -> watch::Receiver<Option<Stamped<Self::State>>> {
         self.receiving().states()
+    }
+
+    /// Every state from now on, in order, stamped with its arrival (for a reader that must see
+    /// each one).
+    fn every_state(&self) -> broadcast::Receiver<Stamped<Self::State>> {
+        self.receiving().every_state()
     }
 
     /// The connection as the watchdog sees it.

@@ -332,12 +332,6 @@ macro_rules! client_accessors {
                 Some((&state.state).into())
             }
 
-            /// Every state datagram from now on, in order, stamped with its arrival (for a
-            /// reader that must see each one; [`Device::states`] coalesces).
-            pub fn every_state(&self) -> tokio::sync::broadcast::Receiver<robowire_rt::device::Stamped<$wire_state>> {
-                self.session.receiving().every_state()
-            }
-
             /// Waits for state, up to `timeout`; whether the client is connected.
             pub async fn wait_connected(&self, timeout: std::time::Duration) -> bool {
                 self.session.receiving().wait_for(timeout, |_| true).await.is_some()
