@@ -1,5 +1,7 @@
 //! robowire project automation, as a library so that its checks also run under `cargo test`.
 
+#![forbid(unsafe_code)]
+
 pub mod bench;
 mod bench_apps;
 pub mod fuzz;

@@ -34,7 +34,7 @@ impl DeviceReport {
     }
 
     pub(crate) fn set_guard(&self, counters: GuardCounters) {
-        *self.guard.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = counters;
+        *robowire_rt::lock(&self.guard) = counters;
     }
 
     /// The counters now.
@@ -42,7 +42,7 @@ impl DeviceReport {
         DeviceCounters {
             published: self.published.load(Ordering::Relaxed),
             service_calls: self.service_calls.load(Ordering::Relaxed),
-            cmd_vel: *self.guard.lock().unwrap_or_else(std::sync::PoisonError::into_inner),
+            cmd_vel: *robowire_rt::lock(&self.guard),
         }
     }
 }

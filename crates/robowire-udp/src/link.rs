@@ -3,9 +3,10 @@
 use std::fmt;
 use std::io;
 use std::net::SocketAddr;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use robowire_core::DatagramCodec;
+use robowire_rt::Latest;
 use robowire_tap::{Direction, Tap};
 use tokio::net::UdpSocket;
 
@@ -52,11 +53,45 @@ impl Peer {
     }
 }
 
-/// The destination, shared by both halves (learned by the receiver on a [`Peer::Any`] link).
-type Destination = Arc<Mutex<Option<SocketAddr>>>;
+/// The destination, shared by both halves: learned by the receiver on a [`Peer::Any`] link, read
+/// by the sender without a lock (a seqlock: the sender may be a stream thread).
+type Destination = Arc<Latest<[u32; 7]>>;
+
+/// A socket address as seven words: family and port, the IP (v4 in the first word), v6 flow
+/// info and scope.
+fn address_words(addr: SocketAddr) -> [u32; 7] {
+    match addr {
+        SocketAddr::V4(v4) => [4 << 16 | u32::from(v4.port()), u32::from(*v4.ip()), 0, 0, 0, 0, 0],
+        SocketAddr::V6(v6) => {
+            let ip = v6.ip().to_bits();
+            let word = |i: u32| (ip >> (96 - 32 * i)) as u32;
+            [6 << 16 | u32::from(v6.port()), word(0), word(1), word(2), word(3), v6.flowinfo(), v6.scope_id()]
+        }
+    }
+}
+
+fn words_address(w: [u32; 7]) -> Option<SocketAddr> {
+    let port = (w[0] & 0xffff) as u16;
+    match w[0] >> 16 {
+        4 => Some(SocketAddr::new(std::net::Ipv4Addr::from(w[1]).into(), port)),
+        6 => {
+            let ip = w[1..5].iter().fold(0u128, |ip, &word| ip << 32 | u128::from(word));
+            Some(SocketAddr::V6(std::net::SocketAddrV6::new(std::net::Ipv6Addr::from_bits(ip), port, w[5], w[6])))
+        }
+        _ => None,
+    }
+}
+
+fn new_destination(initial: Option<SocketAddr>) -> Destination {
+    let shared = Arc::new(Latest::new());
+    if let Some(addr) = initial {
+        shared.write(robowire_rt::now(), &address_words(addr));
+    }
+    shared
+}
 
 fn destination(shared: &Destination) -> Option<SocketAddr> {
-    *shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    shared.read().and_then(|(_, words)| words_address(words))
 }
 
 /// A UDP socket bound to a local address, talking to a [`Peer`] through codec `C`.
@@ -86,7 +121,7 @@ impl<C: DatagramCodec + Clone> UdpLink<C> {
         let sync_socket = std_socket.try_clone()?;
         let socket = Arc::new(UdpSocket::from_std(std_socket)?);
         let counters = Arc::new(Counters::default());
-        let destination: Destination = Arc::new(Mutex::new(peer.initial_destination()));
+        let destination = new_destination(peer.initial_destination());
         let sender = UdpSender {
             socket: socket.clone(),
             sync_socket,
@@ -364,7 +399,10 @@ impl<C: DatagramCodec> UdpReceiver<C> {
         Some(match self.codec.decode(&self.buf[..len]) {
             Ok(message) => {
                 if self.peer.learns() {
-                    *self.destination.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(from);
+                    // Only when it changed: the sender's read never retries on a steady peer.
+                    if destination(&self.destination) != Some(from) {
+                        self.destination.write(robowire_rt::now(), &address_words(from));
+                    }
                 }
                 Ok(message)
             }
@@ -398,5 +436,22 @@ impl<C: DatagramCodec> UdpReceiver<C> {
     /// The codec, for codecs that keep state (to reset it after a timeout, say).
     pub fn codec_mut(&mut self) -> &mut C {
         &mut self.codec
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn addresses_cross_the_seqlock_whole() {
+        for text in ["127.0.0.1:43988", "[::1]:7", "[fe80::1%3]:65535", "0.0.0.0:0"] {
+            let addr: SocketAddr = text.parse().unwrap();
+            assert_eq!(words_address(address_words(addr)), Some(addr), "{text}");
+        }
+        let shared = new_destination(None);
+        assert_eq!(destination(&shared), None);
+        shared.write(robowire_rt::now(), &address_words("10.0.0.2:9".parse().unwrap()));
+        assert_eq!(destination(&shared), Some("10.0.0.2:9".parse().unwrap()));
     }
 }
