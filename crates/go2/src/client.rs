@@ -183,7 +183,8 @@ where
                 (options.participant.clone(), options.service_timeout, ticks.clone());
             move || async move {
                 let participant = Arc::new(Participant::new(participant_options)?);
-                let writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::WRITER)?;
+                // Reliable like Unitree's, but the stream thread's writes never wait.
+                let writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::STREAM_WRITER)?;
                 let reader = participant.reader::<R::State>(R::State::TOPIC, Qos::READER)?;
                 let lowstate = reader.stats_handle();
                 // Their answers are read by tasks of this thread's runtime.

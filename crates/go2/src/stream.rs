@@ -77,9 +77,9 @@ impl<R: Robot> StreamJob<R> {
     }
 
     fn write(&self, command: R::Cmd) {
-        // The encoder zeroes padding and writes the CRC; a failed write is counted, the next
-        // tick writes again.
-        if self.writer.write(command).is_err() {
+        // The encoder zeroes padding and writes the CRC. Never waits: a full send window (a
+        // reader that does not acknowledge) drops this one, counted; the next tick writes again.
+        if self.writer.try_write(command).is_err() {
             self.shared.write_errors.add(1);
         }
     }

@@ -11,4 +11,4 @@ mod topic;
 
 pub use error::DdsError;
 pub use participant::{DiscoveredTopic, Participant, ParticipantOptions};
-pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, Writer};
+pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, WriteRefused, Writer};

@@ -1,5 +1,6 @@
 //! The QoS Unitree's software gets from CycloneDDS's defaults (spec `unitree-dds.md`): writers
 //! reliable (blocking at most 100 ms), keep last 1, volatile; readers best effort, keep last 1.
+//! A stream thread's writer is the same on the wire but never blocks.
 //! A reader of requests or answers keeps a few more samples locally (history depth is not
 //! matched between peers), so that two calls in a row are not one.
 
@@ -11,6 +12,10 @@ use rustdds::{QosPolicies, QosPolicyBuilder};
 pub struct Qos {
     /// Reliable (with the writer's blocking bound) or best effort.
     pub reliable: bool,
+    /// How long a reliable writer's `write` may wait for room in its send window (a reader that
+    /// does not acknowledge), ms; 0: never, a full window refuses the sample at once. Local to
+    /// the writer: it is not matched against readers.
+    pub max_blocking_ms: i64,
     /// Samples kept.
     pub depth: i32,
     /// Transient local: a late-joining reader gets the samples kept (ROS 2's `/tf_static`).
@@ -22,21 +27,24 @@ pub const MAX_BLOCKING_MS: i64 = 100;
 
 impl Qos {
     /// A writer as Unitree's: reliable, keep last 1, volatile.
-    pub const WRITER: Self = Self { reliable: true, depth: 1, transient_local: false };
+    pub const WRITER: Self = Self { reliable: true, max_blocking_ms: MAX_BLOCKING_MS, depth: 1, transient_local: false };
+    /// A writer on a real-time stream thread: as [`WRITER`](Self::WRITER) on the wire, but a
+    /// write never waits (a full send window is a dropped sample, counted).
+    pub const STREAM_WRITER: Self = Self { max_blocking_ms: 0, ..Self::WRITER };
     /// A reader as Unitree's: best effort, keep last 1.
-    pub const READER: Self = Self { reliable: false, depth: 1, transient_local: false };
+    pub const READER: Self = Self { reliable: false, max_blocking_ms: 0, depth: 1, transient_local: false };
     /// A reader of requests or answers: best effort, keep last 16.
-    pub const RPC_READER: Self = Self { reliable: false, depth: 16, transient_local: false };
+    pub const RPC_READER: Self = Self { depth: 16, ..Self::READER };
     /// ROS 2's sensor data profile: best effort, keep last 5.
-    pub const ROS_SENSOR_DATA: Self = Self { reliable: false, depth: 5, transient_local: false };
+    pub const ROS_SENSOR_DATA: Self = Self { depth: 5, ..Self::READER };
     /// ROS 2's default profile (commands, odometry, `/tf`, services): reliable, keep last 10.
-    pub const ROS_DEFAULT: Self = Self { reliable: true, depth: 10, transient_local: false };
+    pub const ROS_DEFAULT: Self = Self { depth: 10, ..Self::WRITER };
     /// ROS 2's `/tf_static`: reliable, keep last 1, transient local.
-    pub const ROS_TF_STATIC: Self = Self { reliable: true, depth: 1, transient_local: true };
+    pub const ROS_TF_STATIC: Self = Self { transient_local: true, ..Self::WRITER };
 
     pub(crate) fn policies(self) -> QosPolicies {
         let reliability = if self.reliable {
-            Reliability::Reliable { max_blocking_time: rustdds::Duration::from_millis(MAX_BLOCKING_MS) }
+            Reliability::Reliable { max_blocking_time: rustdds::Duration::from_millis(self.max_blocking_ms) }
         } else {
             Reliability::BestEffort
         };

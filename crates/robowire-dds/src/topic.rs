@@ -18,6 +18,8 @@ pub struct TopicStats {
     pub samples: u64,
     /// Writes that failed.
     pub write_errors: u64,
+    /// Samples a never-blocking writer dropped because its send window was full.
+    pub dropped: u64,
     /// Received samples whose body did not decode (checksum failures not included).
     pub decode_errors: u64,
     /// Received samples whose integrity check (CRC) failed.
@@ -28,6 +30,7 @@ pub struct TopicStats {
 struct Counters {
     samples: AtomicU64,
     write_errors: AtomicU64,
+    dropped: AtomicU64,
     decode_errors: AtomicU64,
     checksum_errors: AtomicU64,
 }
@@ -41,6 +44,7 @@ impl Counters {
         TopicStats {
             samples: self.samples.load(Ordering::Relaxed),
             write_errors: self.write_errors.load(Ordering::Relaxed),
+            dropped: self.dropped.load(Ordering::Relaxed),
             decode_errors: self.decode_errors.load(Ordering::Relaxed),
             checksum_errors: self.checksum_errors.load(Ordering::Relaxed),
         }
@@ -58,8 +62,21 @@ impl StatsHandle {
     }
 }
 
-/// Writes `T` to one topic. Usable from any thread; a write never waits for a reader (keep
-/// last 1).
+/// Why [`Writer::try_write`] did not publish a sample (counted; nothing allocated).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum WriteRefused {
+    /// The send window was full (a reliable reader that does not acknowledge): dropped.
+    #[error("the send window is full; the sample was dropped")]
+    WindowFull,
+    /// The middleware failed (its threads gone, the encoder refused).
+    #[error("the middleware refused the sample")]
+    Failed,
+}
+
+/// Writes `T` to one topic. Usable from any thread. With a reliable QoS, a `write` may wait up to
+/// the QoS's blocking bound while a reader does not acknowledge; a stream thread uses
+/// [`Qos::STREAM_WRITER`](crate::qos::Qos::STREAM_WRITER) and [`try_write`](Self::try_write),
+/// which never waits.
 pub struct Writer<T: CdrType + 'static> {
     inner: DataWriter<T, CdrAdapter<T>>,
     topic: String,
@@ -89,6 +106,25 @@ impl<T: CdrType + 'static> Writer<T> {
             Err(e) => {
                 Counters::bump(&self.counters.write_errors);
                 Err(DdsError::Write { topic: self.topic.clone(), source: e.forget_data() })
+            }
+        }
+    }
+
+    /// Publishes `sample` without ever waiting (with [`Qos::STREAM_WRITER`](crate::qos::Qos::STREAM_WRITER)):
+    /// a full send window drops it. No allocation on a refusal. For stream threads.
+    pub fn try_write(&self, sample: T) -> Result<(), WriteRefused> {
+        match self.inner.write(sample, None) {
+            Ok(()) => {
+                Counters::bump(&self.counters.samples);
+                Ok(())
+            }
+            Err(rustdds::dds::WriteError::WouldBlock { .. }) => {
+                Counters::bump(&self.counters.dropped);
+                Err(WriteRefused::WindowFull)
+            }
+            Err(_) => {
+                Counters::bump(&self.counters.write_errors);
+                Err(WriteRefused::Failed)
             }
         }
     }
