@@ -6,6 +6,8 @@ pub mod codec;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod decode_roundtrip;
+#[cfg(feature = "serde")]
+pub mod description;
 pub mod rules;
 #[cfg(feature = "serde")]
 mod serde_impl;
