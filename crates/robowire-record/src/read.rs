@@ -98,9 +98,11 @@ fn raw_channel(
         }
     };
     let protocol = field("protocol")?;
-    let description = known.iter().copied().find(|d| d.protocol() == protocol).ok_or_else(|| {
-        ReadError::UnknownProtocol { topic: channel.topic.clone(), protocol: protocol.clone() }
-    })?;
+    let description = known
+        .iter()
+        .copied()
+        .find(|d| d.protocol() == protocol)
+        .ok_or_else(|| ReadError::UnknownProtocol { topic: channel.topic.clone(), protocol: protocol.clone() })?;
     Ok((field("link")?.clone(), direction, description))
 }
 
@@ -124,7 +126,13 @@ pub fn read_frames(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Re
             continue;
         }
         let (link, direction, protocol) = raw_channel(&message.channel, known)?;
-        frames.push(RecordedFrame { link, direction, protocol, unix_ns: message.log_time, bytes: message.data.into_owned() });
+        frames.push(RecordedFrame {
+            link,
+            direction,
+            protocol,
+            unix_ns: message.log_time,
+            bytes: message.data.into_owned(),
+        });
     }
     Ok(frames)
 }

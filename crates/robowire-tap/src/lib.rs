@@ -87,7 +87,8 @@ impl TapRing {
     /// A ring of `slots` slots (at least one), every one allocated now: about
     /// `slots × (SLOT_BYTES + 32)` bytes.
     pub fn with_slots(slots: usize) -> Self {
-        let ring = Ring { slots: ArrayQueue::new(slots.max(1)), counters: TapCounters::default(), closed: false.into() };
+        let ring =
+            Ring { slots: ArrayQueue::new(slots.max(1)), counters: TapCounters::default(), closed: false.into() };
         Self { ring: Arc::new(ring) }
     }
 
@@ -158,8 +159,13 @@ impl Tap {
             counters.dropped.fetch_add(1, Ordering::Relaxed);
             return;
         }
-        let mut frame =
-            TappedFrame { link: self.link, direction, monotonic_ns: robowire_rt::monotonic_ns(), len, slot: [0; SLOT_BYTES] };
+        let mut frame = TappedFrame {
+            link: self.link,
+            direction,
+            monotonic_ns: robowire_rt::monotonic_ns(),
+            len,
+            slot: [0; SLOT_BYTES],
+        };
         frame.slot[..bytes.len()].copy_from_slice(bytes);
         let counter = match self.ring.slots.push(frame) {
             Ok(()) => &counters.recorded,

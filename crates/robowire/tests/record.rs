@@ -153,7 +153,8 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     let _ = sim.kill();
     let _ = sim.wait();
 
-    let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap())
+    let zsl = zsl_proto::description::DESCRIPTIONS;
+    let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap(), &zsl)
         .unwrap()
         .into_iter()
         .filter_map(|f| match AnyDatagram::decode(&f.bytes) {
@@ -180,7 +181,9 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
         let options = zsl::udp::ClientOptions::high_level([127, 0, 0, 26].into(), 0, [127, 0, 0, 27].into());
         let client = zsl::udp::HighLevel::connect(options).await.unwrap();
         let mut updates = client.state_updates();
-        let mut seen = Vec::new();
+        // The replay starts on the client's first command: its first state (the one mode-1 state
+        // of the recording, 0.4 ms before the first mode-18 one) may already be in.
+        let mut seen: Vec<_> = updates.borrow_and_update().iter().copied().collect();
         // Until the replay has gone quiet for a second.
         while let Ok(Ok(())) = tokio::time::timeout(std::time::Duration::from_secs(1), updates.changed()).await {
             if let Some(state) = *updates.borrow_and_update() {
