@@ -199,8 +199,8 @@ impl WriterState {
             if stopping {
                 ring.close();
             }
-            while let Some(frame) = ring.pop() {
-                self.write(&frame)?;
+            while let Some(written) = ring.pop(|frame| self.write(frame)) {
+                written?;
             }
             if stopping {
                 return self.close();

@@ -13,8 +13,10 @@ pub use robowire_core::Direction;
 /// ([`TapCounters::oversize`]), never recorded in part.
 pub const SLOT_BYTES: usize = 2304;
 
+/// A slot's bytes.
+type Slot = Box<[u8; SLOT_BYTES]>;
+
 /// One frame as it was on the wire, in its slot.
-#[derive(Clone)]
 pub struct TappedFrame {
     /// The link, as the recorder numbered it.
     pub link: u16,
@@ -23,7 +25,7 @@ pub struct TappedFrame {
     /// When the tap took it: `CLOCK_MONOTONIC`, ns ([`robowire_rt::monotonic_ns`]).
     pub monotonic_ns: u64,
     len: u16,
-    slot: [u8; SLOT_BYTES],
+    slot: Slot,
 }
 
 impl TappedFrame {
@@ -69,15 +71,19 @@ impl TapCounters {
     }
 }
 
+/// The slots, each either free or holding a frame for the recorder: a frame moves between the
+/// two queues by its slot's pointer, and only its own bytes are copied.
 #[derive(Debug)]
 struct Ring {
-    slots: ArrayQueue<TappedFrame>,
+    free: ArrayQueue<Slot>,
+    filled: ArrayQueue<TappedFrame>,
     counters: TapCounters,
     closed: AtomicBool,
 }
 
 /// A recorder's ring: preallocated slots of [`SLOT_BYTES`], filled by any number of [`Tap`]s
-/// (lock-free: crossbeam's `ArrayQueue`), emptied by the recorder.
+/// and emptied by the recorder, lock-free both ways (two of crossbeam's `ArrayQueue`s: the free
+/// slots and the filled ones).
 #[derive(Debug, Clone)]
 pub struct TapRing {
     ring: Arc<Ring>,
@@ -85,10 +91,15 @@ pub struct TapRing {
 
 impl TapRing {
     /// A ring of `slots` slots (at least one), every one allocated now: about
-    /// `slots × (SLOT_BYTES + 32)` bytes.
+    /// `slots × (SLOT_BYTES + 48)` bytes.
     pub fn with_slots(slots: usize) -> Self {
+        let slots = slots.max(1);
+        let free = ArrayQueue::new(slots);
+        for _ in 0..slots {
+            let _ = free.push(Box::new([0; SLOT_BYTES]));
+        }
         let ring =
-            Ring { slots: ArrayQueue::new(slots.max(1)), counters: TapCounters::default(), closed: false.into() };
+            Ring { free, filled: ArrayQueue::new(slots), counters: TapCounters::default(), closed: false.into() };
         Self { ring: Arc::new(ring) }
     }
 
@@ -97,9 +108,14 @@ impl TapRing {
         Tap { link, ring: self.ring.clone() }
     }
 
-    /// The oldest frame in the ring (frames of one tap come out in the order it took them).
-    pub fn pop(&self) -> Option<TappedFrame> {
-        self.ring.slots.pop()
+    /// Hands the oldest frame in the ring to `read`, then frees its slot; `None` if the ring
+    /// is empty. Frames of one tap come out in the order it took them.
+    pub fn pop<R>(&self, read: impl FnOnce(&TappedFrame) -> R) -> Option<R> {
+        let frame = self.ring.filled.pop()?;
+        let result = read(&frame);
+        // Never full: there are as many places as slots.
+        let _ = self.ring.free.push(frame.slot);
+        Some(result)
     }
 
     /// Refuses frames from now on (each tap drops and counts them); those in the ring stay.
@@ -114,7 +130,7 @@ impl TapRing {
 
     /// How many frames the ring holds at most.
     pub fn slots(&self) -> usize {
-        self.ring.slots.capacity()
+        self.ring.filled.capacity()
     }
 }
 
@@ -159,19 +175,21 @@ impl Tap {
             counters.dropped.fetch_add(1, Ordering::Relaxed);
             return;
         }
-        let mut frame = TappedFrame {
-            link: self.link,
-            direction,
-            monotonic_ns: robowire_rt::monotonic_ns(),
-            len,
-            slot: [0; SLOT_BYTES],
+        let monotonic_ns = robowire_rt::monotonic_ns();
+        let Some(mut slot) = self.ring.free.pop() else {
+            counters.dropped.fetch_add(1, Ordering::Relaxed);
+            return;
         };
-        frame.slot[..bytes.len()].copy_from_slice(bytes);
-        let counter = match self.ring.slots.push(frame) {
-            Ok(()) => &counters.recorded,
-            Err(_) => &counters.dropped,
+        slot[..bytes.len()].copy_from_slice(bytes);
+        let frame = TappedFrame { link: self.link, direction, monotonic_ns, len, slot };
+        match self.ring.filled.push(frame) {
+            Ok(()) => counters.recorded.fetch_add(1, Ordering::Relaxed),
+            // Never full: a filled frame holds one of the slots. Should it be, the slot goes back.
+            Err(frame) => {
+                let _ = self.ring.free.push(frame.slot);
+                counters.dropped.fetch_add(1, Ordering::Relaxed)
+            }
         };
-        counter.fetch_add(1, Ordering::Relaxed);
     }
 }
 
@@ -185,12 +203,15 @@ mod tests {
         let (a, b) = (ring.tap(1), ring.tap(2));
         a.record(Direction::Sent, &[1]);
         b.record(Direction::Received, &[2, 2]);
-        let first = ring.pop().unwrap();
-        let second = ring.pop().unwrap();
-        assert!(ring.pop().is_none());
-        let got = [&first, &second].map(|f| (f.link, f.direction, f.bytes().to_vec()));
-        assert_eq!(got, [(1, Direction::Sent, vec![1]), (2, Direction::Received, vec![2, 2])]);
-        assert!(first.monotonic_ns <= second.monotonic_ns);
+        let read = |f: &TappedFrame| (f.link, f.direction, f.bytes().to_vec(), f.monotonic_ns);
+        let first = ring.pop(read).unwrap();
+        let second = ring.pop(read).unwrap();
+        assert!(ring.pop(read).is_none());
+        assert_eq!(
+            [&first, &second].map(|f| (f.0, f.1, f.2.clone())),
+            [(1, Direction::Sent, vec![1]), (2, Direction::Received, vec![2, 2])]
+        );
+        assert!(first.3 <= second.3);
         assert_ne!(a, b);
         assert_eq!(a, a.clone());
     }
@@ -207,10 +228,15 @@ mod tests {
         let c = ring.counters();
         assert_eq!((c.recorded(), c.dropped(), c.oversize()), (2, 3, 2));
         // The ring kept the first two: nothing is overwritten.
-        assert_eq!([ring.pop().unwrap().bytes(), ring.pop().unwrap().bytes()], [&[0][..], &[1][..]]);
-        // A whole slot is not oversize.
+        let bytes = |f: &TappedFrame| f.bytes().to_vec();
+        assert_eq!([ring.pop(bytes), ring.pop(bytes)], [Some(vec![0]), Some(vec![1])]);
+        // Their slots are free again; a whole slot is not oversize, and a shorter frame in a
+        // used slot is its own bytes only.
         tap.record(Direction::Sent, &[9; SLOT_BYTES]);
-        assert_eq!(ring.pop().unwrap().bytes(), &[9; SLOT_BYTES][..]);
+        tap.record(Direction::Sent, &[7; 3]);
+        assert_eq!(ring.pop(bytes), Some(vec![9; SLOT_BYTES]));
+        assert_eq!(ring.pop(bytes), Some(vec![7; 3]));
+        assert_eq!(ring.counters().recorded(), 4);
     }
 
     #[test]
@@ -221,8 +247,8 @@ mod tests {
         ring.close();
         tap.record(Direction::Received, &[2]);
         assert_eq!((ring.counters().recorded(), ring.counters().dropped()), (1, 1));
-        assert_eq!(ring.pop().unwrap().bytes(), [1]);
-        assert!(ring.pop().is_none());
+        assert_eq!(ring.pop(|f| f.bytes().to_vec()), Some(vec![1]));
+        assert!(ring.pop(|_| ()).is_none());
     }
 
     #[test]
@@ -238,10 +264,11 @@ mod tests {
                 let mut popped = 0u64;
                 loop {
                     let done = stop.load(Ordering::Acquire);
-                    while let Some(frame) = ring.pop() {
-                        let n = u32::from_le_bytes(frame.bytes().try_into().unwrap());
-                        let last = &mut last[usize::from(frame.link)];
-                        assert!(last.is_none_or(|l| l < n), "link {}: {n} after {last:?}", frame.link);
+                    while let Some((link, n)) =
+                        ring.pop(|f| (f.link, u32::from_le_bytes(f.bytes().try_into().unwrap())))
+                    {
+                        let last = &mut last[usize::from(link)];
+                        assert!(last.is_none_or(|l| l < n), "link {link}: {n} after {last:?}");
                         *last = Some(n);
                         popped += 1;
                     }
