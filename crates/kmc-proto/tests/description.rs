@@ -2,7 +2,7 @@
 //! direction it travels, to its schema name and the fixture's fields; the other frame set's
 //! decoder refuses it where the two differ; any bytes give JSON or a typed error.
 
-use kmc_proto::description::{ChassisLink, DESCRIPTIONS, HostLink};
+use kmc_proto::description::{CHASSIS, DESCRIPTIONS, HOST};
 use proptest::prelude::*;
 use robowire_core::Direction;
 use robowire_core::json::LinkDescription;
@@ -49,7 +49,7 @@ fn golden_frames_decode_on_the_end_and_direction_they_travel() {
             "chassis->host" => (Direction::Received, Direction::Sent),
             other => panic!("{name}: direction {other}"),
         };
-        for (description, direction) in [(&HostLink as &dyn LinkDescription, host), (&ChassisLink, chassis)] {
+        for (description, direction) in [(&HOST as &dyn LinkDescription, host), (&CHASSIS, chassis)] {
             let frame = description.decode(direction, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
             let expected = schema_of_frame(fields["frame"].as_str().unwrap());
             assert_eq!(frame.schema, expected, "{name}");
@@ -61,10 +61,10 @@ fn golden_frames_decode_on_the_end_and_direction_they_travel() {
 #[test]
 fn a_frame_read_the_wrong_way_is_a_typed_error() {
     let speed_response = [0xb3, 0x00, 0x00, 0xa0, 0x3f];
-    let error = HostLink.decode(Direction::Sent, &speed_response).unwrap_err();
+    let error = HOST.decode(Direction::Sent, &speed_response).unwrap_err();
     assert_eq!(error.to_string(), "5 bytes are not a kmc.host frame");
     assert!(std::error::Error::source(&error).is_some());
-    assert!(ChassisLink.decode(Direction::Received, &[0xa5, 0, 0]).is_err(), "a truncated control frame");
+    assert!(CHASSIS.decode(Direction::Received, &[0xa5, 0, 0]).is_err(), "a truncated control frame");
 }
 
 proptest! {

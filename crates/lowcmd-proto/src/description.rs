@@ -1,32 +1,32 @@
 //! Unitree DDS links described to a recorder (feature `serde`). A frame is a DDS serialized
 //! payload as it travels: the 4-byte encapsulation header (XCDR1 or XCDR2), then the CDR body.
 //!
-//! - [`Go2LowLevel`] (`unitree_go.low_level`) and [`HgLowLevel`] (`unitree_hg.low_level`):
+//! - [`GO2_LOW_LEVEL`] (`unitree_go.low_level`) and [`HG_LOW_LEVEL`] (`unitree_hg.low_level`):
 //!   `rt/lowcmd` and `rt/lowstate`; `LowCmd_` and `LowState_` differ in length in either
 //!   encoding, so a frame is whichever its length says, decoded strictly (CRC checked) and named
 //!   by its DDS type (`unitree_go::msg::dds_::LowState_`), with the IDL field names.
-//! - [`ApiClient`] (`unitree_api.client`) and [`ApiServer`] (`unitree_api.server`): a service's
+//! - [`API_CLIENT`] (`unitree_api.client`) and [`API_SERVER`] (`unitree_api.server`): a service's
 //!   `rt/api/<service>/request` and `/response`, recorded at the caller or at the service; which
 //!   of `Request_` and `Response_` a frame is follows from the end and the direction.
 //!
 //! ```
-//! use lowcmd_proto::description::Go2LowLevel;
+//! use lowcmd_proto::description::GO2_LOW_LEVEL;
 //! use lowcmd_proto::{CdrEncoding, LowState, Message};
 //! use robowire_core::Direction;
 //! use robowire_core::json::LinkDescription;
 //!
 //! let mut payload = [0u8; 1188];
 //! let n = LowState::default().encode_cdr(CdrEncoding::Xcdr2, &mut payload).unwrap();
-//! let frame = Go2LowLevel.decode(Direction::Received, &payload[..n]).unwrap();
+//! let frame = GO2_LOW_LEVEL.decode(Direction::Received, &payload[..n]).unwrap();
 //! assert_eq!(frame.schema, "unitree_go::msg::dds_::LowState_");
 //! assert_eq!(frame.value["motor_state"].as_array().map(Vec::len), Some(20));
-//! assert!(Go2LowLevel.decode(Direction::Received, &payload[..n - 1]).is_err());
+//! assert!(GO2_LOW_LEVEL.decode(Direction::Received, &payload[..n - 1]).is_err());
 //! ```
 
 use robowire_core::Direction;
 use robowire_core::cdr::CdrEncoding;
 use robowire_core::json::serde_json::json;
-use robowire_core::json::{FrameError, JsonFrame, LinkDescription};
+use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
 
 use crate::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
 use crate::{DecodeError, HgLowCmd, HgLowState, LowCmd, LowState, Message};
@@ -37,26 +37,32 @@ const LOW_LEVEL_LAYOUT: &str = "unitree-lowlevel over unitree-dds, CDR payload w
 const API_LAYOUT: &str = "unitree-dds services, CDR payload with its encapsulation header";
 
 /// A Go2's low-level link (`unitree_go.low_level`): `unitree_go` `LowCmd_` and `LowState_`.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Go2LowLevel;
+pub static GO2_LOW_LEVEL: LinkProtocol =
+    LinkProtocol { name: "unitree_go.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<LowCmd, LowState> };
 
 /// An HG robot's (G1's) low-level link (`unitree_hg.low_level`): `unitree_hg` `LowCmd_` and
 /// `LowState_`.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct HgLowLevel;
+pub static HG_LOW_LEVEL: LinkProtocol =
+    LinkProtocol { name: "unitree_hg.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<HgLowCmd, HgLowState> };
 
 /// A service link recorded at the caller (`unitree_api.client`): it sends `Request_` and
 /// receives `Response_`.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct ApiClient;
+pub static API_CLIENT: LinkProtocol = LinkProtocol {
+    name: "unitree_api.client",
+    layout: API_LAYOUT,
+    decode: |p, direction, f| call(p, direction == Direction::Sent, f),
+};
 
 /// A service link recorded at the service (`unitree_api.server`): it receives `Request_` and
 /// sends `Response_`.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct ApiServer;
+pub static API_SERVER: LinkProtocol = LinkProtocol {
+    name: "unitree_api.server",
+    layout: API_LAYOUT,
+    decode: |p, direction, f| call(p, direction == Direction::Received, f),
+};
 
 /// Every Unitree DDS link.
-pub static DESCRIPTIONS: [&dyn LinkDescription; 4] = [&Go2LowLevel, &HgLowLevel, &ApiClient, &ApiServer];
+pub static DESCRIPTIONS: [&dyn LinkDescription; 4] = [&GO2_LOW_LEVEL, &HG_LOW_LEVEL, &API_CLIENT, &API_SERVER];
 
 /// A payload whose length is neither the command's nor the state's in its encoding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -74,12 +80,12 @@ pub struct LowLevelLength {
 
 /// `frame` as the message `M`, CRC checked.
 fn message<M: Message + serde::Serialize>(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError> {
-    let (message, _) = M::decode_cdr(frame).map_err(|e| FrameError::decode(protocol, frame, e.without_message()))?;
-    JsonFrame::serialize(protocol, M::DDS_TYPE_NAME, &message)
+    let decode = |f: &[u8]| M::decode_cdr(f).map(|(m, _)| m).map_err(DecodeError::without_message);
+    JsonFrame::parse(protocol, frame, decode, |_| M::DDS_TYPE_NAME)
 }
 
-/// `frame` as the command `C` or the state `S`, whichever its length is.
-fn low_level<C, S>(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError>
+/// `frame` as the command `C` or the state `S`, whichever its length is (either way).
+fn low_level<C, S>(protocol: &'static str, _: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError>
 where
     C: Message + serde::Serialize,
     S: Message + serde::Serialize,
@@ -114,6 +120,11 @@ fn body<'a>(protocol: &'static str, frame: &'a [u8]) -> Result<&'a [u8], FrameEr
     }
 }
 
+/// A `Request_` payload (`is_request`) or a `Response_` one, with the IDL's nesting.
+fn call(protocol: &'static str, is_request: bool, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    if is_request { request(protocol, frame) } else { response(protocol, frame) }
+}
+
 /// A `Request_` payload, with the IDL's nesting.
 fn request(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError> {
     let r = Request::decode_body(body(protocol, frame)?).map_err(|e| FrameError::decode(protocol, frame, e))?;
@@ -139,66 +150,4 @@ fn response(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameErro
         "binary": r.binary,
     });
     Ok(JsonFrame { schema: RESPONSE_TYPE_NAME, value })
-}
-
-impl LinkDescription for Go2LowLevel {
-    fn protocol(&self) -> &'static str {
-        "unitree_go.low_level"
-    }
-
-    fn layout(&self) -> &'static str {
-        LOW_LEVEL_LAYOUT
-    }
-
-    fn decode(&self, _: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
-        low_level::<LowCmd, LowState>(self.protocol(), frame)
-    }
-}
-
-impl LinkDescription for HgLowLevel {
-    fn protocol(&self) -> &'static str {
-        "unitree_hg.low_level"
-    }
-
-    fn layout(&self) -> &'static str {
-        LOW_LEVEL_LAYOUT
-    }
-
-    fn decode(&self, _: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
-        low_level::<HgLowCmd, HgLowState>(self.protocol(), frame)
-    }
-}
-
-impl LinkDescription for ApiClient {
-    fn protocol(&self) -> &'static str {
-        "unitree_api.client"
-    }
-
-    fn layout(&self) -> &'static str {
-        API_LAYOUT
-    }
-
-    fn decode(&self, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
-        match direction {
-            Direction::Sent => request(self.protocol(), frame),
-            Direction::Received => response(self.protocol(), frame),
-        }
-    }
-}
-
-impl LinkDescription for ApiServer {
-    fn protocol(&self) -> &'static str {
-        "unitree_api.server"
-    }
-
-    fn layout(&self) -> &'static str {
-        API_LAYOUT
-    }
-
-    fn decode(&self, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
-        match direction {
-            Direction::Sent => response(self.protocol(), frame),
-            Direction::Received => request(self.protocol(), frame),
-        }
-    }
 }

@@ -3,7 +3,7 @@
 //! requests and answers by what they are; any bytes give JSON or a typed error.
 
 use lowcmd_proto::api::{self, Request, RequestHeader, Response};
-use lowcmd_proto::description::{ApiClient, ApiServer, DESCRIPTIONS, Go2LowLevel, HgLowLevel};
+use lowcmd_proto::description::{API_CLIENT, API_SERVER, DESCRIPTIONS, GO2_LOW_LEVEL, HG_LOW_LEVEL};
 use lowcmd_proto::{CdrEncoding, HgLowCmd, HgLowState, LowCmd, LowState, Message};
 use proptest::prelude::*;
 use robowire_core::Direction;
@@ -34,7 +34,7 @@ fn golden_payloads_decode_to_their_type_and_the_vendors_fields() {
     assert!(payloads.len() >= 8);
     for payload in payloads {
         let (name, bytes) = (&payload["name"], hex(payload["cdr_hex"].as_str().unwrap()));
-        let frame = Go2LowLevel.decode(Direction::Received, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let frame = GO2_LOW_LEVEL.decode(Direction::Received, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(frame.schema, payload["dds_type_name"], "{name}");
         let fields = source(payload["source_vector"].as_str().unwrap());
         let expected = match frame.schema {
@@ -42,7 +42,7 @@ fn golden_payloads_decode_to_their_type_and_the_vendors_fields() {
             _ => fields_as_json::<LowState>(&fields),
         };
         assert_eq!(frame.value, expected, "{name}");
-        assert_eq!(Go2LowLevel.schema(&frame)["properties"]["crc"]["type"], "integer");
+        assert_eq!(GO2_LOW_LEVEL.schema(&frame)["properties"]["crc"]["type"], "integer");
     }
 }
 
@@ -55,24 +55,24 @@ fn hg_messages_decode_by_their_length_in_either_encoding() {
     let mut out = [0u8; 2200];
     for encoding in [CdrEncoding::Xcdr1, CdrEncoding::Xcdr2] {
         let n = state.encode_cdr(encoding, &mut out).unwrap();
-        let frame = HgLowLevel.decode(Direction::Received, &out[..n]).unwrap();
+        let frame = HG_LOW_LEVEL.decode(Direction::Received, &out[..n]).unwrap();
         assert_eq!(
             (frame.schema, &frame.value["motor_state"][3]["q"]),
             ("unitree_hg::msg::dds_::LowState_", &json!(0.5))
         );
         let n = command.encode_cdr(encoding, &mut out).unwrap();
-        let frame = HgLowLevel.decode(Direction::Sent, &out[..n]).unwrap();
+        let frame = HG_LOW_LEVEL.decode(Direction::Sent, &out[..n]).unwrap();
         assert_eq!((frame.schema, &frame.value["mode_pr"]), ("unitree_hg::msg::dds_::LowCmd_", &json!(1)));
         // A Go2 link does not take an HG message for one of its own.
-        assert!(Go2LowLevel.decode(Direction::Sent, &out[..n]).is_err());
+        assert!(GO2_LOW_LEVEL.decode(Direction::Sent, &out[..n]).is_err());
     }
     let n = state.encode_cdr(CdrEncoding::Xcdr1, &mut out).unwrap();
     out[n - 1] ^= 1;
-    let error = HgLowLevel.decode(Direction::Received, &out[..n]).unwrap_err();
+    let error = HG_LOW_LEVEL.decode(Direction::Received, &out[..n]).unwrap_err();
     assert_eq!(error.to_string(), format!("{n} bytes are not a unitree_hg.low_level frame"));
     let why = std::error::Error::source(&error).unwrap().to_string();
     assert!(why.contains("CRC mismatch"), "{why}");
-    let error = HgLowLevel.decode(Direction::Received, &out[..n - 1]).unwrap_err();
+    let error = HG_LOW_LEVEL.decode(Direction::Received, &out[..n - 1]).unwrap_err();
     assert!(std::error::Error::source(&error).unwrap().to_string().contains("LowCmd_ is 1004"), "{error:?}");
 }
 
@@ -92,7 +92,7 @@ fn service_requests_and_answers_decode_on_the_end_and_direction_they_travel() {
         payload(|out| Request { header, parameter: r#"{"name":"ai"}"#, binary: &[1, 2] }.encode_body(out).unwrap());
     let answer = payload(|out| Response::to(&header, 0, r#"{"form":"0","name":"ai"}"#).encode_body(out).unwrap());
     for (description, sent, received) in
-        [(&ApiClient as &dyn LinkDescription, &request, &answer), (&ApiServer, &answer, &request)]
+        [(&API_CLIENT as &dyn LinkDescription, &request, &answer), (&API_SERVER, &answer, &request)]
     {
         let frame = description.decode(Direction::Sent, sent).unwrap();
         let back = description.decode(Direction::Received, received).unwrap();
@@ -110,9 +110,9 @@ fn service_requests_and_answers_decode_on_the_end_and_direction_they_travel() {
     }
     let mut bad = request.clone();
     bad[1] = 0x09;
-    let error = ApiClient.decode(Direction::Sent, &bad).unwrap_err();
+    let error = API_CLIENT.decode(Direction::Sent, &bad).unwrap_err();
     assert!(std::error::Error::source(&error).unwrap().to_string().contains("unknown CDR encapsulation"), "{error:?}");
-    assert!(ApiClient.decode(Direction::Sent, &request[..3]).is_err());
+    assert!(API_CLIENT.decode(Direction::Sent, &request[..3]).is_err());
 }
 
 proptest! {

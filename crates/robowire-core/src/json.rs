@@ -2,7 +2,8 @@
 //! called, which layout its frames follow, and how one of its frames reads as JSON, with a JSON
 //! schema. Each codec crate describes its links behind its `serde` feature; an application
 //! registers the descriptions it knows with a recorder, which holds them as
-//! `&'static dyn LinkDescription` and knows no device.
+//! `&'static dyn LinkDescription` and knows no device. A codec declares each link as a
+//! [`LinkProtocol`] (name, layout, decode function); the example implements the trait itself.
 //!
 //! ```
 //! use robowire_core::Direction;
@@ -70,6 +71,31 @@ pub trait LinkDescription: core::fmt::Debug + Send + Sync {
     }
 }
 
+/// A [`LinkDescription`] from its parts: what each codec declares its links with.
+#[derive(Debug, Clone, Copy)]
+pub struct LinkProtocol {
+    /// The protocol's name ([`LinkDescription::protocol`]).
+    pub name: &'static str,
+    /// The layout its frames follow ([`LinkDescription::layout`]).
+    pub layout: &'static str,
+    /// [`LinkDescription::decode`], given the protocol's name for its errors.
+    pub decode: fn(name: &'static str, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError>,
+}
+
+impl LinkDescription for LinkProtocol {
+    fn protocol(&self) -> &'static str {
+        self.name
+    }
+
+    fn layout(&self) -> &'static str {
+        self.layout
+    }
+
+    fn decode(&self, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+        (self.decode)(self.name, direction, frame)
+    }
+}
+
 /// A frame as JSON.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JsonFrame {
@@ -80,6 +106,18 @@ pub struct JsonFrame {
 }
 
 impl JsonFrame {
+    /// `frame` read by the codec's `parse`, as JSON under the schema name `schema` gives the
+    /// message; the codec's error is a [`FrameError::Decode`] of `protocol`.
+    pub fn parse<M: serde::Serialize, E: Error + Send + Sync + 'static>(
+        protocol: &'static str,
+        frame: &[u8],
+        parse: impl FnOnce(&[u8]) -> Result<M, E>,
+        schema: impl FnOnce(&M) -> &'static str,
+    ) -> Result<Self, FrameError> {
+        let message = parse(frame).map_err(|e| FrameError::decode(protocol, frame, e))?;
+        Self::serialize(protocol, schema(&message), &message)
+    }
+
     /// `message` as JSON under `schema`; a serializer's failure is a [`FrameError::Json`] of
     /// `protocol`.
     pub fn serialize<T: serde::Serialize + ?Sized>(

@@ -13,7 +13,7 @@ use robowire_record::{Direction, Recorder};
 use robowire_sim::dog::{DogSim, DogSimConfig};
 use serde_json::json;
 use zsl::udp::{ClientOptions, HighLevel};
-use zsl_proto::description::HighLevelDatagrams;
+use zsl_proto::description::HIGH_LEVEL;
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
 fn temp(name: &str) -> std::path::PathBuf {
@@ -30,7 +30,7 @@ fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32
             ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into())
         };
         if let Some(recorder) = &recorder {
-            options = options.with_tap(recorder.link("dog/high_level", &HighLevelDatagrams));
+            options = options.with_tap(recorder.link("dog/high_level", &HIGH_LEVEL));
         }
         let dog = HighLevel::connect(options).await.unwrap();
         assert!(dog.wait_connected(Duration::from_secs(2)).await);
@@ -70,7 +70,7 @@ fn main() {
         HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() }.encode();
     let path = temp("throughput");
     let recorder = Recorder::create(&path, "bench").unwrap();
-    let tap = recorder.link("dog/high_level", &HighLevelDatagrams);
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
     let start = Instant::now();
     for _ in 0..frames {
         tap.record(Direction::Received, &state);

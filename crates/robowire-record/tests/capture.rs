@@ -8,7 +8,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use proptest::prelude::*;
 use robowire_record::{Direction, ReadError, Recorder, read_frames, summarize};
 use robowire_tap::SLOT_BYTES;
-use zsl_proto::description::{DESCRIPTIONS, HighLevelDatagrams};
+use zsl_proto::description::{DESCRIPTIONS, HIGH_LEVEL};
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model};
 
 fn unix_ns() -> u64 {
@@ -20,7 +20,7 @@ fn capture(frames: &[(Direction, Vec<u8>)]) -> Vec<u8> {
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(format!("robowire-capture-{}-{n}.mcap", std::process::id()));
     let recorder = Recorder::create(&path, "test").unwrap();
-    let tap = recorder.link("dog/high_level", &HighLevelDatagrams);
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
     for (direction, bytes) in frames {
         tap.record(*direction, bytes);
     }
@@ -98,7 +98,7 @@ fn a_capture_written_before_link_descriptions_still_reads() {
 fn an_oversize_frame_is_counted_apart_and_the_rest_recorded() {
     let path = std::env::temp_dir().join(format!("robowire-capture-{}-oversize.mcap", std::process::id()));
     let recorder = Recorder::create(&path, "test").unwrap();
-    let tap = recorder.link("dog/high_level", &HighLevelDatagrams);
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
     tap.record(Direction::Received, &[0; SLOT_BYTES + 1]);
     tap.record(Direction::Sent, &HighLevelCommand::stand_up().encode(Model::Zsl1));
     assert_eq!(recorder.oversize(), 1);

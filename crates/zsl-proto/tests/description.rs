@@ -5,7 +5,7 @@ use proptest::prelude::*;
 use robowire_core::Direction;
 use robowire_core::json::LinkDescription;
 use serde_json::{Value, json};
-use zsl_proto::description::{DESCRIPTIONS, HighLevelDatagrams, LowLevelDatagrams};
+use zsl_proto::description::{DESCRIPTIONS, HIGH_LEVEL, LOW_LEVEL};
 
 /// The golden datagrams: (the vendor call or state it is, its bytes).
 fn golden() -> Vec<(String, Vec<u8>)> {
@@ -59,7 +59,7 @@ fn golden_datagrams_decode_to_their_schema_and_fields() {
 
 #[test]
 fn a_state_without_its_magic_is_a_typed_error() {
-    let error = LowLevelDatagrams.decode(Direction::Received, &datagram("LowLevel state without 0x5AA5")).unwrap_err();
+    let error = LOW_LEVEL.decode(Direction::Received, &datagram("LowLevel state without 0x5AA5")).unwrap_err();
     assert_eq!(error.to_string(), "272 bytes are not a zsl1.low_level frame");
     let source = std::error::Error::source(&error).map(ToString::to_string);
     assert!(source.is_some_and(|s| s.contains("magic")), "{error:?}");
@@ -74,7 +74,7 @@ proptest! {
         prop::collection::vec(any::<u8>(), 272),
         prop::collection::vec(any::<u8>(), 560),
     ]) {
-        let decoded = HighLevelDatagrams.decode(Direction::Received, &bytes);
+        let decoded = HIGH_LEVEL.decode(Direction::Received, &bytes);
         if ![40, 248, 272, 560].contains(&bytes.len()) {
             prop_assert!(decoded.is_err());
         }

@@ -12,7 +12,7 @@ use anyhow::Context;
 use robowire_record::{LinkDescription, RecordedFrame};
 use robowire_udp::{Peer, UdpLink};
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
-use zsl_proto::description::{DESCRIPTIONS, LowLevelDatagrams};
+use zsl_proto::description::{DESCRIPTIONS, LOW_LEVEL};
 use zsl_proto::udp::{AnyDatagram, HIGH_LEVEL_PORT, LOW_LEVEL_PORT};
 
 /// Which datagrams are the device's: the states of a ZSL-1 link, whichever side recorded them.
@@ -43,7 +43,7 @@ pub(crate) fn run(
     let first = states.first().with_context(|| format!("link {link} has no device frames"))?;
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
-        if first.protocol.protocol() == LowLevelDatagrams.protocol() {
+        if first.protocol.protocol() == LOW_LEVEL.protocol() {
             play(SocketAddr::new(bind, LOW_LEVEL_PORT), LowLevelDogCodec::default(), &link, &states, speed).await
         } else {
             play(SocketAddr::new(bind, HIGH_LEVEL_PORT), HighLevelDogCodec::default(), &link, &states, speed).await
