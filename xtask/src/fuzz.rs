@@ -45,7 +45,11 @@ pub const TARGETS: &[Target] = &[
         check: lowcmd_proto::decode_roundtrip::cdr_decode,
     },
     Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::decode_roundtrip::datagram_decode },
-    Target { name: "mcap_replay_read", seeds: capture_seeds, check: robowire_record::fuzz_read },
+    Target {
+        name: "mcap_replay_read",
+        seeds: capture_seeds,
+        check: |bytes| robowire_record::fuzz_read(bytes, &zsl_proto::description::DESCRIPTIONS),
+    },
 ];
 
 /// Which datagrams a capture seed keeps.
@@ -68,8 +72,8 @@ fn capture_seeds() -> Seeds {
         .map(|(name, keep)| {
             let path = std::env::temp_dir().join(format!("robowire-fuzz-{name}-{}.mcap", std::process::id()));
             let recorder = robowire_record::Recorder::create(&path, "cargo xtask fuzz (seed)")?;
-            let high = recorder.link("dog/high_level", robowire_record::Protocol::ZslHighLevel);
-            let low = recorder.link("dog/low_level", robowire_record::Protocol::ZslLowLevel);
+            let high = recorder.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL);
+            let low = recorder.link("dog/low_level", &zsl_proto::description::LOW_LEVEL);
             for (i, (_, bytes)) in datagrams.iter().enumerate().filter(|(_, (_, d))| keep(d)) {
                 let tap = if low_level(bytes) { &low } else { &high };
                 let direction =

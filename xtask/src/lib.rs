@@ -2,6 +2,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod architecture;
 pub mod bench;
 mod bench_apps;
 pub mod fuzz;

@@ -5,6 +5,8 @@
 mod af;
 mod control;
 mod decoder;
+#[cfg(feature = "serde")]
+pub mod description;
 mod error;
 mod frame;
 #[cfg(feature = "serde")]

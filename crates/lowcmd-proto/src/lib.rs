@@ -8,6 +8,8 @@ pub mod crc;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod decode_roundtrip;
+#[cfg(feature = "serde")]
+pub mod description;
 mod error;
 pub mod go2;
 pub mod hg;

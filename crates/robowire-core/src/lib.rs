@@ -4,6 +4,8 @@
 
 pub mod cdr;
 mod datagram;
+#[cfg(feature = "json")]
+pub mod json;
 pub mod le;
 pub mod schedule;
 #[cfg(feature = "serde")]
@@ -14,6 +16,25 @@ pub mod timing;
 
 pub use datagram::DatagramCodec;
 pub use stream::{DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};
+
+/// Which way a frame went, seen from the end of the link that owns it (the one recording it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Direction {
+    /// Written by this end.
+    Sent,
+    /// Read by this end.
+    Received,
+}
+
+impl Direction {
+    /// `sent` or `received`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sent => "sent",
+            Self::Received => "received",
+        }
+    }
+}
 
 /// A float argument that must be finite is NaN or infinite. Every facade refuses such a value
 /// before anything is queued or sent.

@@ -3,16 +3,17 @@
 //! - the ZSL-1 HighLevel command stream's send lateness (2 ms period, the client's own figures)
 //!   with its link recorded and without, against the simulated dog, alternating;
 //! - the recorder's throughput: 560-byte states tapped as fast as one thread can, written raw
-//!   and decoded to JSON; frames/s and MB/s of what was written, and what the queue dropped.
+//!   and decoded to JSON; frames/s and MB/s of what was written, and what the ring dropped.
 //!
 //! Figures to `ROBOWIRE_BENCH_META_RECORD` for `cargo xtask bench`.
 
 use std::time::{Duration, Instant};
 
-use robowire_record::{Direction, Protocol, Recorder};
+use robowire_record::{Direction, Recorder};
 use robowire_sim::dog::{DogSim, DogSimConfig};
 use serde_json::json;
 use zsl::udp::{ClientOptions, Device, HighLevel};
+use zsl_proto::description::HIGH_LEVEL;
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
 
 fn temp(name: &str) -> std::path::PathBuf {
@@ -29,7 +30,7 @@ fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32
             ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into())
         };
         if let Some(recorder) = &recorder {
-            options = options.with_tap(recorder.link("dog/high_level", Protocol::ZslHighLevel));
+            options = options.with_tap(recorder.link("dog/high_level", &HIGH_LEVEL));
         }
         let dog = HighLevel::open(options).unwrap();
         assert!(dog.wait_connected(Duration::from_secs(2)).await);
@@ -69,7 +70,7 @@ fn main() {
         HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() }.encode();
     let path = temp("throughput");
     let recorder = Recorder::create(&path, "bench").unwrap();
-    let tap = recorder.link("dog/high_level", Protocol::ZslHighLevel);
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
     let start = Instant::now();
     for _ in 0..frames {
         tap.record(Direction::Received, &state);

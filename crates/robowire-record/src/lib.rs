@@ -1,24 +1,23 @@
 #![doc = include_str!("../README.md")]
 
 mod framing;
-mod protocol;
 mod read;
-mod schema;
 mod write;
 
-pub use protocol::Protocol;
 pub use read::{CaptureSummary, ChannelSummary, ReadError, RecordedFrame, read_frames, summarize};
+pub use robowire_core::json::{FrameError, JsonFrame, LinkDescription};
 pub use robowire_tap::{Direction, Tap};
 pub use write::{RecordError, Recorder, RecordingSummary};
 
 /// The message encoding of the raw channels: the frame's bytes, as on the wire.
 pub const RAW_ENCODING: &str = "robowire.raw";
 
-/// The replay reader's check for the fuzz target: any bytes read as a capture give frames or a
-/// typed error, never a panic; what reads as frames also summarizes.
-pub fn fuzz_read(bytes: &[u8]) {
-    let frames = read_frames(bytes);
-    let summary = summarize(bytes);
+/// The replay reader's check for the fuzz target: any bytes read as a capture, with the
+/// descriptions `known`, give frames or a typed error, never a panic; what reads as frames also
+/// summarizes.
+pub fn fuzz_read(bytes: &[u8], known: &[&'static dyn LinkDescription]) {
+    let frames = read_frames(bytes, known);
+    let summary = summarize(bytes, known);
     if let (Ok(frames), Ok(summary)) = (frames, summary) {
         let raw: u64 = summary.channels.iter().filter(|c| c.encoding == RAW_ENCODING).map(|c| c.count).sum();
         assert_eq!(raw, frames.len() as u64, "the summary counts every raw frame read");

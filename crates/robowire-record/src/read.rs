@@ -2,10 +2,10 @@
 
 use std::collections::BTreeMap;
 
+use robowire_core::json::{FrameError, JsonFrame, LinkDescription};
 use robowire_tap::Direction;
 
 use crate::RAW_ENCODING;
-use crate::protocol::Protocol;
 
 /// Why a capture could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -27,7 +27,7 @@ pub enum ReadError {
         /// What should have been there.
         expected: String,
     },
-    /// A raw channel whose metadata names no direction or protocol robowire knows.
+    /// A raw channel whose metadata lacks its link, direction or protocol.
     #[error("channel {topic}: {reason}")]
     Channel {
         /// The channel's topic.
@@ -35,21 +35,75 @@ pub enum ReadError {
         /// What is wrong.
         reason: String,
     },
+    /// A raw channel of a protocol no description the application registered has: its frames
+    /// cannot be told apart, and are not guessed at.
+    #[error("channel {topic}: protocol {protocol:?} is not one this application describes")]
+    UnknownProtocol {
+        /// The channel's topic.
+        topic: String,
+        /// The protocol its metadata names.
+        protocol: String,
+    },
 }
 
 /// One frame as recorded.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub struct RecordedFrame {
     /// The link's name (`dog/high_level`).
     pub link: String,
     /// Sent or received, from the recording side.
     pub direction: Direction,
-    /// What it carries.
-    pub protocol: Protocol,
+    /// The description of the link's protocol, among those the reader was given.
+    pub protocol: &'static dyn LinkDescription,
     /// When, ns since the Unix epoch.
     pub unix_ns: u64,
     /// The bytes as on the wire.
     pub bytes: Vec<u8>,
+}
+
+impl RecordedFrame {
+    /// The frame as JSON, by its link's description.
+    pub fn decode(&self) -> Result<JsonFrame, FrameError> {
+        self.protocol.decode(self.direction, &self.bytes)
+    }
+}
+
+/// Equal frames: same link, direction, protocol name, time and bytes.
+impl PartialEq for RecordedFrame {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.link, self.direction, self.protocol.protocol(), self.unix_ns, &self.bytes)
+            == (&other.link, other.direction, other.protocol.protocol(), other.unix_ns, &other.bytes)
+    }
+}
+
+impl Eq for RecordedFrame {}
+
+/// What the metadata of a raw channel says: link, direction, and the description of its
+/// protocol among `known`.
+fn raw_channel(
+    channel: &mcap::Channel<'_>,
+    known: &[&'static dyn LinkDescription],
+) -> Result<(String, Direction, &'static dyn LinkDescription), ReadError> {
+    let field = |key: &str| {
+        channel.metadata.get(key).ok_or_else(|| ReadError::Channel {
+            topic: channel.topic.clone(),
+            reason: format!("no {key} in its metadata"),
+        })
+    };
+    let direction = match field("direction")?.as_str() {
+        "sent" => Direction::Sent,
+        "received" => Direction::Received,
+        other => {
+            return Err(ReadError::Channel { topic: channel.topic.clone(), reason: format!("direction {other:?}") });
+        }
+    };
+    let protocol = field("protocol")?;
+    let description = known
+        .iter()
+        .copied()
+        .find(|d| d.protocol() == protocol)
+        .ok_or_else(|| ReadError::UnknownProtocol { topic: channel.topic.clone(), protocol: protocol.clone() })?;
+    Ok((field("link")?.clone(), direction, description))
 }
 
 fn mcap_error(len: usize) -> impl Fn(mcap::McapError) -> ReadError {
@@ -61,38 +115,19 @@ fn validate(capture: &[u8]) -> Result<(), ReadError> {
     crate::framing::check(capture).map_err(|b| ReadError::Corrupt { offset: b.offset, expected: b.expected })
 }
 
-/// The raw frames of a capture, in file order (time order per link).
-pub fn read_frames(capture: &[u8]) -> Result<Vec<RecordedFrame>, ReadError> {
+/// The raw frames of a capture, in file order (time order per link). `known` are the
+/// descriptions the application registers; a link of another protocol is an error.
+pub fn read_frames(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Result<Vec<RecordedFrame>, ReadError> {
     validate(capture)?;
     let mut frames = Vec::new();
     for message in mcap::MessageStream::new(capture).map_err(mcap_error(capture.len()))? {
         let message = message.map_err(mcap_error(capture.len()))?;
-        let channel = &message.channel;
-        if channel.message_encoding != RAW_ENCODING {
+        if message.channel.message_encoding != RAW_ENCODING {
             continue;
         }
-        let field = |key: &str| {
-            channel.metadata.get(key).ok_or_else(|| ReadError::Channel {
-                topic: channel.topic.clone(),
-                reason: format!("no {key} in its metadata"),
-            })
-        };
-        let direction = match field("direction")?.as_str() {
-            "sent" => Direction::Sent,
-            "received" => Direction::Received,
-            other => {
-                return Err(ReadError::Channel {
-                    topic: channel.topic.clone(),
-                    reason: format!("direction {other:?}"),
-                });
-            }
-        };
-        let protocol = Protocol::from_name(field("protocol")?).ok_or_else(|| ReadError::Channel {
-            topic: channel.topic.clone(),
-            reason: format!("unknown protocol {:?}", channel.metadata.get("protocol")),
-        })?;
+        let (link, direction, protocol) = raw_channel(&message.channel, known)?;
         frames.push(RecordedFrame {
-            link: field("link")?.clone(),
+            link,
             direction,
             protocol,
             unix_ns: message.log_time,
@@ -119,7 +154,7 @@ pub struct ChannelSummary {
     pub max_gap_ns: u64,
     /// Log times that went backwards.
     pub out_of_order: u64,
-    /// Raw frames that do not decode as their protocol.
+    /// Raw frames that do not decode by their link's description.
     pub decode_errors: u64,
 }
 
@@ -132,17 +167,22 @@ pub struct CaptureSummary {
     pub channels: Vec<ChannelSummary>,
 }
 
-/// Channels, counts, rates, gaps and decode errors of a capture.
-pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
+/// Channels, counts, rates, gaps and decode errors of a capture. `known` are the descriptions
+/// the application registers; a link of another protocol is an error.
+pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Result<CaptureSummary, ReadError> {
     validate(capture)?;
-    let mut channels: BTreeMap<String, (ChannelSummary, Option<Protocol>)> = BTreeMap::new();
+    type Decoder = Option<(Direction, &'static dyn LinkDescription)>;
+    let mut channels: BTreeMap<String, (ChannelSummary, Decoder)> = BTreeMap::new();
     for message in mcap::MessageStream::new(capture).map_err(mcap_error(capture.len()))? {
         let message = message.map_err(mcap_error(capture.len()))?;
         let channel = &message.channel;
-        let (summary, protocol) = channels.entry(channel.topic.clone()).or_insert_with(|| {
-            let protocol = (channel.message_encoding == RAW_ENCODING)
-                .then(|| channel.metadata.get("protocol").and_then(|p| Protocol::from_name(p)))
-                .flatten();
+        if !channels.contains_key(&channel.topic) {
+            let decoder = if channel.message_encoding == RAW_ENCODING {
+                let (_, direction, description) = raw_channel(channel, known)?;
+                Some((direction, description))
+            } else {
+                None
+            };
             let summary = ChannelSummary {
                 topic: channel.topic.clone(),
                 encoding: channel.message_encoding.clone(),
@@ -153,8 +193,9 @@ pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
                 out_of_order: 0,
                 decode_errors: 0,
             };
-            (summary, protocol)
-        });
+            channels.insert(channel.topic.clone(), (summary, decoder));
+        }
+        let Some((summary, decoder)) = channels.get_mut(&channel.topic) else { continue };
         let last = summary.span_ns.1;
         if summary.count > 0 {
             if message.log_time < last {
@@ -165,8 +206,8 @@ pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
         }
         summary.span_ns.1 = summary.span_ns.1.max(message.log_time);
         summary.count += 1;
-        if let Some(protocol) = protocol
-            && protocol.decode(&message.data).is_err()
+        if let Some((direction, description)) = decoder
+            && description.decode(*direction, &message.data).is_err()
         {
             summary.decode_errors += 1;
         }

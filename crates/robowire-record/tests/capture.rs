@@ -1,21 +1,31 @@
-//! A capture holds every tapped frame byte for byte, in order, with its direction and time; any
-//! truncation or corruption of it is a typed error, never a panic.
+//! A capture holds every tapped frame byte for byte, in order, with its direction and time; it
+//! reads back with the descriptions the application knows, and a protocol none of them has is a
+//! typed error; captures written before descriptions still read; any truncation or corruption
+//! of a capture is a typed error, never a panic.
+
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use proptest::prelude::*;
-use robowire_record::{Direction, Protocol, Recorder, read_frames, summarize};
+use robowire_record::{Direction, ReadError, Recorder, read_frames, summarize};
+use robowire_tap::SLOT_BYTES;
+use zsl_proto::description::{DESCRIPTIONS, HIGH_LEVEL};
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model};
+
+fn unix_ns() -> u64 {
+    SystemTime::now().duration_since(UNIX_EPOCH).unwrap().as_nanos() as u64
+}
 
 fn capture(frames: &[(Direction, Vec<u8>)]) -> Vec<u8> {
     static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(format!("robowire-capture-{}-{n}.mcap", std::process::id()));
     let recorder = Recorder::create(&path, "test").unwrap();
-    let tap = recorder.link("dog/high_level", Protocol::ZslHighLevel);
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
     for (direction, bytes) in frames {
         tap.record(*direction, bytes);
     }
     let summary = recorder.finish().unwrap();
-    assert_eq!((summary.frames, summary.dropped), (frames.len() as u64, 0));
+    assert_eq!((summary.frames, summary.dropped, summary.oversize), (frames.len() as u64, 0, 0));
     let bytes = std::fs::read(&path).unwrap();
     let _ = std::fs::remove_file(path);
     bytes
@@ -34,18 +44,76 @@ fn session() -> Vec<(Direction, Vec<u8>)> {
 }
 
 #[test]
-fn frames_come_back_byte_for_byte_in_order() {
+fn frames_come_back_byte_for_byte_in_order_at_unix_time() {
     let frames = session();
-    let read = read_frames(&capture(&frames)).unwrap();
+    let before = unix_ns();
+    let capture = capture(&frames);
+    let after = unix_ns();
+    let read = read_frames(&capture, &DESCRIPTIONS).unwrap();
     let got: Vec<_> = read.iter().map(|f| (f.direction, f.bytes.clone())).collect();
     assert_eq!(got, frames);
     assert!(read.windows(2).all(|w| w[0].unix_ns <= w[1].unix_ns));
-    assert!(read.iter().all(|f| f.link == "dog/high_level" && f.protocol == Protocol::ZslHighLevel));
+    assert!(read.iter().all(|f| f.link == "dog/high_level" && f.protocol.protocol() == "zsl1.high_level"));
+    // The taps' monotonic stamps, logged at Unix time (1 ms of slack for the clocks' reads).
+    assert!(read.iter().all(|f| (before - 1_000_000..=after + 1_000_000).contains(&f.unix_ns)), "{before} {after}");
+    assert_eq!(read[0].decode().unwrap().schema, "zsl1.HighLevelCommand");
+}
+
+#[test]
+fn a_protocol_nobody_described_is_an_error_naming_it() {
+    let capture = capture(&session());
+    for result in [read_frames(&capture, &[]).map(|_| ()), summarize(&capture, &[]).map(|_| ())] {
+        match result {
+            Err(e @ ReadError::UnknownProtocol { .. }) => {
+                assert!(e.to_string().contains("protocol \"zsl1.high_level\""), "{e}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_capture_written_before_link_descriptions_still_reads() {
+    // Written by the recorder whose protocols were a closed enum; never regenerated.
+    let capture = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/before-descriptions.mcap")).unwrap();
+    let frames = read_frames(&capture, &DESCRIPTIONS).unwrap();
+    let protocols: Vec<_> = frames.iter().map(|f| (f.link.as_str(), f.protocol.protocol(), f.bytes.len())).collect();
+    assert_eq!(
+        protocols,
+        [
+            ("dog/high_level", "zsl1.high_level", 40),
+            ("dog/high_level", "zsl1.high_level", 560),
+            ("dog/high_level", "zsl1.high_level", 3),
+            ("dog/low_level", "zsl1.low_level", 272)
+        ]
+    );
+    let schemas: Vec<_> = frames.iter().map(|f| f.decode().map(|j| j.schema).ok()).collect();
+    assert_eq!(schemas, [Some("zsl1.HighLevelCommand"), Some("zsl1.HighLevelState"), None, Some("zsl1.LowLevelState")]);
+    let summary = summarize(&capture, &DESCRIPTIONS).unwrap();
+    assert_eq!(summary.metadata["link:dog/low_level"], "zsl1.low_level (zsl1-udp, vendor SDK v0.2.7)");
+    assert_eq!(summary.channels.iter().map(|c| c.decode_errors).sum::<u64>(), 1);
+}
+
+#[test]
+fn an_oversize_frame_is_counted_apart_and_the_rest_recorded() {
+    let path = std::env::temp_dir().join(format!("robowire-capture-{}-oversize.mcap", std::process::id()));
+    let recorder = Recorder::create(&path, "test").unwrap();
+    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
+    tap.record(Direction::Received, &[0; SLOT_BYTES + 1]);
+    tap.record(Direction::Sent, &HighLevelCommand::stand_up().encode(Model::Zsl1));
+    assert_eq!(recorder.oversize(), 1);
+    let summary = recorder.finish().unwrap();
+    assert_eq!((summary.frames, summary.dropped, summary.oversize), (1, 0, 1));
+    // A tap used after the recorder finished drops and counts; nothing waits.
+    tap.record(Direction::Sent, &[1]);
+    let frames = read_frames(&std::fs::read(&path).unwrap(), &DESCRIPTIONS).unwrap();
+    assert_eq!(frames.len(), 1);
+    let _ = std::fs::remove_file(path);
 }
 
 #[test]
 fn the_summary_counts_channels_and_decode_errors() {
-    let summary = summarize(&capture(&session())).unwrap();
+    let summary = summarize(&capture(&session()), &DESCRIPTIONS).unwrap();
     let topic = |t: &str| summary.channels.iter().find(|c| c.topic == t).unwrap_or_else(|| panic!("{t}: {summary:?}"));
     assert_eq!(topic("/dog/high_level/sent/raw").count, 2);
     assert_eq!(topic("/dog/high_level/received/raw").count, 2);
@@ -59,8 +127,8 @@ fn the_summary_counts_channels_and_decode_errors() {
 fn every_truncation_is_an_error_or_a_prefix_never_a_panic() {
     let whole = capture(&session());
     for len in 0..whole.len() {
-        let _ = summarize(&whole[..len]);
-        if let Ok(frames) = read_frames(&whole[..len]) {
+        let _ = summarize(&whole[..len], &DESCRIPTIONS);
+        if let Ok(frames) = read_frames(&whole[..len], &DESCRIPTIONS) {
             assert!(frames.len() <= 4);
         }
     }
@@ -74,13 +142,11 @@ proptest! {
             let i = at.index(bytes.len());
             bytes[i] = value;
         }
-        let _ = read_frames(&bytes);
-        let _ = summarize(&bytes);
+        robowire_record::fuzz_read(&bytes, &DESCRIPTIONS);
     }
 
     #[test]
     fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
-        let _ = read_frames(&bytes);
-        let _ = summarize(&bytes);
+        robowire_record::fuzz_read(&bytes, &DESCRIPTIONS);
     }
 }

@@ -1,92 +1,144 @@
 #![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
-/// Which way a frame went, seen from the link's owner.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Direction {
-    /// Written by this side.
-    Sent,
-    /// Read by this side.
-    Received,
-}
+use crossbeam_queue::ArrayQueue;
+pub use robowire_core::Direction;
 
-impl Direction {
-    /// `sent` or `received`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sent => "sent",
-            Self::Received => "received",
-        }
-    }
-}
+/// Bytes one slot holds: the largest frame robowire records, a Unitree HG `LowState_` DDS
+/// payload (2100 bytes in XCDR2, 2092 in XCDR1), with room to spare. A Go2 `LowState_` is 1188,
+/// a ZSL-1 HighLevel state 560, a KMC frame at most 84. A longer frame is counted
+/// ([`TapCounters::oversize`]), never recorded in part.
+pub const SLOT_BYTES: usize = 2304;
 
-/// One frame as it was on the wire.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// A slot's bytes.
+type Slot = Box<[u8; SLOT_BYTES]>;
+
+/// One frame as it was on the wire, in its slot.
 pub struct TappedFrame {
     /// The link, as the recorder numbered it.
     pub link: u16,
     /// Sent or received.
     pub direction: Direction,
-    /// When, ns since the Unix epoch (`CLOCK_REALTIME`).
-    pub unix_ns: u64,
-    /// The bytes, exactly.
-    pub bytes: Vec<u8>,
+    /// When the tap took it: `CLOCK_MONOTONIC`, ns ([`robowire_rt::monotonic_ns`]).
+    pub monotonic_ns: u64,
+    len: u16,
+    slot: Slot,
 }
 
-/// What the taps of one queue did.
+impl TappedFrame {
+    /// The bytes, exactly.
+    pub fn bytes(&self) -> &[u8] {
+        &self.slot[..usize::from(self.len)]
+    }
+}
+
+impl std::fmt::Debug for TappedFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TappedFrame")
+            .field("link", &self.link)
+            .field("direction", &self.direction)
+            .field("monotonic_ns", &self.monotonic_ns)
+            .field("len", &self.len)
+            .finish_non_exhaustive()
+    }
+}
+
+/// What the taps of one ring did.
 #[derive(Debug, Default)]
 pub struct TapCounters {
     recorded: AtomicU64,
     dropped: AtomicU64,
+    oversize: AtomicU64,
 }
 
 impl TapCounters {
-    /// Frames queued for the recorder.
+    /// Frames put into the ring.
     pub fn recorded(&self) -> u64 {
         self.recorded.load(Ordering::Relaxed)
     }
 
-    /// Frames dropped because the queue was full (or the recorder gone).
+    /// Frames dropped because the ring was full (the recorder fell behind) or closed.
     pub fn dropped(&self) -> u64 {
         self.dropped.load(Ordering::Relaxed)
     }
+
+    /// Frames dropped because they are longer than a slot ([`SLOT_BYTES`]).
+    pub fn oversize(&self) -> u64 {
+        self.oversize.load(Ordering::Relaxed)
+    }
 }
 
-/// The sending side of a recorder's queue; hands out a [`Tap`] per link.
+/// The slots, each either free or holding a frame for the recorder: a frame moves between the
+/// two queues by its slot's pointer, and only its own bytes are copied.
+#[derive(Debug)]
+struct Ring {
+    free: ArrayQueue<Slot>,
+    filled: ArrayQueue<TappedFrame>,
+    counters: TapCounters,
+    closed: AtomicBool,
+}
+
+/// A recorder's ring: preallocated slots of [`SLOT_BYTES`], filled by any number of [`Tap`]s
+/// and emptied by the recorder, lock-free both ways (two of crossbeam's `ArrayQueue`s: the free
+/// slots and the filled ones).
 #[derive(Debug, Clone)]
-pub struct TapQueue {
-    tx: SyncSender<TappedFrame>,
-    counters: Arc<TapCounters>,
+pub struct TapRing {
+    ring: Arc<Ring>,
 }
 
-impl TapQueue {
-    /// A queue of `capacity` frames and its receiving end.
-    pub fn bounded(capacity: usize) -> (Self, Receiver<TappedFrame>) {
-        let (tx, rx) = sync_channel(capacity);
-        (Self { tx, counters: Arc::default() }, rx)
+impl TapRing {
+    /// A ring of `slots` slots (at least one), every one allocated now: about
+    /// `slots × (SLOT_BYTES + 48)` bytes.
+    pub fn with_slots(slots: usize) -> Self {
+        let slots = slots.max(1);
+        let free = ArrayQueue::new(slots);
+        for _ in 0..slots {
+            let _ = free.push(Box::new([0; SLOT_BYTES]));
+        }
+        let ring =
+            Ring { free, filled: ArrayQueue::new(slots), counters: TapCounters::default(), closed: false.into() };
+        Self { ring: Arc::new(ring) }
     }
 
     /// A tap for link number `link`.
     pub fn tap(&self, link: u16) -> Tap {
-        Tap { link, tx: self.tx.clone(), counters: self.counters.clone() }
+        Tap { link, ring: self.ring.clone() }
     }
 
-    /// The counters of every tap of this queue.
+    /// Hands the oldest frame in the ring to `read`, then frees its slot; `None` if the ring
+    /// is empty. Frames of one tap come out in the order it took them.
+    pub fn pop<R>(&self, read: impl FnOnce(&TappedFrame) -> R) -> Option<R> {
+        let frame = self.ring.filled.pop()?;
+        let result = read(&frame);
+        // Never full: there are as many places as slots.
+        let _ = self.ring.free.push(frame.slot);
+        Some(result)
+    }
+
+    /// Refuses frames from now on (each tap drops and counts them); those in the ring stay.
+    pub fn close(&self) {
+        self.ring.closed.store(true, Ordering::Release);
+    }
+
+    /// The counters of every tap of this ring.
     pub fn counters(&self) -> &TapCounters {
-        &self.counters
+        &self.ring.counters
+    }
+
+    /// How many frames the ring holds at most.
+    pub fn slots(&self) -> usize {
+        self.ring.filled.capacity()
     }
 }
 
-/// A link's tap: [`record`](Self::record) never blocks.
+/// A link's tap: [`record`](Self::record) never blocks, allocates or reads the wall clock.
 #[derive(Clone)]
 pub struct Tap {
     link: u16,
-    tx: SyncSender<TappedFrame>,
-    counters: Arc<TapCounters>,
+    ring: Arc<Ring>,
 }
 
 impl std::fmt::Debug for Tap {
@@ -95,10 +147,10 @@ impl std::fmt::Debug for Tap {
     }
 }
 
-/// Two taps are equal when they feed the same queue as the same link.
+/// Two taps are equal when they feed the same ring as the same link.
 impl PartialEq for Tap {
     fn eq(&self, other: &Self) -> bool {
-        self.link == other.link && Arc::ptr_eq(&self.counters, &other.counters)
+        self.link == other.link && Arc::ptr_eq(&self.ring, &other.ring)
     }
 }
 
@@ -110,16 +162,34 @@ impl Tap {
         self.link
     }
 
-    /// Hands a copy of `bytes` to the recorder, stamped now; drops it (counted) if the queue is
-    /// full.
+    /// Copies `bytes` into a slot of the ring, stamped now on the monotonic clock. A frame
+    /// longer than [`SLOT_BYTES`] is counted as oversize; one that finds the ring full or closed
+    /// is counted as dropped.
     pub fn record(&self, direction: Direction, bytes: &[u8]) {
-        let unix_ns = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
-        let frame = TappedFrame { link: self.link, direction, unix_ns, bytes: bytes.to_vec() };
-        let counter = match self.tx.try_send(frame) {
-            Ok(()) => &self.counters.recorded,
-            Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => &self.counters.dropped,
+        let counters = &self.ring.counters;
+        let Some(len) = u16::try_from(bytes.len()).ok().filter(|_| bytes.len() <= SLOT_BYTES) else {
+            counters.oversize.fetch_add(1, Ordering::Relaxed);
+            return;
         };
-        counter.fetch_add(1, Ordering::Relaxed);
+        if self.ring.closed.load(Ordering::Acquire) {
+            counters.dropped.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        let monotonic_ns = robowire_rt::monotonic_ns();
+        let Some(mut slot) = self.ring.free.pop() else {
+            counters.dropped.fetch_add(1, Ordering::Relaxed);
+            return;
+        };
+        slot[..bytes.len()].copy_from_slice(bytes);
+        let frame = TappedFrame { link: self.link, direction, monotonic_ns, len, slot };
+        match self.ring.filled.push(frame) {
+            Ok(()) => counters.recorded.fetch_add(1, Ordering::Relaxed),
+            // Never full: a filled frame holds one of the slots. Should it be, the slot goes back.
+            Err(frame) => {
+                let _ = self.ring.free.push(frame.slot);
+                counters.dropped.fetch_add(1, Ordering::Relaxed)
+            }
+        };
     }
 }
 
@@ -128,23 +198,97 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_gone_recorder_drops_and_counts() {
-        let (queue, frames) = TapQueue::bounded(4);
-        let tap = queue.tap(1);
-        drop(frames);
-        tap.record(Direction::Received, &[1]);
-        assert_eq!(queue.counters().dropped(), 1);
+    fn frames_keep_their_link_direction_bytes_and_order() {
+        let ring = TapRing::with_slots(8);
+        let (a, b) = (ring.tap(1), ring.tap(2));
+        a.record(Direction::Sent, &[1]);
+        b.record(Direction::Received, &[2, 2]);
+        let read = |f: &TappedFrame| (f.link, f.direction, f.bytes().to_vec(), f.monotonic_ns);
+        let first = ring.pop(read).unwrap();
+        let second = ring.pop(read).unwrap();
+        assert!(ring.pop(read).is_none());
+        assert_eq!(
+            [&first, &second].map(|f| (f.0, f.1, f.2.clone())),
+            [(1, Direction::Sent, vec![1]), (2, Direction::Received, vec![2, 2])]
+        );
+        assert!(first.3 <= second.3);
+        assert_ne!(a, b);
+        assert_eq!(a, a.clone());
     }
 
     #[test]
-    fn frames_keep_their_link_direction_and_order() {
-        let (queue, frames) = TapQueue::bounded(8);
-        let (a, b) = (queue.tap(1), queue.tap(2));
-        a.record(Direction::Sent, &[1]);
-        b.record(Direction::Received, &[2, 2]);
-        let got: Vec<_> = frames.try_iter().map(|f| (f.link, f.direction, f.bytes)).collect();
-        assert_eq!(got, [(1, Direction::Sent, vec![1]), (2, Direction::Received, vec![2, 2])]);
-        assert_ne!(a, b);
-        assert_eq!(a, a.clone());
+    fn a_full_ring_drops_and_an_oversize_frame_is_its_own_count() {
+        let ring = TapRing::with_slots(2);
+        let tap = ring.tap(0);
+        for n in 0..5u8 {
+            tap.record(Direction::Sent, &[n]);
+        }
+        tap.record(Direction::Sent, &[0; SLOT_BYTES + 1]);
+        tap.record(Direction::Sent, &vec![0; usize::from(u16::MAX) + 1]);
+        let c = ring.counters();
+        assert_eq!((c.recorded(), c.dropped(), c.oversize()), (2, 3, 2));
+        // The ring kept the first two: nothing is overwritten.
+        let bytes = |f: &TappedFrame| f.bytes().to_vec();
+        assert_eq!([ring.pop(bytes), ring.pop(bytes)], [Some(vec![0]), Some(vec![1])]);
+        // Their slots are free again; a whole slot is not oversize, and a shorter frame in a
+        // used slot is its own bytes only.
+        tap.record(Direction::Sent, &[9; SLOT_BYTES]);
+        tap.record(Direction::Sent, &[7; 3]);
+        assert_eq!(ring.pop(bytes), Some(vec![9; SLOT_BYTES]));
+        assert_eq!(ring.pop(bytes), Some(vec![7; 3]));
+        assert_eq!(ring.counters().recorded(), 4);
+    }
+
+    #[test]
+    fn a_closed_ring_drops_and_counts_but_keeps_what_it_holds() {
+        let ring = TapRing::with_slots(4);
+        let tap = ring.tap(1);
+        tap.record(Direction::Received, &[1]);
+        ring.close();
+        tap.record(Direction::Received, &[2]);
+        assert_eq!((ring.counters().recorded(), ring.counters().dropped()), (1, 1));
+        assert_eq!(ring.pop(|f| f.bytes().to_vec()), Some(vec![1]));
+        assert!(ring.pop(|_| ()).is_none());
+    }
+
+    #[test]
+    fn several_threads_record_at_once_and_every_frame_is_counted_once() {
+        const PER_THREAD: u32 = 20_000;
+        let ring = TapRing::with_slots(64);
+        let taps: Vec<Tap> = (0..3).map(|link| ring.tap(link)).collect();
+        let stop = AtomicBool::new(false);
+        let popped = std::thread::scope(|s| {
+            let reader = s.spawn(|| {
+                // Per link, what came out must be in the order it went in.
+                let mut last = [None::<u32>; 3];
+                let mut popped = 0u64;
+                loop {
+                    let done = stop.load(Ordering::Acquire);
+                    while let Some((link, n)) =
+                        ring.pop(|f| (f.link, u32::from_le_bytes(f.bytes().try_into().unwrap())))
+                    {
+                        let last = &mut last[usize::from(link)];
+                        assert!(last.is_none_or(|l| l < n), "link {link}: {n} after {last:?}");
+                        *last = Some(n);
+                        popped += 1;
+                    }
+                    if done {
+                        return popped;
+                    }
+                    std::thread::yield_now();
+                }
+            });
+            let writers: Vec<_> = taps
+                .iter()
+                .map(|tap| s.spawn(move || (0..PER_THREAD).for_each(|n| tap.record(Direction::Sent, &n.to_le_bytes()))))
+                .collect();
+            writers.into_iter().for_each(|w| w.join().unwrap());
+            stop.store(true, Ordering::Release);
+            reader.join().unwrap()
+        });
+        let c = ring.counters();
+        assert_eq!(c.recorded() + c.dropped(), 3 * u64::from(PER_THREAD));
+        assert_eq!(popped, c.recorded());
+        assert_eq!(c.oversize(), 0);
     }
 }

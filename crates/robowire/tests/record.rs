@@ -165,7 +165,8 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     let _ = sim.kill();
     let _ = sim.wait();
 
-    let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap())
+    let zsl = zsl_proto::description::DESCRIPTIONS;
+    let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap(), &zsl)
         .unwrap()
         .into_iter()
         .filter_map(|f| match AnyDatagram::decode(&f.bytes) {

@@ -7,6 +7,8 @@ pub mod gate;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod decode_roundtrip;
+#[cfg(feature = "serde")]
+pub mod description;
 pub mod rules;
 #[cfg(feature = "serde")]
 mod serde_impl;

@@ -50,6 +50,9 @@ pub const EVERY_STATE_CAPACITY: usize = 256;
 pub struct StateFeed<S> {
     latest: watch::Sender<Option<Stamped<S>>>,
     every: broadcast::Sender<Stamped<S>>,
+    /// Subscribed when the feed was made: handed to the first [`every_state`](Self::every_state)
+    /// caller, so that it sees the states that arrived before it asked.
+    since_open: std::sync::Mutex<Option<broadcast::Receiver<Stamped<S>>>>,
     connection: watch::Sender<Connection>,
     states: Counter,
     disconnects: Counter,
@@ -67,9 +70,11 @@ impl<S: Clone> Default for StateFeed<S> {
 impl<S: Clone> StateFeed<S> {
     /// Nothing received yet; the connection `Waiting`.
     pub fn new() -> Self {
+        let every = broadcast::Sender::new(EVERY_STATE_CAPACITY);
         Self {
             latest: watch::Sender::new(None),
-            every: broadcast::Sender::new(EVERY_STATE_CAPACITY),
+            since_open: std::sync::Mutex::new(Some(every.subscribe())),
+            every,
             connection: watch::Sender::new(Connection::Waiting),
             states: Counter::default(),
             disconnects: Counter::default(),
@@ -89,10 +94,11 @@ impl<S: Clone> StateFeed<S> {
         self.latest.subscribe()
     }
 
-    /// Every state from now on, in order. A reader that falls more than
+    /// Every state, in order: for the first caller, every state since the feed was made (the
+    /// device opened); for later callers, from now on. A reader that falls more than
     /// [`EVERY_STATE_CAPACITY`] behind is told how many it missed (`RecvError::Lagged`).
     pub fn every_state(&self) -> broadcast::Receiver<Stamped<S>> {
-        self.every.subscribe()
+        crate::lock(&self.since_open).take().unwrap_or_else(|| self.every.subscribe())
     }
 
     /// The connection now.
@@ -158,11 +164,13 @@ mod tests {
     #[test]
     fn the_connection_changes_before_the_state_and_every_state_is_kept() {
         let feed: StateFeed<u32> = StateFeed::new();
-        let mut every = feed.every_state();
         let mut connection = feed.connection_events();
         assert_eq!((feed.latest(), feed.connection()), (None, Connection::Waiting));
         let counters = WatchdogCounters::default();
         feed.on_sign_of_life(Time::from_nanos(10), Some(Event::Connected), counters, Some(1));
+        // The first reader gets the states from the start, even those before it asked.
+        let mut every = feed.every_state();
+        let mut later = feed.every_state();
         feed.on_sign_of_life(Time::from_nanos(20), None, counters, None);
         feed.on_sign_of_life(Time::from_nanos(30), None, counters, Some(2));
         assert!(connection.has_changed().unwrap());
@@ -170,6 +178,7 @@ mod tests {
         assert_eq!(feed.latest(), Some(Stamped { at: Time::from_nanos(30), state: 2 }));
         assert_eq!(every.try_recv().map(|s| s.state), Ok(1));
         assert_eq!(every.try_recv().map(|s| s.state), Ok(2));
+        assert_eq!(later.try_recv().map(|s| s.state), Ok(2), "a later reader from when it asked");
         feed.on_disconnected(WatchdogCounters { disconnects: 1, reconnects: 0 });
         let stats = feed.stats();
         assert_eq!((stats.states, stats.disconnects, stats.state_gap.count), (2, 1, 2));

@@ -45,8 +45,8 @@ pub trait Device {
         self.receiving().states()
     }
 
-    /// Every state from now on, in order, stamped with its arrival (for a reader that must see
-    /// each one).
+    /// Every state in order, stamped with its arrival, for a reader that must see each one: the
+    /// first caller gets every state since the device opened, later callers from now on.
     fn every_state(&self) -> broadcast::Receiver<Stamped<Self::State>> {
         self.receiving().every_state()
     }

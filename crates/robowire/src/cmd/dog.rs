@@ -145,7 +145,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
     let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire dog")?;
     let mut options = options(&args);
     if let Some(recorder) = &recorder {
-        options = options.with_tap(recorder.link("dog/high_level", robowire_record::Protocol::ZslHighLevel));
+        options = options.with_tap(recorder.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL));
     }
     let dog = HighLevel::open(options).context("starting the HighLevel client")?;
     let timeout = Duration::from_secs_f64(args.connect_timeout_s);

@@ -6,7 +6,18 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Args;
-use robowire_record::Recorder;
+use robowire_record::{LinkDescription, Recorder};
+
+/// Every link description the CLI knows, one list from each codec: what reading a capture back
+/// (`robowire replay`, `robowire decode --mcap`) understands.
+pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
+    [
+        &zsl_proto::description::DESCRIPTIONS[..],
+        &kmc_proto::description::DESCRIPTIONS,
+        &lowcmd_proto::description::DESCRIPTIONS,
+    ]
+    .concat()
+}
 
 /// A recorder on `path`, if given.
 pub(crate) fn start(path: Option<&Path>, command: &str) -> anyhow::Result<Option<Recorder>> {
@@ -18,8 +29,8 @@ pub(crate) fn finish(recorder: Option<Recorder>) -> anyhow::Result<()> {
     if let Some(recorder) = recorder {
         let summary = recorder.finish().context("closing the capture")?;
         eprintln!(
-            "record: {} frames written, {} dropped (the writer fell behind), {} not decodable",
-            summary.frames, summary.dropped, summary.decode_errors
+            "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable",
+            summary.frames, summary.dropped, summary.oversize, summary.decode_errors
         );
     }
     Ok(())
@@ -58,7 +69,8 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
         args.speed
     );
     let bytes = std::fs::read(&args.file).with_context(|| format!("reading {}", args.file.display()))?;
-    let frames = robowire_record::read_frames(&bytes).with_context(|| format!("{}", args.file.display()))?;
+    let frames =
+        robowire_record::read_frames(&bytes, &descriptions()).with_context(|| format!("{}", args.file.display()))?;
     if args.as_device {
         let speed = (!args.fast).then_some(args.speed);
         return crate::cmd::replay_device::run(&frames, args.link.as_deref(), args.bind, speed);
@@ -79,15 +91,15 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
         }
         let t = offset_ns as f64 / 1e9;
         let direction = frame.direction.name();
-        match frame.protocol.decode(&frame.bytes) {
-            Ok((name, value)) if args.json => println!(
+        match frame.decode() {
+            Ok(m) if args.json => println!(
                 "{}",
-                serde_json::json!({ "t_s": t, "link": frame.link, "direction": direction, "message": name, "value": value })
+                serde_json::json!({ "t_s": t, "link": frame.link, "direction": direction, "message": m.schema, "value": m.value })
             ),
-            Ok((name, value)) => println!("{t:10.6} {} {direction:8} {name}: {value}", frame.link),
+            Ok(m) => println!("{t:10.6} {} {direction:8} {}: {}", frame.link, m.schema, m.value),
             Err(e) => {
                 errors += 1;
-                eprintln!("{t:10.6} {} {direction:8} {} bytes do not decode: {e}", frame.link, frame.bytes.len());
+                eprintln!("{t:10.6} {} {direction:8} {:#}", frame.link, anyhow::Error::from(e));
             }
         }
     }
@@ -98,7 +110,7 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
 /// `robowire decode --mcap FILE`: channels, counts, rates, gaps, decode errors.
 pub(crate) fn summarize(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let summary = robowire_record::summarize(&bytes).with_context(|| format!("{}", path.display()))?;
+    let summary = robowire_record::summarize(&bytes, &descriptions()).with_context(|| format!("{}", path.display()))?;
     if json {
         let channels: Vec<_> = summary
             .channels
@@ -134,4 +146,21 @@ pub(crate) fn summarize(path: &Path, json: bool) -> anyhow::Result<ExitCode> {
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_protocol_is_described_once() {
+        let mut names: Vec<_> = super::descriptions().iter().map(|d| d.protocol()).collect();
+        let count = names.len();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), count, "{names:?}");
+        assert!(
+            names.contains(&"zsl1.high_level")
+                && names.contains(&"kmc.host")
+                && names.contains(&"unitree_go.low_level")
+        );
+    }
 }

@@ -9,14 +9,19 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use robowire_record::{Protocol, RecordedFrame};
+use robowire_record::{LinkDescription, RecordedFrame};
 use robowire_udp::{Peer, UdpLink};
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
+use zsl_proto::description::{DESCRIPTIONS, LOW_LEVEL};
 use zsl_proto::udp::{AnyDatagram, HIGH_LEVEL_PORT, LOW_LEVEL_PORT};
 
-/// Which datagrams are the device's: the states, whichever side recorded them.
+/// Which datagrams are the device's: the states of a ZSL-1 link, whichever side recorded them.
 fn is_device_frame(frame: &RecordedFrame) -> bool {
-    matches!(AnyDatagram::decode(&frame.bytes), Ok(AnyDatagram::HighLevelState(_) | AnyDatagram::LowLevelState(_)))
+    DESCRIPTIONS.iter().any(|d| d.protocol() == frame.protocol.protocol())
+        && matches!(
+            AnyDatagram::decode(&frame.bytes),
+            Ok(AnyDatagram::HighLevelState(_) | AnyDatagram::LowLevelState(_))
+        )
 }
 
 /// Plays the device frames of `link` (default: the first link that has any) on `bind`.
@@ -38,13 +43,10 @@ pub(crate) fn run(
     let first = states.first().with_context(|| format!("link {link} has no device frames"))?;
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
-        match first.protocol {
-            Protocol::ZslLowLevel => {
-                play(SocketAddr::new(bind, LOW_LEVEL_PORT), LowLevelDogCodec::default(), &link, &states, speed).await
-            }
-            _ => {
-                play(SocketAddr::new(bind, HIGH_LEVEL_PORT), HighLevelDogCodec::default(), &link, &states, speed).await
-            }
+        if first.protocol.protocol() == LOW_LEVEL.protocol() {
+            play(SocketAddr::new(bind, LOW_LEVEL_PORT), LowLevelDogCodec::default(), &link, &states, speed).await
+        } else {
+            play(SocketAddr::new(bind, HIGH_LEVEL_PORT), HighLevelDogCodec::default(), &link, &states, speed).await
         }
     })
 }

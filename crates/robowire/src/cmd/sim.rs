@@ -183,8 +183,8 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
-    use robowire_record::Protocol;
     use robowire_sim::dog::{DogSim, DogSimConfig};
+    use zsl_proto::description::{HIGH_LEVEL, LOW_LEVEL};
     let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire sim dog")?;
     let config = DogSimConfig {
         bind: args.bind,
@@ -192,8 +192,8 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
         low_level_port: args.low_level_port,
         client: args.client,
         model: args.model.into(),
-        high_level_tap: recorder.as_ref().map(|r| r.link("dog/high_level", Protocol::ZslHighLevel)),
-        low_level_tap: recorder.as_ref().map(|r| r.link("dog/low_level", Protocol::ZslLowLevel)),
+        high_level_tap: recorder.as_ref().map(|r| r.link("dog/high_level", &HIGH_LEVEL)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("dog/low_level", &LOW_LEVEL)),
         ..DogSimConfig::default()
     };
     let sim = DogSim::spawn(config).context("starting the dog simulator")?;

@@ -1,0 +1,153 @@
+//! Unitree DDS links described to a recorder (feature `serde`). A frame is a DDS serialized
+//! payload as it travels: the 4-byte encapsulation header (XCDR1 or XCDR2), then the CDR body.
+//!
+//! - [`GO2_LOW_LEVEL`] (`unitree_go.low_level`) and [`HG_LOW_LEVEL`] (`unitree_hg.low_level`):
+//!   `rt/lowcmd` and `rt/lowstate`; `LowCmd_` and `LowState_` differ in length in either
+//!   encoding, so a frame is whichever its length says, decoded strictly (CRC checked) and named
+//!   by its DDS type (`unitree_go::msg::dds_::LowState_`), with the IDL field names.
+//! - [`API_CLIENT`] (`unitree_api.client`) and [`API_SERVER`] (`unitree_api.server`): a service's
+//!   `rt/api/<service>/request` and `/response`, recorded at the caller or at the service; which
+//!   of `Request_` and `Response_` a frame is follows from the end and the direction.
+//!
+//! ```
+//! use lowcmd_proto::description::GO2_LOW_LEVEL;
+//! use lowcmd_proto::{CdrEncoding, LowState, Message};
+//! use robowire_core::Direction;
+//! use robowire_core::json::LinkDescription;
+//!
+//! let mut payload = [0u8; 1188];
+//! let n = LowState::default().encode_cdr(CdrEncoding::Xcdr2, &mut payload).unwrap();
+//! let frame = GO2_LOW_LEVEL.decode(Direction::Received, &payload[..n]).unwrap();
+//! assert_eq!(frame.schema, "unitree_go::msg::dds_::LowState_");
+//! assert_eq!(frame.value["motor_state"].as_array().map(Vec::len), Some(20));
+//! assert!(GO2_LOW_LEVEL.decode(Direction::Received, &payload[..n - 1]).is_err());
+//! ```
+
+use robowire_core::Direction;
+use robowire_core::cdr::CdrEncoding;
+use robowire_core::json::serde_json::json;
+use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
+
+use crate::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
+use crate::{DecodeError, HgLowCmd, HgLowState, LowCmd, LowState, Message};
+
+/// The layout of the low-level links.
+const LOW_LEVEL_LAYOUT: &str = "unitree-lowlevel over unitree-dds, CDR payload with its encapsulation header";
+/// The layout of the service links.
+const API_LAYOUT: &str = "unitree-dds services, CDR payload with its encapsulation header";
+
+/// A Go2's low-level link (`unitree_go.low_level`): `unitree_go` `LowCmd_` and `LowState_`.
+pub static GO2_LOW_LEVEL: LinkProtocol =
+    LinkProtocol { name: "unitree_go.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<LowCmd, LowState> };
+
+/// An HG robot's (G1's) low-level link (`unitree_hg.low_level`): `unitree_hg` `LowCmd_` and
+/// `LowState_`.
+pub static HG_LOW_LEVEL: LinkProtocol =
+    LinkProtocol { name: "unitree_hg.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<HgLowCmd, HgLowState> };
+
+/// A service link recorded at the caller (`unitree_api.client`): it sends `Request_` and
+/// receives `Response_`.
+pub static API_CLIENT: LinkProtocol = LinkProtocol {
+    name: "unitree_api.client",
+    layout: API_LAYOUT,
+    decode: |p, direction, f| call(p, direction == Direction::Sent, f),
+};
+
+/// A service link recorded at the service (`unitree_api.server`): it receives `Request_` and
+/// sends `Response_`.
+pub static API_SERVER: LinkProtocol = LinkProtocol {
+    name: "unitree_api.server",
+    layout: API_LAYOUT,
+    decode: |p, direction, f| call(p, direction == Direction::Received, f),
+};
+
+/// Every Unitree DDS link.
+pub static DESCRIPTIONS: [&dyn LinkDescription; 4] = [&GO2_LOW_LEVEL, &HG_LOW_LEVEL, &API_CLIENT, &API_SERVER];
+
+/// A payload whose length is neither the command's nor the state's in its encoding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("a {encoding:?} payload of {found} bytes: LowCmd_ is {command}, LowState_ {state} with the header")]
+pub struct LowLevelLength {
+    /// The payload's encoding, from its header.
+    pub encoding: CdrEncoding,
+    /// `LowCmd_`'s payload length in it.
+    pub command: usize,
+    /// `LowState_`'s payload length in it.
+    pub state: usize,
+    /// The frame's length.
+    pub found: usize,
+}
+
+/// `frame` as the message `M`, CRC checked.
+fn message<M: Message + serde::Serialize>(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    let decode = |f: &[u8]| M::decode_cdr(f).map(|(m, _)| m).map_err(DecodeError::without_message);
+    JsonFrame::parse(protocol, frame, decode, |_| M::DDS_TYPE_NAME)
+}
+
+/// `frame` as the command `C` or the state `S`, whichever its length is (either way).
+fn low_level<C, S>(protocol: &'static str, _: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError>
+where
+    C: Message + serde::Serialize,
+    S: Message + serde::Serialize,
+{
+    match encoding(frame) {
+        Some(encoding) if frame.len() == S::cdr_len(encoding) => message::<S>(protocol, frame),
+        Some(encoding) if frame.len() != C::cdr_len(encoding) => {
+            let (command, state, found) = (C::cdr_len(encoding), S::cdr_len(encoding), frame.len());
+            Err(FrameError::decode(protocol, frame, LowLevelLength { encoding, command, state, found }))
+        }
+        // The command's length, or no encapsulation header: the command's decoder says which.
+        _ => message::<C>(protocol, frame),
+    }
+}
+
+/// The encoding the payload's header announces.
+fn encoding(frame: &[u8]) -> Option<CdrEncoding> {
+    CdrEncoding::from_header(frame.get(..4)?.try_into().ok()?)
+}
+
+/// The CDR body after the encapsulation header.
+fn body<'a>(protocol: &'static str, frame: &'a [u8]) -> Result<&'a [u8], FrameError> {
+    match (encoding(frame), frame.get(..4)) {
+        (Some(_), _) => Ok(&frame[4..]),
+        (None, Some(header)) => {
+            let found = header.try_into().unwrap_or_default();
+            Err(FrameError::decode(protocol, frame, DecodeError::<()>::Encapsulation { found }))
+        }
+        (None, None) => {
+            Err(FrameError::decode(protocol, frame, DecodeError::<()>::NoEncapsulation { found: frame.len() }))
+        }
+    }
+}
+
+/// A `Request_` payload (`is_request`) or a `Response_` one, with the IDL's nesting.
+fn call(protocol: &'static str, is_request: bool, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    if is_request { request(protocol, frame) } else { response(protocol, frame) }
+}
+
+/// A `Request_` payload, with the IDL's nesting.
+fn request(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    let r = Request::decode_body(body(protocol, frame)?).map_err(|e| FrameError::decode(protocol, frame, e))?;
+    let h = r.header;
+    let value = json!({
+        "header": {
+            "identity": { "id": h.id, "api_id": h.api_id },
+            "lease": { "id": h.lease_id },
+            "policy": { "priority": h.priority, "noreply": h.noreply },
+        },
+        "parameter": r.parameter,
+        "binary": r.binary,
+    });
+    Ok(JsonFrame { schema: REQUEST_TYPE_NAME, value })
+}
+
+/// A `Response_` payload, with the IDL's nesting.
+fn response(protocol: &'static str, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    let r = Response::decode_body(body(protocol, frame)?).map_err(|e| FrameError::decode(protocol, frame, e))?;
+    let value = json!({
+        "header": { "identity": { "id": r.id, "api_id": r.api_id }, "status": { "code": r.code } },
+        "data": r.data,
+        "binary": r.binary,
+    });
+    Ok(JsonFrame { schema: RESPONSE_TYPE_NAME, value })
+}

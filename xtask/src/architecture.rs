@@ -1,0 +1,60 @@
+//! `docs/architecture.md` checked against the workspace: its layer table names every crate, once,
+//! and nothing else.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::process::Command;
+
+use anyhow::Context;
+
+/// The workspace's packages, from `cargo metadata`.
+pub fn workspace_packages(root: &Path) -> anyhow::Result<BTreeSet<String>> {
+    let out = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+        .args(["metadata", "--no-deps", "--format-version", "1", "--offline"])
+        .current_dir(root)
+        .output()
+        .context("running cargo metadata")?;
+    anyhow::ensure!(out.status.success(), "cargo metadata failed: {}", String::from_utf8_lossy(&out.stderr));
+    let metadata: serde_json::Value = serde_json::from_slice(&out.stdout).context("cargo metadata's JSON")?;
+    let packages = metadata["packages"].as_array().context("no packages in cargo metadata")?;
+    Ok(packages.iter().filter_map(|p| p["name"].as_str().map(str::to_owned)).collect())
+}
+
+/// The crates the layer table of `architecture.md` lists: the backticked names in the second
+/// column of the table under `## The layers`.
+pub fn documented_crates(architecture: &str) -> anyhow::Result<Vec<String>> {
+    let section = architecture.split("\n## The layers").nth(1).context("no `## The layers` section")?;
+    let rows = section.lines().skip_while(|l| !l.starts_with('|')).take_while(|l| l.starts_with('|'));
+    let mut crates = Vec::new();
+    for row in rows.skip(2) {
+        let column = row.split('|').nth(2).with_context(|| format!("a row without a crates column: {row}"))?;
+        crates.extend(column.split('`').skip(1).step_by(2).map(str::to_owned));
+    }
+    anyhow::ensure!(!crates.is_empty(), "the layer table lists no crate");
+    Ok(crates)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_layer_table_lists_every_crate_of_the_workspace_once() {
+        let root = crate::workspace_root();
+        let text = std::fs::read_to_string(root.join("docs/architecture.md")).unwrap();
+        let documented = documented_crates(&text).unwrap();
+        let unique: BTreeSet<String> = documented.iter().cloned().collect();
+        assert_eq!(unique.len(), documented.len(), "a crate listed twice: {documented:?}");
+        let packages = workspace_packages(&root).unwrap();
+        let missing: Vec<_> = packages.difference(&unique).collect();
+        let unknown: Vec<_> = unique.difference(&packages).collect();
+        assert!(missing.is_empty() && unknown.is_empty(), "not in the table: {missing:?}; not crates: {unknown:?}");
+    }
+
+    #[test]
+    fn the_table_parser_reads_the_crates_column() {
+        let text = "# x\n\n## The layers\n\n| layer | crates | owns |\n|---|---|---|\n| codec | `a`, `b` | bytes |\n| app | `c` | `not-a-crate` |\n\nafter";
+        assert_eq!(documented_crates(text).unwrap(), ["a", "b", "c"]);
+        assert!(documented_crates("# nothing").is_err());
+    }
+}
