@@ -112,9 +112,12 @@ async fn each_sample<T: robowire_core::cdr::CdrType + 'static>(
     mut print: impl FnMut(T) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
     let mut printed = 0;
+    // One listener for the whole loop: a Ctrl-C between two samples is not lost.
+    let ctrl_c = tokio::signal::ctrl_c();
+    tokio::pin!(ctrl_c);
     while count == 0 || printed < count {
         tokio::select! {
-            signal = tokio::signal::ctrl_c() => return signal.context("waiting for Ctrl-C"),
+            signal = &mut ctrl_c => return signal.context("waiting for Ctrl-C"),
             sample = reader.recv() => {
                 print(sample?.value)?;
                 printed += 1;

@@ -15,6 +15,10 @@ pub(crate) struct DeviceArgs {
     /// DDS domain (go2:, hg:, sim:go2).
     #[arg(long, default_value_t = 0)]
     domain: u16,
+    /// Local address of a zsl1:/zsl1w: client: where the robot sends its state (its
+    /// sdk_config.yaml target_ip/target_port).
+    #[arg(long, default_value = "0.0.0.0:43988")]
+    local: std::net::SocketAddr,
     /// Seconds to wait for the device's first state.
     #[arg(long, default_value_t = 5.0)]
     connect_timeout_s: f64,
@@ -33,7 +37,7 @@ impl DeviceArgs {
     /// Opens the device and waits for its first state.
     async fn open(&self) -> anyhow::Result<AnyDevice> {
         let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
-        let options = OpenOptions { domain: self.domain, ..OpenOptions::default() };
+        let options = OpenOptions { domain: self.domain, zsl_local: self.local, ..OpenOptions::default() };
         let address = &self.address;
         let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
         if !device.wait_state(timeout).await {

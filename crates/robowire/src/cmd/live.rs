@@ -13,9 +13,12 @@ pub(crate) async fn watch_until_ctrl_c(
     line: impl Fn() -> Option<String>,
 ) -> anyhow::Result<()> {
     let mut ticker = tokio::time::interval(Duration::from_millis(100));
+    // One listener for the whole loop: a Ctrl-C between two iterations is not lost.
+    let ctrl_c = tokio::signal::ctrl_c();
+    tokio::pin!(ctrl_c);
     loop {
         tokio::select! {
-            signal = tokio::signal::ctrl_c() => return signal.context("waiting for Ctrl-C"),
+            signal = &mut ctrl_c => return signal.context("waiting for Ctrl-C"),
             changed = events.changed() => {
                 changed.context("client stopped")?;
                 println!("connection: {:?}", *events.borrow_and_update());

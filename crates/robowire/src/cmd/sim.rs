@@ -104,9 +104,12 @@ fn until_ctrl_c(every_s: f64, mut report: impl FnMut()) -> anyhow::Result<()> {
         let enabled = every_s.is_finite() && every_s > 0.0;
         let mut ticker = tokio::time::interval(Duration::from_secs_f64(if enabled { every_s } else { 3600.0 }));
         ticker.tick().await;
+        // One listener for the whole loop: a Ctrl-C between two iterations is not lost.
+        let ctrl_c = tokio::signal::ctrl_c();
+        tokio::pin!(ctrl_c);
         loop {
             tokio::select! {
-                signal = tokio::signal::ctrl_c() => {
+                signal = &mut ctrl_c => {
                     signal.context("waiting for Ctrl-C")?;
                     return Ok(());
                 }

@@ -1,0 +1,103 @@
+//! `robowire status ADDRESS` and `robowire watch ADDRESS` for every kind of address, against
+//! the simulators: a chassis on a pseudo-terminal, a dog on loopback UDP, and the `sim:`
+//! addresses. (The Go2 on DDS is in `tests/go2.rs`, in a private network.)
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+
+use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+use serde_json::Value;
+
+fn robowire() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+/// `robowire status ARGS --json`: its JSON.
+fn status_json(args: &[&str]) -> Value {
+    let out = robowire().arg("status").args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "status {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)))
+}
+
+/// `robowire watch ARGS` until it printed `lines` state lines, then Ctrl-C: the lines.
+fn watch(args: &[&str], lines: usize) -> Vec<String> {
+    let mut child = robowire().arg("watch").args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut seen = Vec::new();
+    let mut line = String::new();
+    while seen.len() < lines {
+        line.clear();
+        assert!(out.read_line(&mut line).unwrap() > 0, "watch {args:?} ended after {seen:?}");
+        if !line.starts_with("connection:") {
+            seen.push(line.trim().to_owned());
+        }
+    }
+    interrupt(child);
+    seen
+}
+
+/// Ctrl-C, and a clean exit.
+fn interrupt(mut child: Child) {
+    rustix::process::kill_process(rustix::process::Pid::from_child(&child), rustix::process::Signal::INT).unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "exit after Ctrl-C: {status}");
+}
+
+#[test]
+fn a_chassis_on_a_serial_port() {
+    let chassis = ChassisSim::spawn(ChassisSimConfig::default()).unwrap();
+    let address = format!("kmc:{}", chassis.path().display());
+    let status = status_json(&[&address]);
+    assert_eq!(status["port"], chassis.path().display().to_string());
+    assert_eq!(status["link"], "Connected");
+    assert_eq!(status["speed_mps"], 0.0, "a chassis at rest: {status}");
+    assert_eq!(status["odometry"]["x_m"], 0.0, "{status}");
+    let lines = watch(&[&address], 3);
+    assert!(lines.iter().all(|l| l.starts_with("speed ")), "{lines:?}");
+}
+
+#[test]
+fn a_dog_on_loopback_udp() {
+    let mut sim = robowire()
+        .args(["sim", "dog", "--bind", "127.0.0.31", "--report-every-s", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut ready = String::new();
+    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut ready).unwrap();
+    let status = status_json(&["zsl1:127.0.0.31", "--local", "127.0.0.31:0"]);
+    assert_eq!(status["datagram"], "high_level_state", "{status}");
+    assert!(status["mode"].is_u64() && status["battery_percent"].is_u64(), "{status}");
+    let lines = watch(&["zsl1:127.0.0.31", "--local", "127.0.0.31:0"], 3);
+    assert!(lines.iter().all(|l| l.starts_with("mode ")), "{lines:?}");
+    let _ = sim.kill();
+    let _ = sim.wait();
+}
+
+#[test]
+fn simulated_devices_by_address() {
+    let chassis = status_json(&["sim:kmc"]);
+    assert_eq!(chassis["link"], "Connected", "{chassis}");
+    let dog = status_json(&["sim:zsl1w"]);
+    assert_eq!(dog["datagram"], "high_level_state", "{dog}");
+    let lines = watch(&["sim:zsl1"], 2);
+    assert!(lines.iter().all(|l| l.contains("age")), "{lines:?}");
+}
+
+#[test]
+fn a_silent_device_and_a_bad_address_are_one_clear_line_each() {
+    let out = robowire().args(["status", "zsl1:127.0.0.32", "--local", "127.0.0.32:0", "--connect-timeout-s", "0.3"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no state from zsl1:127.0.0.32") && err.contains("target_ip"), "{err}");
+    let out = robowire().args(["status", "tank:1"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "a usage error");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown kind") && err.contains("kmc:/dev/ttyUSB0"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let out = robowire().args(["status", "kmc:/dev/robowire-no-such-port"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("kmc:/dev/robowire-no-such-port") && err.contains("cannot open serial port"), "{err}");
+}
