@@ -9,6 +9,8 @@ pub mod qos;
 pub mod rpc;
 mod topic;
 
+#[doc(hidden)]
+pub use adapter::fuzz_receive;
 pub use error::DdsError;
 pub use participant::{DiscoveredTopic, Participant, ParticipantOptions};
 pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, Writer};
