@@ -183,13 +183,18 @@ pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
     Ok(CaptureSummary { metadata, channels })
 }
 
-/// The `robowire` metadata record, read through the summary section's index.
+/// The `robowire` metadata record, read through the summary section's index. An index whose
+/// range is not inside the file is skipped (`mcap::read::metadata` adds offset and length
+/// unchecked, and panics on their overflow).
 fn read_metadata(capture: &[u8]) -> BTreeMap<String, String> {
     let Ok(Some(summary)) = mcap::Summary::read(capture) else { return BTreeMap::new() };
+    let inside = |index: &mcap::records::MetadataIndex| {
+        index.offset.checked_add(index.length).is_some_and(|end| end <= capture.len() as u64)
+    };
     summary
         .metadata_indexes
         .iter()
-        .filter(|index| index.name == "robowire")
+        .filter(|index| index.name == "robowire" && inside(index))
         .find_map(|index| mcap::read::metadata(capture, index).ok())
         .map(|m| m.metadata)
         .unwrap_or_default()

@@ -66,6 +66,24 @@ fn every_truncation_is_an_error_or_a_prefix_never_a_panic() {
     }
 }
 
+#[test]
+fn a_metadata_index_pointing_outside_the_file_is_skipped() {
+    let whole = capture(&session());
+    let channels = summarize(&whole).unwrap().channels;
+    let summary = mcap::Summary::read(&whole).unwrap().unwrap();
+    let index = &summary.metadata_indexes[0];
+    let target = [index.offset.to_le_bytes(), index.length.to_le_bytes()].concat();
+    let at = whole.windows(16).position(|w| w == target).expect("the metadata index record");
+    for (offset, length) in [(u64::MAX - 8, 0xff00), (whole.len() as u64, 1), (8, u64::MAX)] {
+        let mut bad = whole.clone();
+        bad[at..at + 8].copy_from_slice(&offset.to_le_bytes());
+        bad[at + 8..at + 16].copy_from_slice(&length.to_le_bytes());
+        let summary = summarize(&bad).unwrap();
+        assert!(summary.metadata.is_empty(), "offset {offset}, length {length}");
+        assert_eq!(summary.channels, channels);
+    }
+}
+
 proptest! {
     #[test]
     fn corrupt_bytes_never_panic(flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
