@@ -128,32 +128,34 @@ pub struct ChannelSummary {
 pub struct CaptureSummary {
     /// The `robowire` metadata record (version, command, links), if any.
     pub metadata: BTreeMap<String, String>,
-    /// Every channel, by topic.
+    /// Every channel, by topic and encoding (channels that share both are counted together).
     pub channels: Vec<ChannelSummary>,
 }
 
 /// Channels, counts, rates, gaps and decode errors of a capture.
 pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
     validate(capture)?;
-    let mut channels: BTreeMap<String, (ChannelSummary, Option<Protocol>)> = BTreeMap::new();
+    let mut channels: BTreeMap<(String, String), ChannelSummary> = BTreeMap::new();
+    // Each raw channel's protocol, by channel id: a topic may have channels of several.
+    let mut protocols: BTreeMap<u16, Option<Protocol>> = BTreeMap::new();
     for message in mcap::MessageStream::new(capture).map_err(mcap_error(capture.len()))? {
         let message = message.map_err(mcap_error(capture.len()))?;
         let channel = &message.channel;
-        let (summary, protocol) = channels.entry(channel.topic.clone()).or_insert_with(|| {
-            let protocol = (channel.message_encoding == RAW_ENCODING)
+        let protocol = *protocols.entry(channel.id).or_insert_with(|| {
+            (channel.message_encoding == RAW_ENCODING)
                 .then(|| channel.metadata.get("protocol").and_then(|p| Protocol::from_name(p)))
-                .flatten();
-            let summary = ChannelSummary {
-                topic: channel.topic.clone(),
-                encoding: channel.message_encoding.clone(),
-                count: 0,
-                span_ns: (message.log_time, message.log_time),
-                rate_hz: 0.0,
-                max_gap_ns: 0,
-                out_of_order: 0,
-                decode_errors: 0,
-            };
-            (summary, protocol)
+                .flatten()
+        });
+        let key = (channel.topic.clone(), channel.message_encoding.clone());
+        let summary = channels.entry(key).or_insert_with(|| ChannelSummary {
+            topic: channel.topic.clone(),
+            encoding: channel.message_encoding.clone(),
+            count: 0,
+            span_ns: (message.log_time, message.log_time),
+            rate_hz: 0.0,
+            max_gap_ns: 0,
+            out_of_order: 0,
+            decode_errors: 0,
         });
         let last = summary.span_ns.1;
         if summary.count > 0 {
@@ -174,7 +176,7 @@ pub fn summarize(capture: &[u8]) -> Result<CaptureSummary, ReadError> {
     let metadata = read_metadata(capture);
     let channels = channels
         .into_values()
-        .map(|(mut c, _)| {
+        .map(|mut c| {
             let span_s = (c.span_ns.1 - c.span_ns.0) as f64 / 1e9;
             c.rate_hz = if span_s > 0.0 { (c.count - 1) as f64 / span_s } else { 0.0 };
             c

@@ -84,6 +84,28 @@ fn a_metadata_index_pointing_outside_the_file_is_skipped() {
     }
 }
 
+#[test]
+fn a_raw_and_a_json_channel_on_one_topic_are_summarized_apart() {
+    let mut writer = mcap::WriteOptions::new().compression(None).create(std::io::Cursor::new(Vec::new())).unwrap();
+    let raw_metadata = [("link", "dog/high_level"), ("direction", "sent"), ("protocol", "zsl1.high_level")]
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .into();
+    let json = writer.add_channel(0, "/dog/high_level/sent/raw", "json", &Default::default()).unwrap();
+    let raw = writer.add_channel(0, "/dog/high_level/sent/raw", "robowire.raw", &raw_metadata).unwrap();
+    let header =
+        |channel_id, log_time| mcap::records::MessageHeader { channel_id, sequence: 0, log_time, publish_time: 0 };
+    writer.write_to_known_channel(&header(json, 1), b"{}").unwrap();
+    for t in 2..5 {
+        writer.write_to_known_channel(&header(raw, t), &[1, 2, 3]).unwrap();
+    }
+    writer.finish().unwrap();
+    let bytes = writer.into_inner().into_inner();
+    assert_eq!(read_frames(&bytes).unwrap().len(), 3);
+    let summary = summarize(&bytes).unwrap();
+    let counts: Vec<_> = summary.channels.iter().map(|c| (c.encoding.as_str(), c.count, c.decode_errors)).collect();
+    assert_eq!(counts, [("json", 1, 0), ("robowire.raw", 3, 3)]);
+}
+
 proptest! {
     #[test]
     fn corrupt_bytes_never_panic(flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
