@@ -2,7 +2,7 @@
 //! truncation or corruption of it is a typed error, never a panic.
 
 use proptest::prelude::*;
-use robowire_record::{Direction, Protocol, Recorder, read_frames, summarize};
+use robowire_record::{Direction, Protocol, ReadError, Recorder, read_frames, summarize};
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, Model};
 
 fn capture(frames: &[(Direction, Vec<u8>)]) -> Vec<u8> {
@@ -104,6 +104,23 @@ fn a_raw_and_a_json_channel_on_one_topic_are_summarized_apart() {
     let summary = summarize(&bytes).unwrap();
     let counts: Vec<_> = summary.channels.iter().map(|c| (c.encoding.as_str(), c.count, c.decode_errors)).collect();
     assert_eq!(counts, [("json", 1, 0), ("robowire.raw", 3, 3)]);
+}
+
+#[test]
+fn a_summary_start_off_a_record_is_refused() {
+    let whole = capture(&session());
+    let field = whole.len() - 8 - 20; // the footer's summary start, before its offset start and CRC
+    let start = u64::from_le_bytes(whole[field..field + 8].try_into().unwrap());
+    assert_ne!(start, 0, "robowire writes a summary section");
+    for bad in [start + 1, start - 1, whole.len() as u64 - 8, u64::MAX] {
+        let mut bytes = whole.clone();
+        bytes[field..field + 8].copy_from_slice(&bad.to_le_bytes());
+        assert!(matches!(summarize(&bytes), Err(ReadError::Corrupt { offset, .. }) if offset == field), "{bad}");
+        assert!(matches!(read_frames(&bytes), Err(ReadError::Corrupt { .. })), "{bad}");
+    }
+    let mut no_summary = whole.clone();
+    no_summary[field..field + 8].fill(0);
+    assert!(summarize(&no_summary).unwrap().metadata.is_empty(), "no summary, no metadata index");
 }
 
 proptest! {
