@@ -8,6 +8,8 @@ use anyhow::{Context, bail};
 use crate::golden::kmc::{kmc_fixture_path, load_kmc};
 use crate::{hex_decode, workspace_root};
 
+mod messages;
+
 /// Named seed inputs for a corpus directory.
 pub type Seeds = anyhow::Result<Vec<(String, Vec<u8>)>>;
 
@@ -50,7 +52,34 @@ pub const TARGETS: &[Target] = &[
         seeds: capture_seeds,
         check: |bytes| robowire_record::fuzz_read(bytes, &zsl_proto::description::DESCRIPTIONS),
     },
+    Target {
+        name: "ros2_message_decode",
+        seeds: || Ok(messages::ros2_seeds()),
+        check: ros2_proto::decode_roundtrip::message_decode,
+    },
+    Target { name: "dds_sample_receive", seeds: dds_seeds, check: go2::fuzz_receive },
+    Target {
+        name: "lowcmd_api_decode",
+        seeds: || Ok(messages::api_seeds()),
+        check: lowcmd_proto::decode_roundtrip::api_decode,
+    },
 ];
+
+/// DDS sample seeds: every golden CDR payload (Go2, selector 0 `LowCmd_`, 1 `LowState_`) as
+/// sent, with its CRC broken, and with the big-endian header of its representation (`00 00`,
+/// `00 06`: refused); then the HG and service payloads made with the codecs.
+fn dds_seeds() -> Seeds {
+    let mut seeds = Vec::new();
+    for (name, input) in unitree_seeds("cdr_hex")? {
+        let mut bad_crc = input.clone();
+        *bad_crc.last_mut().context("empty payload")? ^= 0x5a;
+        let mut big_endian = input.clone();
+        big_endian[2] -= 1; // the identifier's second byte: 01 → 00 (CDR_BE), 07 → 06 (XCDR2_BE)
+        seeds.extend([(format!("{name}-bad-crc"), bad_crc), (format!("{name}-big-endian"), big_endian), (name, input)]);
+    }
+    seeds.extend(messages::dds_seeds());
+    Ok(seeds)
+}
 
 /// Which datagrams a capture seed keeps.
 type Keep = fn(&[u8]) -> bool;

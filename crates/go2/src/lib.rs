@@ -20,3 +20,40 @@ pub use robowire_rt::{Placement, RtError};
 
 /// The stand pose of Unitree's examples, per leg (hip, thigh, calf), rad.
 pub const STAND_POSE_RAD: [f32; 3] = [0.0, 0.67, -1.3];
+
+/// The DDS receive path of every Unitree message, for the fuzz target (not public API). Byte 0
+/// selects the type (`% 6`: Go2 `LowCmd_`, Go2 `LowState_`, HG `LowCmd_`, HG `LowState_`,
+/// `Request_`, `Response_`); the rest is a sample's serialized payload, checked by
+/// `robowire_dds::fuzz_check_sample` (the reader agrees with the codec, a message read writes and
+/// reads back the same) and, for the low-level messages, the CRC: a message is read only with a
+/// CRC that matches (any CRC when built with `cfg(fuzzing)`), a checksum failure only with one
+/// that does not. Panics otherwise.
+#[doc(hidden)]
+pub fn fuzz_receive(bytes: &[u8]) {
+    use lowcmd_proto::api::{ApiRequest, ApiResponse};
+    let Some((&selector, payload)) = bytes.split_first() else { return };
+    match selector % 6 {
+        0 => check_message::<LowCmd>(payload),
+        1 => check_message::<LowState>(payload),
+        2 => check_message::<HgLowCmd>(payload),
+        3 => check_message::<HgLowState>(payload),
+        4 => drop(robowire_dds::fuzz_check_sample::<ApiRequest>(payload)),
+        _ => drop(robowire_dds::fuzz_check_sample::<ApiResponse>(payload)),
+    }
+}
+
+fn check_message<M>(payload: &[u8])
+where
+    M: lowcmd_proto::Message + robowire_core::cdr::CdrType + std::fmt::Debug + Eq,
+{
+    let Some(sample) = robowire_dds::fuzz_check_sample::<M>(payload) else { return };
+    match (sample, M::decode_cdr_unverified(payload)) {
+        (Ok(message), Ok((unverified, _))) => {
+            assert!(unverified.crc.is_ok() || cfg!(fuzzing), "a message with a wrong CRC was read");
+            assert_eq!(message, unverified.message);
+        }
+        (Err(checksum), Ok((unverified, _))) => assert!(checksum && !unverified.crc.is_ok()),
+        (Err(checksum), Err(_)) => assert!(!checksum, "a payload the codec refuses read as a checksum failure"),
+        (Ok(message), Err(e)) => panic!("{message:?} read from a payload the codec refuses: {e:?}"),
+    }
+}

@@ -9,6 +9,9 @@ pub mod qos;
 pub mod rpc;
 mod topic;
 
+#[doc(hidden)]
+#[doc(hidden)]
+pub use adapter::fuzz_check_sample;
 pub use error::DdsError;
 pub use participant::{DiscoveredTopic, Participant, ParticipantOptions};
 pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, WriteRefused, Writer};

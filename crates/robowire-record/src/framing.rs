@@ -183,5 +183,34 @@ pub(crate) fn check(bytes: &[u8]) -> Result<(), Broken> {
     if bytes.get(after_footer..) != Some(MAGIC.as_slice()) {
         return Err(broken(after_footer, "the closing MCAP magic"));
     }
-    Ok(())
+    check_summary_start(bytes)
+}
+
+/// The MCAP reader takes the footer to be the 29 bytes before the closing magic and reads the
+/// summary section from the footer's summary start to the end of the file: that offset must be
+/// 0 (no summary) or where one of the records checked above starts.
+fn check_summary_start(bytes: &[u8]) -> Result<(), Broken> {
+    // Summary start: 20 bytes before the closing magic (then the summary offset start, the CRC).
+    let Some(field) = bytes.len().checked_sub(8 + 20) else { return Ok(()) };
+    let Some(start) = bytes.get(field..field + 8) else { return Ok(()) };
+    let start = u64::from_le_bytes(start.try_into().unwrap_or([0; 8]));
+    if start == 0 || usize::try_from(start).is_ok_and(|start| record_starts_at(bytes, start)) {
+        Ok(())
+    } else {
+        Err(broken(field, format!("a summary start on a record, not {start}")))
+    }
+}
+
+/// Whether a top-level record starts at `offset` (walking the record headers from the start).
+fn record_starts_at(bytes: &[u8], offset: usize) -> bool {
+    let mut at = MAGIC.len();
+    while at < offset {
+        let Some(len) = bytes.get(at..).and_then(|record| record.get(1..9)) else { return false };
+        let len = u64::from_le_bytes(len.try_into().unwrap_or([0; 8]));
+        match usize::try_from(len).ok().and_then(|len| (at + 9).checked_add(len)) {
+            Some(next) => at = next,
+            None => return false,
+        }
+    }
+    at == offset && offset < bytes.len().saturating_sub(MAGIC.len())
 }

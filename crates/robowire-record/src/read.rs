@@ -163,7 +163,7 @@ pub struct ChannelSummary {
 pub struct CaptureSummary {
     /// The `robowire` metadata record (version, command, links), if any.
     pub metadata: BTreeMap<String, String>,
-    /// Every channel, by topic.
+    /// Every channel, by topic and encoding (channels that share both are counted together).
     pub channels: Vec<ChannelSummary>,
 }
 
@@ -172,30 +172,36 @@ pub struct CaptureSummary {
 pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Result<CaptureSummary, ReadError> {
     validate(capture)?;
     type Decoder = Option<(Direction, &'static dyn LinkDescription)>;
-    let mut channels: BTreeMap<String, (ChannelSummary, Decoder)> = BTreeMap::new();
+    let mut channels: BTreeMap<(String, String), ChannelSummary> = BTreeMap::new();
+    // Each raw channel's decoder, by channel id: a topic may have channels of several encodings.
+    let mut decoders: BTreeMap<u16, Decoder> = BTreeMap::new();
     for message in mcap::MessageStream::new(capture).map_err(mcap_error(capture.len()))? {
         let message = message.map_err(mcap_error(capture.len()))?;
         let channel = &message.channel;
-        if !channels.contains_key(&channel.topic) {
-            let decoder = if channel.message_encoding == RAW_ENCODING {
-                let (_, direction, description) = raw_channel(channel, known)?;
-                Some((direction, description))
-            } else {
-                None
-            };
-            let summary = ChannelSummary {
-                topic: channel.topic.clone(),
-                encoding: channel.message_encoding.clone(),
-                count: 0,
-                span_ns: (message.log_time, message.log_time),
-                rate_hz: 0.0,
-                max_gap_ns: 0,
-                out_of_order: 0,
-                decode_errors: 0,
-            };
-            channels.insert(channel.topic.clone(), (summary, decoder));
-        }
-        let Some((summary, decoder)) = channels.get_mut(&channel.topic) else { continue };
+        let decoder = match decoders.get(&channel.id) {
+            Some(decoder) => *decoder,
+            None => {
+                let decoder = if channel.message_encoding == RAW_ENCODING {
+                    let (_, direction, description) = raw_channel(channel, known)?;
+                    Some((direction, description))
+                } else {
+                    None
+                };
+                decoders.insert(channel.id, decoder);
+                decoder
+            }
+        };
+        let key = (channel.topic.clone(), channel.message_encoding.clone());
+        let summary = channels.entry(key).or_insert_with(|| ChannelSummary {
+            topic: channel.topic.clone(),
+            encoding: channel.message_encoding.clone(),
+            count: 0,
+            span_ns: (message.log_time, message.log_time),
+            rate_hz: 0.0,
+            max_gap_ns: 0,
+            out_of_order: 0,
+            decode_errors: 0,
+        });
         let last = summary.span_ns.1;
         if summary.count > 0 {
             if message.log_time < last {
@@ -207,7 +213,7 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
         summary.span_ns.1 = summary.span_ns.1.max(message.log_time);
         summary.count += 1;
         if let Some((direction, description)) = decoder
-            && description.decode(*direction, &message.data).is_err()
+            && description.decode(direction, &message.data).is_err()
         {
             summary.decode_errors += 1;
         }
@@ -215,7 +221,7 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
     let metadata = read_metadata(capture);
     let channels = channels
         .into_values()
-        .map(|(mut c, _)| {
+        .map(|mut c| {
             let span_s = (c.span_ns.1 - c.span_ns.0) as f64 / 1e9;
             c.rate_hz = if span_s > 0.0 { (c.count - 1) as f64 / span_s } else { 0.0 };
             c
@@ -224,13 +230,18 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
     Ok(CaptureSummary { metadata, channels })
 }
 
-/// The `robowire` metadata record, read through the summary section's index.
+/// The `robowire` metadata record, read through the summary section's index. An index whose
+/// range is not inside the file is skipped (`mcap::read::metadata` adds offset and length
+/// unchecked, and panics on their overflow).
 fn read_metadata(capture: &[u8]) -> BTreeMap<String, String> {
     let Ok(Some(summary)) = mcap::Summary::read(capture) else { return BTreeMap::new() };
+    let inside = |index: &mcap::records::MetadataIndex| {
+        index.offset.checked_add(index.length).is_some_and(|end| end <= capture.len() as u64)
+    };
     summary
         .metadata_indexes
         .iter()
-        .filter(|index| index.name == "robowire")
+        .filter(|index| index.name == "robowire" && inside(index))
         .find_map(|index| mcap::read::metadata(capture, index).ok())
         .map(|m| m.metadata)
         .unwrap_or_default()

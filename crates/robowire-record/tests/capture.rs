@@ -134,6 +134,63 @@ fn every_truncation_is_an_error_or_a_prefix_never_a_panic() {
     }
 }
 
+#[test]
+fn a_metadata_index_pointing_outside_the_file_is_skipped() {
+    let whole = capture(&session());
+    let channels = summarize(&whole, &DESCRIPTIONS).unwrap().channels;
+    let summary = mcap::Summary::read(&whole).unwrap().unwrap();
+    let index = &summary.metadata_indexes[0];
+    let target = [index.offset.to_le_bytes(), index.length.to_le_bytes()].concat();
+    let at = whole.windows(16).position(|w| w == target).expect("the metadata index record");
+    for (offset, length) in [(u64::MAX - 8, 0xff00), (whole.len() as u64, 1), (8, u64::MAX)] {
+        let mut bad = whole.clone();
+        bad[at..at + 8].copy_from_slice(&offset.to_le_bytes());
+        bad[at + 8..at + 16].copy_from_slice(&length.to_le_bytes());
+        let summary = summarize(&bad, &DESCRIPTIONS).unwrap();
+        assert!(summary.metadata.is_empty(), "offset {offset}, length {length}");
+        assert_eq!(summary.channels, channels);
+    }
+}
+
+#[test]
+fn a_raw_and_a_json_channel_on_one_topic_are_summarized_apart() {
+    let mut writer = mcap::WriteOptions::new().compression(None).create(std::io::Cursor::new(Vec::new())).unwrap();
+    let raw_metadata = [("link", "dog/high_level"), ("direction", "sent"), ("protocol", "zsl1.high_level")]
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .into();
+    let json = writer.add_channel(0, "/dog/high_level/sent/raw", "json", &Default::default()).unwrap();
+    let raw = writer.add_channel(0, "/dog/high_level/sent/raw", "robowire.raw", &raw_metadata).unwrap();
+    let header =
+        |channel_id, log_time| mcap::records::MessageHeader { channel_id, sequence: 0, log_time, publish_time: 0 };
+    writer.write_to_known_channel(&header(json, 1), b"{}").unwrap();
+    for t in 2..5 {
+        writer.write_to_known_channel(&header(raw, t), &[1, 2, 3]).unwrap();
+    }
+    writer.finish().unwrap();
+    let bytes = writer.into_inner().into_inner();
+    assert_eq!(read_frames(&bytes, &DESCRIPTIONS).unwrap().len(), 3);
+    let summary = summarize(&bytes, &DESCRIPTIONS).unwrap();
+    let counts: Vec<_> = summary.channels.iter().map(|c| (c.encoding.as_str(), c.count, c.decode_errors)).collect();
+    assert_eq!(counts, [("json", 1, 0), ("robowire.raw", 3, 3)]);
+}
+
+#[test]
+fn a_summary_start_off_a_record_is_refused() {
+    let whole = capture(&session());
+    let field = whole.len() - 8 - 20; // the footer's summary start, before its offset start and CRC
+    let start = u64::from_le_bytes(whole[field..field + 8].try_into().unwrap());
+    assert_ne!(start, 0, "robowire writes a summary section");
+    for bad in [start + 1, start - 1, whole.len() as u64 - 8, u64::MAX] {
+        let mut bytes = whole.clone();
+        bytes[field..field + 8].copy_from_slice(&bad.to_le_bytes());
+        assert!(matches!(summarize(&bytes, &DESCRIPTIONS), Err(ReadError::Corrupt { offset, .. }) if offset == field), "{bad}");
+        assert!(matches!(read_frames(&bytes, &DESCRIPTIONS), Err(ReadError::Corrupt { .. })), "{bad}");
+    }
+    let mut no_summary = whole.clone();
+    no_summary[field..field + 8].fill(0);
+    assert!(summarize(&no_summary, &DESCRIPTIONS).unwrap().metadata.is_empty(), "no summary, no metadata index");
+}
+
 proptest! {
     #[test]
     fn corrupt_bytes_never_panic(flips in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {

@@ -13,6 +13,9 @@ use robowire_core::cdr::{CdrError, CdrReader, CdrWriter};
 mod macros;
 
 pub mod builtin;
+#[cfg(feature = "fuzzing")]
+#[doc(hidden)]
+pub mod decode_roundtrip;
 pub mod diagnostic;
 pub mod geometry;
 pub mod nav;
