@@ -77,13 +77,15 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     }
     out.line("");
     out.line("checks");
-    for check in reports.iter().flat_map(|r| &r.checks) {
-        out.line(format_args!(
-            "  [{}] {:<52} {}",
-            if check.passed { " ok " } else { "FAIL" },
-            check.what,
-            check.observed
-        ));
+    for check in reports.iter().flat_map(|r| &r.checks).filter(|c| !c.timing) {
+        let mark = if check.passed { " ok " } else { "FAIL" };
+        out.line(format_args!("  [{mark}] {:<52} {}", check.what, check.observed));
+    }
+    out.line("");
+    out.line("timing (reported, not judged here: `cargo xtask bench` holds the targets on an idle machine)");
+    for check in reports.iter().flat_map(|r| &r.checks).filter(|c| c.timing) {
+        let mark = if check.passed { " ok " } else { "slow" };
+        out.line(format_args!("  [{mark}] {:<52} {}", check.what, check.observed));
     }
     out.line("");
     out.line("summary");
@@ -91,8 +93,9 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report::json(&reports))?);
     }
-    let total = reports.iter().map(|r| r.checks.len()).sum::<usize>();
-    let failed = reports.iter().flat_map(|r| &r.checks).filter(|c| !c.passed).count();
+    let functional = || reports.iter().flat_map(|r| &r.checks).filter(|c| !c.timing);
+    let total = functional().count();
+    let failed = functional().filter(|c| !c.passed).count();
     out.line("");
     if failed == 0 {
         out.line(format_args!("demo passed: {total} checks"));

@@ -12,15 +12,25 @@ pub(crate) struct Check {
     pub(crate) what: String,
     pub(crate) passed: bool,
     pub(crate) observed: String,
+    /// A timing figure against a loose bound: reported, never a failure of the demo (the
+    /// machine may be shared; `cargo xtask bench` enforces the targets on an idle one).
+    pub(crate) timing: bool,
 }
 
 impl Check {
+    /// A functional check: what was commanded was observed.
     pub(crate) fn new(what: impl Into<String>, passed: bool, observed: impl Into<String>) -> Self {
-        Self { what: what.into(), passed, observed: observed.into() }
+        Self { what: what.into(), passed, observed: observed.into(), timing: false }
+    }
+
+    /// A timing figure and whether it met its loose bound (reported only).
+    pub(crate) fn timing(what: impl Into<String>, met: bool, observed: impl Into<String>) -> Self {
+        Self { timing: true, ..Self::new(what, met, observed) }
     }
 
     fn json(&self) -> Value {
-        json!({"check": self.what, "passed": self.passed, "observed": self.observed})
+        let kind = if self.timing { "timing" } else { "functional" };
+        json!({"check": self.what, "kind": kind, "passed": self.passed, "observed": self.observed})
     }
 }
 
@@ -29,9 +39,10 @@ impl Check {
 pub(crate) const MAX_P50_LATENESS_US: u32 = 100;
 
 impl Check {
-    /// "`stream` sends on time": its median lateness within [`MAX_P50_LATENESS_US`].
+    /// "`stream` sends on time": its median lateness within [`MAX_P50_LATENESS_US`] (a timing
+    /// figure).
     pub(crate) fn on_time(stream: &str, lateness: &LatenessSummary) -> Self {
-        Self::new(
+        Self::timing(
             format!("{stream}: send lateness p50 ≤ {MAX_P50_LATENESS_US} µs"),
             lateness.count > 0 && lateness.p50_us <= MAX_P50_LATENESS_US,
             format!("p50 {} µs, p99 {} µs over {} sends", lateness.p50_us, lateness.p99_us, lateness.count),
@@ -95,8 +106,9 @@ impl DeviceReport {
         }
     }
 
+    /// Every functional check passed (timing figures are reported, not judged here).
     pub(crate) fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        self.checks.iter().filter(|c| !c.timing).all(|c| c.passed)
     }
 
     /// The device's entry of the `--json` report.
@@ -125,9 +137,10 @@ fn round3(v: f64) -> f64 {
     (v * 1e3).round() / 1e3
 }
 
-/// The whole demo as JSON: overall result, every check (flat, as before), every device.
+/// The whole demo as JSON: overall result (functional checks), every check (flat, with its
+/// kind), every device.
 pub(crate) fn json(reports: &[DeviceReport]) -> Value {
-    let failed = reports.iter().flat_map(|r| &r.checks).filter(|c| !c.passed).count();
+    let failed = reports.iter().flat_map(|r| &r.checks).filter(|c| !c.timing && !c.passed).count();
     json!({
         "passed": failed == 0,
         "failed": failed,
@@ -145,8 +158,9 @@ pub(crate) fn table(reports: &[DeviceReport]) -> String {
             reports
                 .iter()
                 .map(|r| {
-                    let ok = r.checks.iter().filter(|c| c.passed).count();
-                    vec![format!("{} {ok}/{} checks", if r.passed() { "ok" } else { "FAIL" }, r.checks.len())]
+                    let functional: Vec<_> = r.checks.iter().filter(|c| !c.timing).collect();
+                    let ok = functional.iter().filter(|c| c.passed).count();
+                    vec![format!("{} {ok}/{} checks", if r.passed() { "ok" } else { "FAIL" }, functional.len())]
                 })
                 .collect(),
         ),
