@@ -50,8 +50,15 @@ fn main() -> ExitCode {
     // panicking in println!.
     sigpipe::reset();
     let cli = Cli::parse();
+    // Before anything else: the demo's Go2 needs multicast on loopback, and a normal user gets
+    // it by running the demo again in a user + network namespace of its own (this process then
+    // exits with its status).
+    let loopback = match &cli.command {
+        Command::Demo(args) if args.runs_go2() => Some(robowire_dds::netns::for_this_process()),
+        _ => None,
+    };
     let result = match cli.command {
-        Command::Demo(args) => cmd::demo::run(&args),
+        Command::Demo(args) => cmd::demo::run(&args, loopback),
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),
