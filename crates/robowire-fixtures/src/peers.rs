@@ -24,7 +24,14 @@ fn workspace() -> PathBuf {
 
 /// The vendors' software: `$ROBOWIRE_PEERS`, else `../shared/peers` beside the workspace.
 pub fn peers_dir() -> PathBuf {
-    std::env::var_os("ROBOWIRE_PEERS").map_or_else(|| workspace().join("../shared/peers"), PathBuf::from)
+    std::env::var_os("ROBOWIRE_PEERS").map_or_else(
+        || {
+            // Resolved, so that a message names `/home/me/shared/peers`, not `…/crates/x/../../..`.
+            let workspace = workspace().canonicalize().unwrap_or_else(|_| workspace());
+            workspace.parent().unwrap_or(&workspace).join("shared/peers")
+        },
+        PathBuf::from,
+    )
 }
 
 /// Where the environment lives: `$CARGO_TARGET_DIR` (or `target/`)`/interop/py310`.
