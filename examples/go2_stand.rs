@@ -1,7 +1,8 @@
 //! Unitree's Go2 low-level stand example with robowire: release the sport mode, move the twelve
 //! joints from where they are to the stand pose, hold it, damp. Against a simulated Go2 on DDS by
-//! default (in a private network namespace when the loopback has no multicast, as root);
-//! `--interface eth0` for a robot on its 192.168.123.x network.
+//! default (where the loopback has no multicast: as root in a network namespace of its own, else
+//! run again in a user + network namespace); `--interface eth0` for a robot on its
+//! 192.168.123.x network.
 //!
 //! ```sh
 //! cargo run --example go2_stand
@@ -35,9 +36,10 @@ fn main() -> anyhow::Result<()> {
     ensure!(args.hold.is_finite() && args.hold >= 0.0, "--hold must not be negative");
     match &args.interface {
         Some(interface) => stand(&args, ParticipantOptions::new(0, Some(interface)), None),
-        None if robowire_dds::netns::loopback_has_multicast() => simulated(&args),
-        None => robowire_dds::netns::in_loopback_namespace(|| simulated(&args))
-            .context("a simulated Go2 on loopback needs multicast on lo: run as root (a private network namespace)")?,
+        // Multicast on loopback: here, or in a user + network namespace this example runs again in.
+        None => robowire_dds::netns::for_this_process()
+            .run(|| simulated(&args))
+            .context("a simulated Go2 on loopback needs multicast on lo")?,
     }
 }
 

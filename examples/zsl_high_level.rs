@@ -67,9 +67,11 @@ async fn main() -> anyhow::Result<()> {
         );
     }
     dog.move_velocity(0.0, 0.0, 0.0)?;
-    dog.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0].abs() < 0.05 && s.body.imu.gyro_radps[2].abs() < 0.05)
-        .await
-        .context("the robot did not stop")?;
+    dog.wait_for_state(WAIT, move |s| {
+        s.body.body_velocity_mps[0].abs() < 0.05 && s.body.imu.gyro_radps[2].abs() < 0.05
+    })
+    .await
+    .context("the robot did not stop")?;
 
     // `attitudeControl(0, 0.3, 0, 0)`: pitch the body for a second, then back.
     dog.attitude_control(0.0, 0.3, 0.0, 0.0)?;

@@ -7,8 +7,12 @@
 //! - 3.10: Unitree's pin of cyclonedds has wheels for it and the vendor's ZSL-1 modules are built
 //!   for it, so this is the environment of the interop tests (`robowire-fixtures`' venv with
 //!   cyclonedds 0.10.2, numpy and Unitree's SDK), where the vendor's module, Unitree's SDK and
-//!   the CLI are required: a missing peer fails the run instead of skipping;
-//! - 3.12 (or 3.13): a bare venv with pytest only, which proves numpy is not needed.
+//!   the CLI are required: a missing peer fails the run instead of skipping. Without CPython 3.10
+//!   or the peers this run is skipped with a line (failed under `ROBOWIRE_INTEROP=1`);
+//! - 3.12 (or 3.13, else any `python3` ≥ 3.9): a bare venv with pytest only, which proves numpy
+//!   is not needed.
+//!
+//! DDS is required in both where a private network can be made (root, or a user namespace).
 //!
 //! `cargo xtask bench` runs `crates/robowire-py/bench/bench_python.py` in the 3.10 environment
 //! on the same wheel, beside the vendor's module and Unitree's SDK ([`bench_rows`]).
@@ -18,6 +22,7 @@ use std::process::Command;
 
 use anyhow::{Context, anyhow, bail};
 use robowire_fixtures::peers::{cpython, peers_dir, unitree_python};
+use robowire_fixtures::{interop, userns};
 use serde_json::Value;
 
 use crate::bench::Row;
@@ -46,7 +51,7 @@ fn pip(python: &Path, args: &[&str]) -> anyhow::Result<()> {
     )
 }
 
-/// Whether this process runs as root (the DDS tests enter a private network namespace).
+/// Whether this process runs as root (pytest then makes its private network itself).
 fn is_root() -> bool {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -68,33 +73,78 @@ fn py310_with_wheel(root: &Path, target: &Path) -> anyhow::Result<(PathBuf, Path
     Ok((py310, wheel))
 }
 
-/// Builds the wheel and runs the Python suite on two CPythons.
+/// `major.minor` of `python`, if it runs.
+fn python_version(python: &Path) -> Option<(u32, u32)> {
+    let out = Command::new(python).args(["-c", "import sys; print(*sys.version_info[:2])"]).output().ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut parts = text.split_whitespace().map(|n| n.parse().ok());
+    Some((parts.next()??, parts.next()??))
+}
+
+/// The Python of the suite's second run: CPython 3.12 or 3.13, else any `python3` ≥ 3.9 on the
+/// `PATH`; its `major.minor`.
+fn second_python() -> anyhow::Result<(String, PathBuf)> {
+    let found = ["3.12", "3.13"].into_iter().find_map(|v| cpython(v).map(|p| (v.to_owned(), p)));
+    if let Some(found) = found {
+        return Ok(found);
+    }
+    let python3 = PathBuf::from("python3");
+    match python_version(&python3) {
+        Some((major, minor)) if (major, minor) >= (3, 9) => Ok((format!("{major}.{minor}"), python3)),
+        Some((major, minor)) => bail!("python3 is {major}.{minor}; the Python suite needs 3.9 or newer"),
+        None => bail!("no python3 on the PATH for the Python suite (3.9 or newer; 3.12 preferred)"),
+    }
+}
+
+/// Builds the wheel and runs the Python suite: on the CPython 3.10 interop environment (gated
+/// like every interop test: skipped with a line when CPython 3.10 or the peers are missing,
+/// failed under `ROBOWIRE_INTEROP=1`), then on CPython 3.12/3.13 or any `python3` ≥ 3.9. Not
+/// root, pytest runs as the root of a user namespace with a network of its own
+/// (`unshare --user --map-root-user --net`), where the suite makes its DDS network; pip runs
+/// before, outside.
 pub fn test_python() -> anyhow::Result<()> {
     let root = workspace_root();
     let target = target_dir(&root);
     cargo(&root, &["build", "-q", "-p", "robowire"])?;
-    let (py310, wheel) = py310_with_wheel(&root, &target)?;
-    let second = ["3.12", "3.13"]
-        .into_iter()
-        .find_map(|v| cpython(v).map(|p| (v, p)))
-        .context("no CPython 3.12 or 3.13 for the second run of the Python suite (pyenv install 3.12)")?;
-    let second_venv = bare_venv(&target, second.0, &second.1)?;
-    install(&second_venv, &wheel)?;
-    let dds = if is_root() { ",dds" } else { "" };
-    for (python, require) in [(py310, format!("vendor,sdk,cli{dds}")), (second_venv, format!("cli{dds}"))] {
+    let py310 = match unitree_python() {
+        Ok(python) => Some(python),
+        Err(e) => {
+            interop::missing("the Python suite's CPython 3.10 interop run", e).map_err(anyhow::Error::msg)?;
+            None
+        }
+    };
+    let (version, second) = second_python()?;
+    let second_venv = bare_venv(&target, &version, &second)?;
+    let wheel = build_wheel(&root, &target, py310.as_ref().unwrap_or(&second_venv))?;
+    // DDS: root makes its namespace in the suite; anyone else runs it in a user namespace.
+    let userns = if is_root() { Ok(false) } else { userns::command("true").map(|_| true) };
+    let dds = match &userns {
+        Ok(_) => ",dds",
+        Err(e) => {
+            interop::missing("the Python suite's DDS tests", format!("no user + network namespace: {e}"))
+                .map_err(anyhow::Error::msg)?;
+            ""
+        }
+    };
+    let runs = py310.map(|python| (python, "vendor,sdk,cli")).into_iter().chain([(second_venv, "cli")]);
+    for (python, require) in runs {
+        install(&python, &wheel)?;
         pip(&python, &["install", "--no-warn-script-location", "pytest"])?;
-        println!("\n== pytest on {} (required here: {require})", python.display());
+        let require = format!("{require}{dds}");
+        let mut pytest = match userns {
+            Ok(true) => userns::command(&python).map_err(anyhow::Error::msg)?,
+            _ => Command::new(&python),
+        };
+        let inside = if matches!(userns, Ok(true)) { " in a user + network namespace" } else { "" };
+        println!("\n== pytest on {}{inside} (required here: {require})", python.display());
         run(
             "pytest",
-            Command::new(&python)
+            pytest
                 .args(["-m", "pytest", "crates/robowire-py/tests", "-q", "-p", "no:cacheprovider", "-rs"])
                 .env("ROBOWIRE_REQUIRE", &require)
                 .env("ROBOWIRE_CLI", target.join("debug/robowire"))
                 .current_dir(&root),
         )?;
-    }
-    if !is_root() {
-        println!("note: not root, so the DDS tests were allowed to skip");
     }
     Ok(())
 }

@@ -10,6 +10,7 @@ use lowcmd_proto::go2::MotorCmd;
 use lowcmd_proto::robot::{Go2, Robot};
 use lowcmd_proto::stream::CommandStream;
 use lowcmd_proto::{LowCmd, Message};
+use robowire_core::schedule::Watchdog;
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, Reader, StatsHandle, TopicStats};
@@ -17,7 +18,6 @@ use robowire_rt::Time;
 use robowire_rt::device::{Device, Receive, Received, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 use robowire_rt::stats::Counter;
-use robowire_core::schedule::Watchdog;
 
 use crate::services::Services;
 use crate::stream::{StreamJob, StreamShared};

@@ -65,7 +65,8 @@ impl ServiceClient {
         let request =
             ApiRequest { header: RequestHeader::call(id, api_id), parameter: parameter.into(), binary: Vec::new() };
         let service = self.service;
-        let answer = self.rpc.call(request, timeout).await.map_err(|source| Go2Error::Service { service, api_id, source })?;
+        let answer =
+            self.rpc.call(request, timeout).await.map_err(|source| Go2Error::Service { service, api_id, source })?;
         if answer.api_id != api_id {
             return Err(Go2Error::Unexpected { service, data: format!("an answer for api {}", answer.api_id) });
         }

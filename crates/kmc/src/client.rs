@@ -8,8 +8,8 @@ use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME
 use robowire_serial::{LinkCounters, SerialLink, SerialPortOptions};
 
 use crate::KmcError;
-use robowire_rt::RtError;
 use robowire_core::finite;
+use robowire_rt::RtError;
 
 /// Sends single frames to a KMC chassis and receives its responses.
 ///

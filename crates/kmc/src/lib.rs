@@ -8,8 +8,8 @@ pub mod odometry;
 
 pub use client::{BlockingUartClient, UartClient};
 pub use driver::{
-    ALL_STATE_POLL_HZ, BATTERY_POLL_HZ, ChassisState, Driver, DriverOptions, DriverStats, LinkState, MAX_COMMAND_TIMEOUT,
-    MAX_RATE_HZ,
+    ALL_STATE_POLL_HZ, BATTERY_POLL_HZ, ChassisState, Driver, DriverOptions, DriverStats, LinkState,
+    MAX_COMMAND_TIMEOUT, MAX_RATE_HZ,
 };
 pub use error::KmcError;
 pub use kmc_proto::{AllState, BatteryVoltage, ChassisFrame, VehicleSpeed};

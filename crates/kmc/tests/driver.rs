@@ -4,7 +4,9 @@
 
 use std::time::{Duration, Instant};
 
-use kmc::{ChassisFrame, Connection, Device, Driver, DriverOptions, KmcError, LinkState, NonFinite, Placement, RtError};
+use kmc::{
+    ChassisFrame, Connection, Device, Driver, DriverOptions, KmcError, LinkState, NonFinite, Placement, RtError,
+};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 
@@ -54,7 +56,9 @@ fn streams_the_latched_command_and_speed_requests() {
     assert_eq!((stats.command_timeouts, stats.write_errors), (0, 0));
     driver.close().unwrap();
     // The stop burst is the sentinel: once it has arrived, so has everything sent before it.
-    wait_until("the stop burst after the command", || controls(&sim).ends_with(&[command, PcControl::STOP, PcControl::STOP, PcControl::STOP]));
+    wait_until("the stop burst after the command", || {
+        controls(&sim).ends_with(&[command, PcControl::STOP, PcControl::STOP, PcControl::STOP])
+    });
     let frames = controls(&sim);
     // (0, 0) until the command was latched, then the command without a gap, then the burst.
     let first = frames.iter().position(|c| *c == command).unwrap();

@@ -3,6 +3,7 @@
 
 mod adapter;
 mod error;
+#[cfg(feature = "test-support")]
 pub mod netns;
 mod participant;
 pub mod qos;

@@ -27,7 +27,8 @@ pub const MAX_BLOCKING_MS: i64 = 100;
 
 impl Qos {
     /// A writer as Unitree's: reliable, keep last 1, volatile.
-    pub const WRITER: Self = Self { reliable: true, max_blocking_ms: MAX_BLOCKING_MS, depth: 1, transient_local: false };
+    pub const WRITER: Self =
+        Self { reliable: true, max_blocking_ms: MAX_BLOCKING_MS, depth: 1, transient_local: false };
     /// A writer on a real-time stream thread: as [`WRITER`](Self::WRITER) on the wire, but a
     /// write never waits (a full send window is a dropped sample, counted).
     pub const STREAM_WRITER: Self = Self { max_blocking_ms: 0, ..Self::WRITER };

@@ -1,11 +1,11 @@
-//! Two participants in one private network namespace: LowCmd and LowState on the wire with
-//! Unitree's type names and QoS, counters, and a request/answer round trip.
+//! Two participants where loopback carries multicast (`netns`): LowCmd and LowState on the wire
+//! with Unitree's type names and QoS, counters, and a request/answer round trip.
 
 use std::time::Duration;
 
 use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, Response, motion_switcher, status};
 use lowcmd_proto::{LowCmd, LowState, Message};
-use robowire_dds::netns::in_loopback_namespace;
+use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::rpc::{RpcClient, RpcServer, Service};
 use robowire_dds::{Participant, ParticipantOptions};
@@ -32,7 +32,7 @@ fn runtime() -> tokio::runtime::Runtime {
 
 #[test]
 fn lowcmd_and_lowstate_between_two_participants_and_a_call() {
-    in_loopback_namespace(|| {
+    with_loopback_multicast(|| {
         runtime().block_on(async {
             let options = ParticipantOptions::new(0, Some("lo"));
             let robot = Participant::new(options.clone()).unwrap();
@@ -79,11 +79,13 @@ fn lowcmd_and_lowstate_between_two_participants_and_a_call() {
                 binary: Vec::new(),
             };
             let answer = switcher.call(request, WAIT).await.unwrap();
-            assert_eq!((answer.id, answer.code, answer.data.as_str()), (7, status::OK, r#"{"form":"0","name":"normal"}"#));
+            assert_eq!(
+                (answer.id, answer.code, answer.data.as_str()),
+                (7, status::OK, r#"{"form":"0","name":"normal"}"#)
+            );
             serve.abort();
 
             let _ = LowState::default();
         })
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }

@@ -69,7 +69,6 @@ fn observation(state: &ChassisState) -> Observation {
 }
 
 impl Describe for Driver {
-
     fn status_json(&self) -> Option<Value> {
         let state = self.latest()?.state;
         Some(json!({

@@ -15,9 +15,7 @@ use std::time::Duration;
 
 pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
 pub use link::{Describe, Observations, StateChanges};
-pub use observation::{
-    BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough,
-};
+pub use observation::{BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough};
 pub use robowire_rt::device::Connection;
 #[cfg(feature = "sim")]
 pub use sim::Simulator;
@@ -149,7 +147,11 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
     let link: Box<dyn Link> = match address {
         DeviceAddress::Kmc(path) => Box::new(::kmc::Driver::open(path, kmc_options(options))?),
         DeviceAddress::Zsl1(ip) | DeviceAddress::Zsl1w(ip) => {
-            let model = if matches!(address, DeviceAddress::Zsl1w(_)) { ::zsl::udp::Model::Zsl1W } else { ::zsl::udp::Model::Zsl1 };
+            let model = if matches!(address, DeviceAddress::Zsl1w(_)) {
+                ::zsl::udp::Model::Zsl1W
+            } else {
+                ::zsl::udp::Model::Zsl1
+            };
             let client = ::zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), *ip)
                 .with_model(model);
             Box::new(::zsl::udp::HighLevel::open(client)?)

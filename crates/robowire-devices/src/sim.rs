@@ -24,10 +24,8 @@ pub(crate) fn open(
     kind: SimKind,
     options: &OpenOptions,
 ) -> Result<(Simulator, Box<dyn Link>), DeviceError> {
-    let failed = |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator {
-        address: address.clone(),
-        source,
-    };
+    let failed =
+        |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator { address: address.clone(), source };
     Ok(match kind {
         SimKind::Kmc => {
             let sim = ChassisSim::spawn(ChassisSimConfig::default()).map_err(|e| failed(e.into()))?;
@@ -36,10 +34,14 @@ pub(crate) fn open(
         }
         SimKind::Zsl1 | SimKind::Zsl1w => {
             let model = if kind == SimKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
-            let sim = DogSim::spawn(DogSimConfig { model, ..DogSimConfig::loopback() }).map_err(|e| failed(e.into()))?;
+            let sim =
+                DogSim::spawn(DogSimConfig { model, ..DogSimConfig::loopback() }).map_err(|e| failed(e.into()))?;
             let dog = sim.high_level_addr();
-            let client = zsl::udp::ClientOptions { dog, ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) }
-                .with_model(model);
+            let client = zsl::udp::ClientOptions {
+                dog,
+                ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip())
+            }
+            .with_model(model);
             let link = zsl::udp::HighLevel::open(client)?;
             (Simulator::Dog(sim), Box::new(link))
         }

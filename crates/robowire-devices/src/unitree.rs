@@ -137,7 +137,6 @@ fn observation<R: Family>(state: &R::State) -> Observation {
 }
 
 impl<R: Family> Describe for LowLevel<R> {
-
     /// The LowState with the IDL field names (as `robowire decode lowstate --json`).
     fn status_json(&self) -> Option<Value> {
         serde_json::to_value(self.latest()?.state).ok()

@@ -104,12 +104,15 @@ fn said(name: &str, outcome: Result<zsl::udp::Latched, zsl::udp::CallError>) -> 
     Ok(if latched.acknowledged() {
         format!("{name} sent; the robot reports mode {:?}", latched.reported)
     } else {
-        format!("{name} sent (return code 0x{:04x}); the robot still reports mode {:?}", latched.return_code.raw(), latched.reported)
+        format!(
+            "{name} sent (return code 0x{:04x}); the robot still reports mode {:?}",
+            latched.return_code.raw(),
+            latched.reported
+        )
     })
 }
 
 impl Describe for HighLevel {
-
     /// The datagram's JSON, as `robowire decode zsl --json` prints it.
     fn status_json(&self) -> Option<Value> {
         serde_json::to_value(self.latest()?.state).ok()

@@ -1,7 +1,9 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+pub mod interop;
 pub mod peers;
+pub mod userns;
 pub mod zsl1;
 
 use std::path::PathBuf;

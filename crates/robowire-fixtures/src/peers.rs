@@ -4,9 +4,10 @@
 //! README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
 //! tree stays untouched).
 //!
-//! Made once per `target/` directory, under a file lock (tests run in parallel), and reused. A
-//! test that needs it fails with the reason when it cannot be made (no CPython 3.10, no
-//! network on the first run): an interop test that skips is a test that cannot fail.
+//! Made once per `target/` directory, under a file lock (tests run in parallel), and reused. When
+//! it cannot be made (no peers, no CPython 3.10, no PyPI on the first run) the error says what is
+//! missing; a test passes it to [`crate::interop::require`], which skips the test with that line,
+//! or fails it under `ROBOWIRE_INTEROP=1`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -23,7 +24,14 @@ fn workspace() -> PathBuf {
 
 /// The vendors' software: `$ROBOWIRE_PEERS`, else `../shared/peers` beside the workspace.
 pub fn peers_dir() -> PathBuf {
-    std::env::var_os("ROBOWIRE_PEERS").map_or_else(|| workspace().join("../shared/peers"), PathBuf::from)
+    std::env::var_os("ROBOWIRE_PEERS").map_or_else(
+        || {
+            // Resolved, so that a message names `/home/me/shared/peers`, not `…/crates/x/../../..`.
+            let workspace = workspace().canonicalize().unwrap_or_else(|_| workspace());
+            workspace.parent().unwrap_or(&workspace).join("shared/peers")
+        },
+        PathBuf::from,
+    )
 }
 
 /// Where the environment lives: `$CARGO_TARGET_DIR` (or `target/`)`/interop/py310`.

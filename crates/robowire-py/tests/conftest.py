@@ -1,7 +1,8 @@
 """Shared fixtures of robowire's Python suite.
 
 Everything runs on loopback (each dog test on its own 127.0.0.x) or, for DDS, in a private
-network namespace entered here before any robowire thread starts. Tests that need something
+network namespace entered here before any robowire thread starts (as root, or as the root of a
+user namespace: ``cargo xtask test`` runs pytest under ``unshare --user --map-root-user --net``). Tests that need something
 this machine may lack (the vendor's CPython 3.10 module, Unitree's SDK, DDS multicast) skip,
 unless ``ROBOWIRE_REQUIRE`` names it (``vendor``, ``sdk``, ``dds``; ``cargo xtask test`` sets
 it): then a missing peer fails the run instead of hiding it.
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+import robowire.errors
 import robowire.sim
 
 REPO = Path(__file__).resolve().parents[3]
@@ -34,17 +36,24 @@ def missing(what: str, reason: str) -> None:
 
 
 DDS_READY = False
+DDS_MISSING = (
+    "DDS needs multicast on loopback, which it lacks here: run as root, or as the root of a user namespace "
+    "(unshare --user --map-root-user --net, as cargo xtask test does), or enable multicast on lo"
+)
 
 
 def pytest_configure(config):
     """DDS discovery needs multicast; without it on loopback, move this process into a private
-    network namespace (root only) before anything starts a thread."""
-    global DDS_READY
+    network namespace (root, or root of a user namespace) before anything starts a thread."""
+    global DDS_READY, DDS_MISSING
     if robowire.sim.loopback_has_multicast():
         DDS_READY = True
     elif os.geteuid() == 0:
-        robowire.sim.enter_loopback_namespace()
-        DDS_READY = robowire.sim.loopback_has_multicast()
+        try:
+            robowire.sim.enter_loopback_namespace()
+            DDS_READY = robowire.sim.loopback_has_multicast()
+        except robowire.errors.Error as e:
+            DDS_MISSING = f"DDS needs multicast on loopback, and no private network namespace can be made: {e}"
 
 
 _addresses = itertools.count(10)
@@ -69,7 +78,7 @@ def dog(ip):
 def dds():
     """DDS is usable here (multicast on loopback)."""
     if not DDS_READY:
-        missing("dds", "DDS needs multicast on loopback: run as root (private namespace) or enable it")
+        missing("dds", DDS_MISSING)
 
 
 def vendor_module_dir(model: str) -> Path:

@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 
 import robowire
-from conftest import REPO, missing, peers_dir
+from conftest import REPO, missing
 from robowire.unitree import ArrayView, HgLowCmd, HgLowState, LowCmd, LowState, StructView
 
-FIXTURES = Path(os.environ.get("ROBOWIRE_FIXTURES", peers_dir().parent / "fixtures"))
+FIXTURES = Path(os.environ.get("ROBOWIRE_FIXTURES", REPO / "fixtures"))  # the golden vectors, in the repo
 VECTORS = json.loads((FIXTURES / "unitree" / "vectors.json").read_text())
 CLASSES = {"lowcmd": LowCmd, "lowstate": LowState}
 

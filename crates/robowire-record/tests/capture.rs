@@ -183,7 +183,10 @@ fn a_summary_start_off_a_record_is_refused() {
     for bad in [start + 1, start - 1, whole.len() as u64 - 8, u64::MAX] {
         let mut bytes = whole.clone();
         bytes[field..field + 8].copy_from_slice(&bad.to_le_bytes());
-        assert!(matches!(summarize(&bytes, &DESCRIPTIONS), Err(ReadError::Corrupt { offset, .. }) if offset == field), "{bad}");
+        assert!(
+            matches!(summarize(&bytes, &DESCRIPTIONS), Err(ReadError::Corrupt { offset, .. }) if offset == field),
+            "{bad}"
+        );
         assert!(matches!(read_frames(&bytes, &DESCRIPTIONS), Err(ReadError::Corrupt { .. })), "{bad}");
     }
     let mut no_summary = whole.clone();

@@ -1,6 +1,6 @@
-//! `cmd_vel` → the command on the device's wire, through `robowire ros2`'s bridge, in a private
-//! network namespace (root): a Twist written by a ROS 2 publisher (robowire-dds, another
-//! participant) → the HighLevel datagram carrying its vx at a socket standing in for a ZSL-1;
+//! `cmd_vel` → the command on the device's wire, through `robowire ros2`'s bridge, where loopback
+//! carries multicast (`robowire_dds::netns`): a Twist written by a ROS 2 publisher (robowire-dds,
+//! another participant) → the HighLevel datagram carrying its vx at a socket standing in for a ZSL-1;
 //! beside, in the same run, the two legs it is made of: the Twist's DDS delivery alone (writer →
 //! reader in another participant) and the facade's `move_velocity()` call → wire. Figures to
 //! `ROBOWIRE_BENCH_META_ROS2` for `cargo xtask bench`.
@@ -8,7 +8,6 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
-use robowire_dds::netns::in_loopback_namespace;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_ros2::{BridgeOptions, DeviceAddress};
@@ -75,7 +74,7 @@ fn main() {
     }
     let quick = std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some();
     let n = if quick { 300 } else { 2000 };
-    let meta = in_loopback_namespace(|| {
+    let meta = robowire_dds::netns::for_this_process().run(|| {
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         let lo = ParticipantOptions::new(0, Some("lo"));
         let dog = Dog::bind();
@@ -162,8 +161,8 @@ fn main() {
             "call_to_wire_p50_us": c50, "call_to_wire_p99_us": c99,
             "samples": n,
         })
-    })
-    .expect("a private network namespace (run as root)");
+    });
+    let meta = meta.unwrap_or_else(|e| panic!("DDS on one machine needs multicast on lo: {e}"));
     println!("ros2 cmd_vel: {meta}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_ROS2") {
         std::fs::write(path, meta.to_string()).unwrap();

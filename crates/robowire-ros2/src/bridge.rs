@@ -138,11 +138,8 @@ pub async fn run(
         .zip(spaces)
         .map(|(address, namespace)| BridgedDevice { address: address.clone(), namespace, report: Arc::default() })
         .collect();
-    let open_options = OpenOptions {
-        domain: options.domain,
-        sim_interface: options.interface.clone(),
-        ..OpenOptions::default()
-    };
+    let open_options =
+        OpenOptions { domain: options.domain, sim_interface: options.interface.clone(), ..OpenOptions::default() };
     let mut opened: Vec<AnyDevice> = Vec::new();
     for device in &devices {
         let failed = |source| BridgeError::Device { address: device.address.clone(), source };

@@ -266,7 +266,11 @@ fn diagnostics(node: &Node<'_>, motors: &[MotorReport], stamp: Time) -> Diagnost
                 name: format!("{}{}", node.frame(""), m.name),
                 message: m.message.clone(),
                 hardware_id: m.hardware_id.clone(),
-                values: m.values.iter().map(|(key, value)| KeyValue { key: key.clone(), value: value.clone() }).collect(),
+                values: m
+                    .values
+                    .iter()
+                    .map(|(key, value)| KeyValue { key: key.clone(), value: value.clone() })
+                    .collect(),
             })
             .collect(),
     }

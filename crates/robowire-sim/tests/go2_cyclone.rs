@@ -1,7 +1,7 @@
 //! The simulated Go2 against CycloneDDS itself (the `cyclonedds` Python binding 0.10.2 with
-//! Unitree's IDL classes and CRC, in CPython 3.10; see `robowire_fixtures::peers`), in a private
-//! network namespace (root): our LowState decodes field for field on CycloneDDS with a CRC that
-//! Unitree's code checks; Unitree's motion_switcher client gets its answers; LowCmds published by
+//! Unitree's IDL classes and CRC, in CPython 3.10; see `robowire_fixtures::peers`), where
+//! loopback carries multicast (`robowire_dds::netns`): our LowState decodes field for field on
+//! CycloneDDS with a CRC that Unitree's code checks; Unitree's motion_switcher client gets its answers; LowCmds published by
 //! CycloneDDS with Unitree's CRC drive the joints, and one with a wrong CRC is dropped.
 
 use std::path::{Path, PathBuf};
@@ -9,7 +9,7 @@ use std::process::Command;
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use robowire_dds::ParticipantOptions;
-use robowire_dds::netns::in_loopback_namespace;
+use robowire_dds::netns::with_loopback_multicast;
 use robowire_sim::go2::{Go2Sim, Go2SimConfig, LYING_POSE_RAD, STAND_POSE_RAD};
 use serde_json::Value;
 
@@ -18,9 +18,9 @@ fn one_at_a_time() -> MutexGuard<'static, ()> {
     TURN.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// The peers' Python, made (with the network) before entering a namespace.
-fn interop_python() -> PathBuf {
-    robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"))
+/// The peers' Python, made (with the network) before entering a namespace; `None`: skipped.
+fn interop_python() -> Option<PathBuf> {
+    robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python())
 }
 
 /// Runs `script` (in `tests/interop/`) with `python` in the current namespace; its JSON.
@@ -44,8 +44,8 @@ fn f32s(value: &Value) -> Vec<f32> {
 #[test]
 fn cyclonedds_reads_our_lowstate_field_for_field_with_a_crc_unitree_accepts() {
     let _turn = one_at_a_time();
-    let py = interop_python();
-    in_loopback_namespace(|| {
+    let Some(py) = interop_python() else { return };
+    with_loopback_multicast(|| {
         let _sim = sim();
         let state = python(&py, "cyclone_reads_lowstate.py");
         assert_eq!(state["crc"], state["unitree_crc"], "Unitree's CRC of the decoded sample: {state}");
@@ -58,15 +58,14 @@ fn cyclonedds_reads_our_lowstate_field_for_field_with_a_crc_unitree_accepts() {
         assert_eq!(f32s(&state["cell_vol"]), [3600.0; 15]);
         assert_eq!(state["power_v"].as_f64().unwrap() as f32, 28.8);
         assert!(state["tick"].as_u64().unwrap() > 0);
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }
 
 #[test]
 fn unitree_clients_release_the_sport_mode_and_drive_the_joints() {
     let _turn = one_at_a_time();
-    let py = interop_python();
-    in_loopback_namespace(|| {
+    let Some(py) = interop_python() else { return };
+    with_loopback_multicast(|| {
         let sim = sim();
         let answers = python(&py, "cyclone_drives_lowcmd.py");
         assert_eq!(answers["check_mode_before"], serde_json::json!([0, {"form": "0", "name": "normal"}]));
@@ -82,6 +81,5 @@ fn unitree_clients_release_the_sport_mode_and_drive_the_joints() {
             "the joints follow CycloneDDS's LowCmds to the stand pose: {q:?}"
         );
         assert!(snapshot.requests >= 3);
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }

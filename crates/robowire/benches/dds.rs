@@ -10,8 +10,8 @@
 //!   another participant, beside `ddsperf`'s half round trip.
 //!
 //! Each side has a CPU of its own (client CPU 0, peer CPU 1), ddsperf's as ours. Figures to
-//! `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Needs root (the namespace) and
-//! `ddsperf` (Debian's cyclonedds-tools).
+//! `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Runs where loopback carries multicast
+//! (`robowire_dds::netns`); needs `ddsperf` (Debian's cyclonedds-tools).
 
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -155,7 +155,7 @@ async fn one_way(seconds: u32) -> Vec<f64> {
 fn main() {
     // `cargo bench` passes harness arguments: not ours.
     let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
-    let meta = robowire_dds::netns::in_loopback_namespace(|| {
+    let meta = robowire_dds::netns::for_this_process().run(|| {
         let (half50, half99) = ddsperf(seconds);
         robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
@@ -173,7 +173,7 @@ fn main() {
             "ddsperf_half_round_trip_us": {"p50": half50, "p99": half99},
         })
     })
-    .expect("a private network namespace (run as root)");
+    .unwrap_or_else(|e| panic!("DDS on one machine needs multicast on lo: {e}"));
     println!("{meta}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_DDS") {
         std::fs::write(path, meta.to_string()).expect("writing the bench metadata");

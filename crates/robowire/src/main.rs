@@ -55,10 +55,19 @@ fn main() -> ExitCode {
     // panicking in println!.
     sigpipe::reset();
     let cli = Cli::parse();
+    // Before anything else: the demo's Go2 needs multicast on loopback, and a normal user gets
+    // it by running the demo again in a user + network namespace of its own (this process then
+    // exits with its status).
+    let loopback = match &cli.command {
+        Command::Demo(args) if args.runs_go2() => Some(robowire_dds::netns::for_this_process()),
+        Command::Status(args) if args.device.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
+        Command::Watch(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
+        _ => None,
+    };
     let result = match cli.command {
-        Command::Demo(args) => cmd::demo::run(&args),
-        Command::Status(args) => cmd::device::status(&args),
-        Command::Watch(args) => cmd::device::watch(&args),
+        Command::Demo(args) => cmd::demo::run(&args, loopback),
+        Command::Status(args) => cmd::device::on_loopback(loopback, || cmd::device::status(&args)),
+        Command::Watch(args) => cmd::device::on_loopback(loopback, || cmd::device::watch(&args)),
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),

@@ -53,9 +53,23 @@ fn every_subcommand_fails_with_one_line_that_says_what_to_do() {
         // Missing devices.
         case(&["status", "kmc:/dev/robowire-no-such-port"], &["cannot open serial port", "/dev/robowire-no-such-port"]),
         case(&["kmc", "--port", "/dev/robowire-no-such-port", "speed"], &["cannot open serial port"]),
-        case(&["kmc", "--port", "/dev/robowire-no-such-port", "drive", "--velocity", "0.1"], &["cannot open serial port"]),
         case(
-            &["dog", "--dog-ip", "127.0.0.34", "--local-ip", "127.0.0.34", "--local-port", "0", "--connect-timeout-s", "0.3", "status"],
+            &["kmc", "--port", "/dev/robowire-no-such-port", "drive", "--velocity", "0.1"],
+            &["cannot open serial port"],
+        ),
+        case(
+            &[
+                "dog",
+                "--dog-ip",
+                "127.0.0.34",
+                "--local-ip",
+                "127.0.0.34",
+                "--local-port",
+                "0",
+                "--connect-timeout-s",
+                "0.3",
+                "status",
+            ],
             &["no state from 127.0.0.34", "target_ip"],
         ),
         case(&["status", "zsl1:127.0.0.34", "--local", "127.0.0.34:0", "--connect-timeout-s", "0.3"], &["no state"]),

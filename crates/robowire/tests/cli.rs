@@ -136,6 +136,8 @@ fn sim_and_device_commands_as_two_processes() {
 
 #[test]
 fn demo_lowcmd_loop_and_json_output() {
+    // The demo makes its own DDS network (as a normal user: a user + network namespace).
+    let Some(()) = robowire_fixtures::interop::require(robowire_dds::netns::available()) else { return };
     let out = demo(&["--only", "lowcmd", "--duration", "1", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");

@@ -87,7 +87,10 @@ fn simulated_devices_by_address() {
 
 #[test]
 fn a_silent_device_and_a_bad_address_are_one_clear_line_each() {
-    let out = robowire().args(["status", "zsl1:127.0.0.32", "--local", "127.0.0.32:0", "--connect-timeout-s", "0.3"]).output().unwrap();
+    let out = robowire()
+        .args(["status", "zsl1:127.0.0.32", "--local", "127.0.0.32:0", "--connect-timeout-s", "0.3"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no state from zsl1:127.0.0.32") && err.contains("target_ip"), "{err}");

@@ -1,11 +1,12 @@
 //! `robowire sim go2` driven by Unitree's own software: the Go2 low-level stand example of
 //! `unitree_sdk2_python`, unchanged, on CycloneDDS (see `robowire_fixtures::peers`); and
-//! `robowire go2 …` against the same simulator. Each in a private network namespace (root).
+//! `robowire go2 …` against the same simulator. Each where loopback carries multicast
+//! (`robowire_dds::netns`).
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, Command, Stdio};
 
-use robowire_dds::netns::in_loopback_namespace;
+use robowire_dds::netns::with_loopback_multicast;
 
 fn robowire() -> Command {
     Command::new(env!("CARGO_BIN_EXE_robowire"))
@@ -47,9 +48,11 @@ impl Drop for Sim {
 
 #[test]
 fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
-    let python = robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"));
+    let Some(python) = robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python()) else {
+        return;
+    };
     let examples = robowire_fixtures::peers::unitree_go2_examples().unwrap();
-    in_loopback_namespace(|| {
+    with_loopback_multicast(|| {
         let sim = Sim::start();
         let mut example = Command::new(&python)
             .arg("go2_stand_example.py")
@@ -82,13 +85,12 @@ fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
         let wide = [-0.35, 1.36, -2.65, 0.35, 1.36, -2.65, -0.5, 1.36, -2.65, 0.5, 1.36, -2.65];
         assert_eq!(q.len(), 12, "{last}");
         assert!(q.iter().zip(wide).all(|(q, w)| (q - w).abs() < 0.05), "final joints {q:?}");
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }
 
 #[test]
 fn robowire_go2_status_release_stand_and_the_dds_inspector() {
-    in_loopback_namespace(|| {
+    with_loopback_multicast(|| {
         let sim = Sim::start();
         let go2 = |args: &[&str]| robowire().args(["go2", "--interface", "lo"]).args(args).output().unwrap();
         let status = go2(&["status", "--json"]);
@@ -117,13 +119,12 @@ fn robowire_go2_status_release_stand_and_the_dds_inspector() {
 
         let log = sim.stop();
         assert!(log.contains("sport StandDown") && log.contains("ReleaseMode"), "{log}");
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }
 
 #[test]
 fn no_robot_on_the_network_is_a_clear_error() {
-    in_loopback_namespace(|| {
+    with_loopback_multicast(|| {
         let out =
             robowire().args(["go2", "--interface", "lo", "--connect-timeout-s", "0.5", "status"]).output().unwrap();
         assert!(!out.status.success());
@@ -132,6 +133,29 @@ fn no_robot_on_the_network_is_a_clear_error() {
         let bad = robowire().args(["go2", "--interface", "no-such-if0", "status"]).output().unwrap();
         let err = String::from_utf8_lossy(&bad.stderr);
         assert!(err.contains("no network interface \"no-such-if0\""), "{err}");
-    })
-    .expect("a private network namespace (run as root)");
+    });
+}
+
+#[test]
+fn status_and_watch_of_a_go2_by_address() {
+    with_loopback_multicast(|| {
+        let sim = Sim::start();
+        let out = robowire().args(["status", "go2:lo", "--json"]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let state: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(state["head"], serde_json::json!([254, 239]), "a Go2 LowState with the IDL's names: {state}");
+        assert_eq!(state["motor_state"].as_array().map(Vec::len), Some(20));
+        let mut watch =
+            robowire().args(["watch", "go2:lo"]).stdout(Stdio::piped()).stderr(Stdio::null()).spawn().unwrap();
+        let mut lines = BufReader::new(watch.stdout.take().unwrap()).lines();
+        let line = lines.find(|l| l.as_ref().is_ok_and(|l| l.starts_with("tick "))).expect("a state line").unwrap();
+        assert!(line.contains("| age "), "{line}");
+        rustix::process::kill_process(rustix::process::Pid::from_child(&watch), rustix::process::Signal::INT).unwrap();
+        assert!(watch.wait().unwrap().success());
+        drop(sim);
+        // The simulator and its client in one process, by address.
+        let out = robowire().args(["status", "sim:go2"]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(String::from_utf8_lossy(&out.stdout).starts_with("tick "), "{}", String::from_utf8_lossy(&out.stdout));
+    });
 }

@@ -1,15 +1,15 @@
 //! `robowire ros2` against a ROS 2 peer on CycloneDDS (the `cyclonedds` Python binding 0.10.2
 //! with the ROS 2 message types declared under their ROS 2 DDS names, `tests/ros2_interop/`),
-//! in a private network namespace (root): the peer drives a simulated chassis and dog through
-//! `cmd_vel`, sees them move on `odom` and stop after the deadman time, reads `joint_states`,
-//! `imu`, `battery_state` and `tf` field for field, calls `stand_up` in rmw_cyclonedds'
-//! request/reply format; unarmed, the same `cmd_vel` moves nothing.
+//! where loopback carries multicast (`robowire_dds::netns`): the peer drives a simulated chassis
+//! and dog through `cmd_vel`, sees them move on `odom` and stop after the deadman time, reads
+//! `joint_states`, `imu`, `battery_state` and `tf` field for field, calls `stand_up` in
+//! rmw_cyclonedds' request/reply format; unarmed, the same `cmd_vel` moves nothing.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use robowire_dds::netns::in_loopback_namespace;
+use robowire_dds::netns::with_loopback_multicast;
 use serde_json::Value;
 
 /// `robowire ros2 ARGS`, started and waited for (its "ready" line).
@@ -56,8 +56,9 @@ impl Drop for Bridge {
     }
 }
 
-fn interop_python() -> PathBuf {
-    robowire_fixtures::peers::unitree_python().unwrap_or_else(|e| panic!("the interop Python: {e}"))
+/// The peers' Python, made (with the network) before entering a namespace; `None`: skipped.
+fn interop_python() -> Option<PathBuf> {
+    robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python())
 }
 
 /// Runs the ROS 2 peer's `scenario` on `namespace`; its JSON.
@@ -79,8 +80,8 @@ const SETTLE_S: f64 = 1.0;
 
 #[test]
 fn a_cyclonedds_peer_drives_senses_and_calls_services_on_two_devices() {
-    let python = interop_python();
-    in_loopback_namespace(|| {
+    let Some(python) = interop_python() else { return };
+    with_loopback_multicast(|| {
         let bridge = Bridge::start(&["--device", "sim:kmc", "--device", "sim:zsl1", "--arm", "--deadman", "0.5"]);
 
         let kmc = peer(&python, "drive", "/kmc0");
@@ -144,14 +145,13 @@ fn a_cyclonedds_peer_drives_senses_and_calls_services_on_two_devices() {
             assert_eq!(cmd_vel["unarmed"], 0);
         }
         assert_eq!(dog["service_calls"], 1, "the one stand_up");
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }
 
 #[test]
 fn unarmed_the_same_cmd_vel_moves_nothing() {
-    let python = interop_python();
-    in_loopback_namespace(|| {
+    let Some(python) = interop_python() else { return };
+    with_loopback_multicast(|| {
         let bridge = Bridge::start(&["--device", "sim:kmc"]);
         let seen = peer(&python, "drive", "");
         assert_eq!(f(&seen["max_speed"]), 0.0, "{seen}");
@@ -161,14 +161,13 @@ fn unarmed_the_same_cmd_vel_moves_nothing() {
         assert!(cmd_vel["received"].as_u64().unwrap() > 10, "the twists arrived: {cmd_vel}");
         assert_eq!(cmd_vel["unarmed"], cmd_vel["received"]);
         assert_eq!(cmd_vel["applied"], 0);
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }
 
 #[test]
 fn a_go2_publishes_joint_states_and_passes_lowstate_through() {
-    let python = interop_python();
-    in_loopback_namespace(|| {
+    let Some(python) = interop_python() else { return };
+    with_loopback_multicast(|| {
         let bridge = Bridge::start(&["--device", "sim:go2", "--interface", "lo", "--namespace", "dog"]);
         let seen = peer(&python, "sense_go2", "/dog");
         let names: Vec<&str> = seen["names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
@@ -184,6 +183,5 @@ fn a_go2_publishes_joint_states_and_passes_lowstate_through() {
         let counters = bridge.stop();
         assert!(counters[0]["published"].as_u64().unwrap() > 100);
         assert_eq!(counters[0]["namespace"], "/dog");
-    })
-    .expect("a private network namespace (run as root)");
+    });
 }

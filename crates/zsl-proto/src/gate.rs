@@ -14,7 +14,9 @@
 //! assert_eq!(gate(HighLevelCall::StandUp, &lying, &idle, Model::Zsl1), Ok(HighLevelCommand::stand_up()));
 //! ```
 
-use crate::rules::{ATTITUDE_RANGES, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running, mode_gate_passes, move_ranges};
+use crate::rules::{
+    ATTITUDE_RANGES, ArgumentError, TWO_LEG_STAND_RANGES, check_all, is_running, mode_gate_passes, move_ranges,
+};
 use crate::udp::{Action, ControlMode, HighLevelCommand, HighLevelState, Model, ReturnCode};
 
 /// A HighLevel call with its arguments (m/s, rad/s), as the vendor's client names them.
@@ -134,9 +136,11 @@ impl Refusal {
         match self {
             Self::SelfCheck(word) => *word,
             Self::Argument(e) => e.return_code(),
-            Self::LyingDown(_) | Self::TwoLegStandActive | Self::Running(_) | Self::Unbalanced(_) | Self::WrongModel { .. } => {
-                ReturnCode::SwitchFailed
-            }
+            Self::LyingDown(_)
+            | Self::TwoLegStandActive
+            | Self::Running(_)
+            | Self::Unbalanced(_)
+            | Self::WrongModel { .. } => ReturnCode::SwitchFailed,
         }
     }
 }

@@ -3,12 +3,12 @@
 #![forbid(unsafe_code)]
 
 pub mod codec;
-pub mod gate;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod decode_roundtrip;
 #[cfg(feature = "serde")]
 pub mod description;
+pub mod gate;
 pub mod rules;
 #[cfg(feature = "serde")]
 mod serde_impl;

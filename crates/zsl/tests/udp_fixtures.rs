@@ -162,7 +162,10 @@ async fn every_high_level_call_in_the_fixtures_puts_its_captured_datagram_on_the
         if args.iter().any(|a| a.is_nan()) {
             // Spec decision 1: the vendor sends NaN and returns 0; robowire refuses it and sends
             // nothing new.
-            assert!(matches!(result, Err(CallError::Refused(zsl::udp::Refusal::Argument(_)))), "#{i} {api}: {result:?}");
+            assert!(
+                matches!(result, Err(CallError::Refused(zsl::udp::Refusal::Argument(_)))),
+                "#{i} {api}: {result:?}"
+            );
             dog.drain();
             assert_eq!(dog.recv(), idle, "#{i}: the previous command keeps streaming");
             checked += 1;

@@ -9,8 +9,8 @@ use std::time::Duration;
 
 use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
 use zsl::udp::{
-    CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, LowLevel, MotorCommand, Placement, Refusal,
-    ReturnCode,
+    CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, LowLevel, MotorCommand, Placement,
+    Refusal, ReturnCode,
 };
 use zsl_proto::rules::ArgumentError;
 use zsl_proto::udp::{HIGH_LEVEL_STATE_HEADER, HighLevelState};
@@ -166,8 +166,8 @@ fn state(mode: u32) -> Vec<u8> {
 async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog() {
     let dog = UdpSocket::bind("127.0.0.1:0").unwrap();
     let spoofer = UdpSocket::bind("127.0.0.2:0").expect("127.0.0.2 is loopback on Linux");
-    let client = HighLevel::open(options_to(dog.local_addr().unwrap()).with_watchdog(Duration::from_millis(300)))
-        .unwrap();
+    let client =
+        HighLevel::open(options_to(dog.local_addr().unwrap()).with_watchdog(Duration::from_millis(300))).unwrap();
     let to = client.local_addr();
     let mut events = client.connection_events();
     let mut spoofed = 0;
@@ -258,12 +258,16 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
     assert!(low.has_motor_data());
 
     let refused = low.send_motor_command(&MotorCommand::default());
-    assert!(matches!(refused, Err(CallError::Refused(Refusal::Argument(ArgumentError::Position { .. })))), "knee 0 is out of range");
+    assert!(
+        matches!(refused, Err(CallError::Refused(Refusal::Argument(ArgumentError::Position { .. })))),
+        "knee 0 is out of range"
+    );
 
     let stand = MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]);
     low.send_motor_command(&stand).unwrap();
     let near = |legs: &[f32; 4], target: f32| legs.iter().all(|q| (q - target).abs() < 0.02);
-    let reached = low.wait_for_state(WAIT, move |s| near(&s.motor.q_rad[1], 0.8) && near(&s.motor.q_rad[2], -1.5)).await;
+    let reached =
+        low.wait_for_state(WAIT, move |s| near(&s.motor.q_rad[1], 0.8) && near(&s.motor.q_rad[2], -1.5)).await;
     assert!(reached.is_some(), "the PD joints reach the targets: {:?}", low.motor_state());
     assert!(
         high.wait_for_state(WAIT, move |s| (s.joints.position_rad.knee[0] + 1.5).abs() < 0.02).await.is_some(),
@@ -271,7 +275,10 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
     );
     let mut nan = stand;
     nan.kp[0][0] = f32::NAN;
-    assert!(matches!(low.send_motor_command(&nan), Err(CallError::Refused(Refusal::Argument(ArgumentError::NonFinite(_))))));
+    assert!(matches!(
+        low.send_motor_command(&nan),
+        Err(CallError::Refused(Refusal::Argument(ArgumentError::NonFinite(_))))
+    ));
     assert_eq!(MotorCommand::from(&low.wire_command().motor), stand);
 }
 

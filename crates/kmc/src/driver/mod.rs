@@ -17,9 +17,9 @@ use std::time::Duration;
 
 use kmc_proto::stream::{ALL_STATE_POLL_PERIOD, BATTERY_POLL_PERIOD, StreamConfig};
 use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, PcControl};
+use robowire_core::DecoderCounters;
 use robowire_core::finite;
 use robowire_core::schedule::Watchdog;
-use robowire_core::DecoderCounters;
 use robowire_core::timing::LatenessSummary;
 use robowire_rt::Placement;
 use robowire_rt::device::{Device, Receiving};
@@ -202,7 +202,6 @@ impl DriverOptions {
             stop_burst: self.stop_burst_count,
         }
     }
-
 }
 
 /// Streams commands to a KMC chassis and collects its responses, like the vendor's host driver.

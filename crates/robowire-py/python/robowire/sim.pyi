@@ -89,4 +89,5 @@ class Go2(_Simulator):
 
 def loopback_has_multicast() -> bool: ...
 def enter_loopback_namespace() -> None:
-    """A private network namespace with multicast on loopback (root, iproute2)."""
+    """A private network namespace with multicast on loopback (root, or root of a user namespace;
+    iproute2)."""

@@ -13,7 +13,8 @@ use crate::stats::{dict, lateness};
 /// A simulated Unitree Go2 on DDS: `rt/lowstate` at 500 Hz, `rt/lowcmd` obeyed once the sport
 /// mode is released, the motion_switcher and sport services. Unitree's own SDK and
 /// `robowire.go2.LowLevel` both drive it. DDS discovery needs multicast: on a machine whose
-/// loopback has none, call `robowire.sim.enter_loopback_namespace()` first (root).
+/// loopback has none, call `robowire.sim.enter_loopback_namespace()` first (as root, or as the
+/// root of a user namespace: `unshare --user --map-root-user python …`).
 #[pyclass(module = "robowire.sim", frozen)]
 pub(crate) struct Go2 {
     sim: Owned<Go2Sim>,
@@ -124,7 +125,8 @@ pub(crate) fn loopback_has_multicast() -> bool {
 
 /// Moves this thread (and every thread and process it starts later) into a private network
 /// namespace whose loopback carries multicast, so DDS participants on this machine find each
-/// other and nothing leaves it. Call it before anything starts robowire's threads. Needs root
+/// other and nothing leaves it. Call it before anything starts robowire's threads. Needs root, or
+/// the root of a user namespace (`unshare --user --map-root-user`, which a normal user may run),
 /// and iproute2.
 #[pyfunction]
 pub(crate) fn enter_loopback_namespace() -> PyResult<()> {

@@ -124,7 +124,13 @@ impl<S: Clone> StateFeed<S> {
     /// A sign of life at `now` (with the watchdog's event and counters after it), and the state
     /// it carried if any. The connection changes first: whoever wakes on the state sees it
     /// connected.
-    pub(crate) fn on_sign_of_life(&self, now: Time, event: Option<Event>, counters: WatchdogCounters, state: Option<S>) {
+    pub(crate) fn on_sign_of_life(
+        &self,
+        now: Time,
+        event: Option<Event>,
+        counters: WatchdogCounters,
+        state: Option<S>,
+    ) {
         use std::sync::atomic::Ordering;
         let previous = self.last_sign_of_life.swap(now.as_nanos(), Ordering::Relaxed);
         if previous != 0 {

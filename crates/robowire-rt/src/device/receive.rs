@@ -117,7 +117,11 @@ impl<S: Clone + Send + Sync + 'static> Receiving<S> {
     /// it), which gives the link and what the caller keeps (`T`: a sender, an address); then the
     /// loop, with `watchdog`, until [`close`](Self::close). An error of `open` is returned and the
     /// thread ends.
-    pub fn spawn<R, T, E, F>(name: &str, watchdog: Watchdog, open: impl FnOnce() -> F + Send + 'static) -> Result<(Self, T), E>
+    pub fn spawn<R, T, E, F>(
+        name: &str,
+        watchdog: Watchdog,
+        open: impl FnOnce() -> F + Send + 'static,
+    ) -> Result<(Self, T), E>
     where
         F: Future<Output = Result<(R, T), E>>,
         R: Receive<State = S>,
@@ -251,7 +255,6 @@ impl<S: Clone + Send + Sync + 'static> Receiving<S> {
             answer(found);
         });
     }
-
 }
 
 impl<S> Receiving<S> {

@@ -291,8 +291,11 @@ impl DogSim {
             grid: Periodic::new(robowire_rt::now(), config.state_period),
             last_step: None,
         };
-        let stream = Runner::spawn(RunnerOptions::placed("dog-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }), job)
-            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
+        let stream = Runner::spawn(
+            RunnerOptions::placed("dog-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }),
+            job,
+        )
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
         Ok(Self {
             shared,
             timing,

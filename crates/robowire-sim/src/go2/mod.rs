@@ -223,7 +223,10 @@ impl Go2Sim {
             last_step: None,
             sent: AtomicU32::new(0),
         };
-        let stream = Runner::spawn(RunnerOptions::placed("go2-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }), job)?;
+        let stream = Runner::spawn(
+            RunnerOptions::placed("go2-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }),
+            job,
+        )?;
         Ok(Self {
             shared,
             stats,

@@ -27,13 +27,18 @@ pub(crate) struct DeviceArgs {
 #[derive(Debug, Args)]
 pub(crate) struct StatusArgs {
     #[command(flatten)]
-    device: DeviceArgs,
+    pub(crate) device: DeviceArgs,
     /// One state as JSON (the same fields as the device's own status command).
     #[arg(long)]
     json: bool,
 }
 
 impl DeviceArgs {
+    /// A simulator on DDS: it and its client meet on loopback, which needs multicast.
+    pub(crate) fn simulates_dds(&self) -> bool {
+        self.address.is_simulated() && self.address.uses_dds()
+    }
+
     /// Opens the device and waits for its first state.
     async fn open(&self) -> anyhow::Result<AnyDevice> {
         let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
@@ -41,11 +46,7 @@ impl DeviceArgs {
         let address = &self.address;
         let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
         if !device.wait_state(timeout).await {
-            anyhow::bail!(
-                "no state from {address} within {:.1} s: {}",
-                timeout.as_secs_f64(),
-                what_to_check(address)
-            );
+            anyhow::bail!("no state from {address} within {:.1} s: {}", timeout.as_secs_f64(), what_to_check(address));
         }
         Ok(device)
     }
@@ -62,6 +63,20 @@ fn what_to_check(address: &DeviceAddress) -> &'static str {
             "is the robot on, and is this the interface of its network (192.168.123.x)?"
         }
         DeviceAddress::Sim(_) => "the simulator did not start sending",
+    }
+}
+
+/// Runs `command` where `lo` carries multicast when `loopback` says how (a `sim:` DDS device);
+/// else here.
+pub(crate) fn on_loopback(
+    loopback: Option<robowire_dds::netns::Loopback>,
+    command: impl FnOnce() -> anyhow::Result<ExitCode> + Send,
+) -> anyhow::Result<ExitCode> {
+    match loopback {
+        None => command(),
+        Some(loopback) => loopback
+            .run(command)
+            .context("a simulated DDS device and its client meet on loopback, which needs multicast here")?,
     }
 }
 

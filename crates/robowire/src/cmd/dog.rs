@@ -189,9 +189,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             let result = dog.two_leg_stand(vx_mps, yaw_rate_radps);
             call(&dog, "two_leg_stand", result, Some(ControlMode::Action)).await
         }
-        DogCommand::CancelTwoLegStand => {
-            call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand(), None).await
-        }
+        DogCommand::CancelTwoLegStand => call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand(), None).await,
         DogCommand::Attitude { roll_radps, pitch_radps, yaw_radps, height_mps, duration: seconds } => {
             let hold = duration("--duration", seconds)?;
             let result = dog.attitude_control(roll_radps, pitch_radps, yaw_radps, height_mps);
@@ -262,8 +260,6 @@ async fn trick(dog: &HighLevel, name: &str, result: Result<Latched, CallError>) 
     ok
 }
 
-
-
 async fn watch_for(dog: &HighLevel, how_long: Duration) {
     let end = Instant::now() + how_long;
     while Instant::now() < end {
@@ -274,4 +270,3 @@ async fn watch_for(dog: &HighLevel, how_long: Duration) {
         }
     }
 }
-

@@ -107,7 +107,9 @@ pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
                 if let Ok(mode) = robot.sport_mode().await
                     && !mode.is_empty()
                 {
-                    eprintln!("warning: sport mode {mode:?} owns the motors; the robot ignores LowCmds until `release`");
+                    eprintln!(
+                        "warning: sport mode {mode:?} owns the motors; the robot ignores LowCmds until `release`"
+                    );
                 }
                 robot.damp();
                 tokio::time::sleep(DAMP_FOR).await;

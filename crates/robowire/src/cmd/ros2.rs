@@ -102,11 +102,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
     })?;
     let report: Vec<DeviceJson> = devices
         .iter()
-        .map(|d| DeviceJson {
-            device: d.address.to_string(),
-            namespace: d.namespace.clone(),
-            counters: d.counters(),
-        })
+        .map(|d| DeviceJson { device: d.address.to_string(), namespace: d.namespace.clone(), counters: d.counters() })
         .collect();
     for d in &report {
         let c = &d.counters;

@@ -219,7 +219,6 @@ impl<I: Wire> Session<I> {
         Ok(Self { shared, receiving, stream: Some(stream), link, local, options })
     }
 
-
     /// Latches `command`; the stream thread sends it at once. A failed send is counted in the
     /// link's statistics and retried by the refresh.
     pub(super) fn submit(&self, command: I::Command) -> Result<(), CallError> {

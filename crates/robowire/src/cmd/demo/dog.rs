@@ -229,7 +229,8 @@ async fn steps(
     let result = dog.jump();
     calls.record("jump", &result);
     let airborne = dog.wait_for_state(WAIT, move |s| s.body.position_m[2] > STANDING_HEIGHT_M + 0.05).await.is_some();
-    let landed = dog.wait_for_state(WAIT, move |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
+    let landed =
+        dog.wait_for_state(WAIT, move |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
     let action_cleared = dog.wire_command().action_code() == Action::None;
     let tricks = sim.snapshot().dog.tricks_done() - tricks_before;
     out.line(format_args!(

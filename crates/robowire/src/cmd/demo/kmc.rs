@@ -155,7 +155,8 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
     // The burst is the sentinel: once three (0, 0) end the line after the command, everything
     // the driver wrote has arrived (or 2 s pass).
     let burst_at_end = |received: &[robowire_sim::kmc::Received]| {
-        let controls: Vec<_> = received.iter().skip(before_stop).filter(|r| matches!(r.frame, HostFrame::PcControl(_))).collect();
+        let controls: Vec<_> =
+            received.iter().skip(before_stop).filter(|r| matches!(r.frame, HostFrame::PcControl(_))).collect();
         controls.iter().rev().take_while(|r| r.frame == HostFrame::PcControl(PcControl::STOP)).count()
     };
     let waited = Instant::now();

@@ -1,7 +1,8 @@
 //! The Unitree scenario: a Go2 on DDS. The simulated Go2 and the `go2` client in one process,
-//! over real DDS participants on loopback (in a private network namespace when the loopback has
-//! no multicast): release the sport mode, stand up from lying, hold, with bit flips injected on
-//! `rt/lowstate` and caught by the CRC.
+//! over real DDS participants on loopback (where it has no multicast: in the user + network
+//! namespace the demo runs in, or, as root, on a thread in a network namespace of its own; see
+//! `robowire_dds::netns`): release the sport mode, stand up from lying, hold, with bit flips
+//! injected on `rt/lowstate` and caught by the CRC.
 
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
@@ -24,11 +25,9 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
     if robowire_dds::netns::loopback_has_multicast() {
         return scenario(duration_s, out);
     }
-    out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace");
-    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out)).context(
-        "DDS on one machine needs multicast on lo: run the demo as root (it makes a private network namespace), \
-         or enable multicast on lo",
-    )?
+    out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace (root)");
+    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out))
+        .context("DDS on one machine needs multicast on lo")?
 }
 
 /// A command for the 12 joints at `pose`, tagged with `tag` (the simulator echoes it).

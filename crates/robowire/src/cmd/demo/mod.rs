@@ -15,6 +15,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
+use robowire_dds::netns::Loopback;
 
 use crate::output::Output;
 
@@ -46,10 +47,18 @@ enum Device {
     Lowcmd,
 }
 
+impl DemoArgs {
+    /// Whether the Go2 scenario is among those to run (it needs multicast on loopback).
+    pub(crate) fn runs_go2(&self) -> bool {
+        self.only.is_none_or(|d| d == Device::Lowcmd)
+    }
+}
+
 /// A device's scenario: runs for about the given seconds of motion, reports what it saw.
 type Scenario = fn(f64, &Output) -> anyhow::Result<DeviceReport>;
 
-pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
+/// Runs the demo; `loopback`: where the Go2 scenario's DDS runs (`None`: it is not run).
+pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
         args.duration.is_finite() && (0.3..=600.0).contains(&args.duration),
         "--duration must be between 0.3 and 600 s, got {}",
@@ -57,6 +66,18 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     );
     // With `--json`, the human-readable report goes to stderr and stdout carries only the JSON.
     let out = Output::new(args.json);
+    let mut go2 = true;
+    match loopback {
+        Some(Loopback::UserNamespace) => out.line(
+            "loopback has no multicast (DDS discovery needs it): the demo runs in a user + network namespace of its own",
+        ),
+        Some(Loopback::Unavailable(e)) if args.only.is_none() => {
+            out.line(format_args!("skipped the Go2 scenario: DDS on one machine needs multicast on lo: {e}"));
+            go2 = false;
+        }
+        Some(Loopback::Unavailable(e)) => anyhow::bail!("the Go2 scenario needs multicast on lo: {e}"),
+        _ => {}
+    }
     let scenarios: [(Device, Scenario); 4] = [
         (Device::Kmc, kmc::run),
         (Device::Dog, dog::run),
@@ -65,7 +86,7 @@ pub(crate) fn run(args: &DemoArgs) -> anyhow::Result<ExitCode> {
     ];
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
-        if args.only.is_none_or(|d| d == device) {
+        if args.only.is_none_or(|d| d == device) && (go2 || device != Device::Lowcmd) {
             if !reports.is_empty() {
                 out.line("");
             }
