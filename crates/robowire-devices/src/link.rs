@@ -116,7 +116,7 @@ trait NextObservation: Send {
 
 /// One step of an every-state channel.
 enum Next {
-    State(Observation),
+    State(Box<Observation>),
     Missed(u64),
     Closed,
 }
@@ -130,7 +130,7 @@ impl<S: Clone + Send + 'static, F: Fn(&S) -> Observation + Send> NextObservation
     fn next(&mut self) -> Pin<Box<dyn Future<Output = Next> + Send + '_>> {
         Box::pin(async move {
             match self.states.recv().await {
-                Ok(stamped) => Next::State((self.observe)(&stamped.state)),
+                Ok(stamped) => Next::State(Box::new((self.observe)(&stamped.state))),
                 Err(broadcast::error::RecvError::Lagged(n)) => Next::Missed(n),
                 Err(broadcast::error::RecvError::Closed) => Next::Closed,
             }
@@ -153,7 +153,7 @@ impl Observations {
     pub async fn next(&mut self) -> Option<Observation> {
         loop {
             match self.states.next().await {
-                Next::State(observation) => return Some(observation),
+                Next::State(observation) => return Some(*observation),
                 Next::Missed(n) => self.missed += n,
                 Next::Closed => return None,
             }

@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use robowire_dds::qos::Qos;
-use robowire_dds::{RawSample, Writer};
+use robowire_dds::{DdsError, RawSample, Writer};
 use robowire_devices::{AnyDevice, BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry};
 use ros2_proto::builtin::Time;
 use ros2_proto::diagnostic::{DiagnosticArray, DiagnosticStatus, KeyValue};
@@ -42,7 +42,7 @@ impl<T: robowire_core::cdr::CdrType + 'static> Topic<T> {
         qos: Qos,
         now: Instant,
         message: impl FnOnce() -> T,
-    ) -> Result<u64, BridgeError> {
+    ) -> Result<u64, DdsError> {
         if !self.limiter.ready(now) {
             return Ok(0);
         }
@@ -143,7 +143,7 @@ pub(crate) async fn run(
 /// The first request of any of the services (at least one).
 async fn next_request(
     services: &mut [TriggerService],
-) -> (usize, Result<robowire_dds::Sample<ros2_proto::srv::TriggerRequest>, robowire_dds::DdsError>) {
+) -> (usize, Result<robowire_dds::Sample<ros2_proto::srv::TriggerRequest>, DdsError>) {
     let waits = services.iter_mut().map(|s| Box::pin(s.requests.recv()));
     let (result, i, _) = futures::future::select_all(waits).await;
     (i, result)
@@ -158,7 +158,7 @@ fn quaternion(xyzw: [f64; 4]) -> Quaternion {
 }
 
 /// Publishes every part of `observation`; the samples written.
-fn publish(node: &Node<'_>, topics: &mut Topics, observation: &Observation, stamp: Time) -> Result<u64, BridgeError> {
+fn publish(node: &Node<'_>, topics: &mut Topics, observation: &Observation, stamp: Time) -> Result<u64, DdsError> {
     let now = Instant::now();
     let mut published = 0;
     if let Some(o) = &observation.odometry {

@@ -292,8 +292,7 @@ mod tests {
     use super::*;
 
     fn state(mode: u32, vx: f32, roll: f32) -> HighLevelState {
-        let mut s = HighLevelState::default();
-        s.control_mode = mode.into();
+        let mut s = HighLevelState { control_mode: mode.into(), ..HighLevelState::default() };
         s.body_velocity[0] = vx.into();
         s.rpy[0] = roll.into();
         s
