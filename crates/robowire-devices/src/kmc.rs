@@ -5,9 +5,8 @@ use std::time::Duration;
 
 use kmc::{ChassisState, Device, Driver};
 use serde_json::{Value, json};
-use tokio::sync::watch;
 
-use crate::link::{Describe, Link, Observations, StateChanges};
+use crate::link::{Describe, Link, Observations};
 use crate::observation::{BatteryReading, MotorReport, Odometry, yaw_quaternion};
 use crate::{DeviceError, Observation};
 
@@ -120,12 +119,13 @@ impl Describe for Driver {
     fn stats_line(&self) -> String {
         let s = self.stats();
         format!(
-            "sent: control {} (timeout stops {}), stop burst {}, speed requests {} | received {} | skipped bytes {}, \
-             rejected candidates {} | disconnects {} silences {} | lateness p50 {} µs p99 {} µs",
+            "sent: control {} (timeout stops {}), speed requests {}, battery {}, all-state {} | received {} | \
+             skipped bytes {}, rejected candidates {} | disconnects {} silences {} | lateness p50 {} µs p99 {} µs",
             s.control_frames_sent,
             s.timeout_frames_sent,
-            s.stop_frames_sent,
             s.speed_requests_sent,
+            s.battery_requests_sent,
+            s.all_state_requests_sent,
             s.frames_received,
             s.link.decoder.skipped_bytes,
             s.link.decoder.rejected_candidates,
@@ -138,18 +138,6 @@ impl Describe for Driver {
 }
 
 impl Link for Driver {
-    fn connection_events(&self) -> watch::Receiver<kmc::Connection> {
-        Device::connection_events(self)
-    }
-
-    fn changes(&self) -> StateChanges {
-        StateChanges(Box::new(self.states()))
-    }
-
-    fn age(&self) -> Option<Duration> {
-        self.latest().map(|s| s.age())
-    }
-
     fn observe(&self) -> Option<Observation> {
         Some(observation(&self.latest()?.state))
     }

@@ -26,16 +26,34 @@ pub trait Describe {
     fn stats_line(&self) -> String;
 }
 
-/// A device's link, whatever its kind.
-pub(crate) trait Link: Describe + Send + Sync + 'static {
+/// What every facade has through its `Device` implementation.
+pub(crate) trait Shape {
     /// Connection events.
     fn connection_events(&self) -> watch::Receiver<Connection>;
     /// Wakes at every new state.
     fn changes(&self) -> StateChanges;
-    /// Every state from now on, device-neutral.
-    fn observations(&self) -> Observations;
     /// How long ago the latest state arrived (`None` before the first).
     fn age(&self) -> Option<Duration>;
+}
+
+impl<D: robowire_rt::device::Device> Shape for D {
+    fn connection_events(&self) -> watch::Receiver<Connection> {
+        robowire_rt::device::Device::connection_events(self)
+    }
+
+    fn changes(&self) -> StateChanges {
+        StateChanges(Box::new(self.states()))
+    }
+
+    fn age(&self) -> Option<Duration> {
+        self.latest().map(|s| s.age())
+    }
+}
+
+/// A device's link, whatever its kind.
+pub(crate) trait Link: Describe + Shape + Send + Sync + 'static {
+    /// Every state from now on, device-neutral.
+    fn observations(&self) -> Observations;
     /// The latest state, device-neutral.
     fn observe(&self) -> Option<Observation>;
     /// Drives a mobile base: forward m/s, left m/s, yaw rate rad/s.

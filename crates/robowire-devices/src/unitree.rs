@@ -2,15 +2,12 @@
 //! LowState itself from `rt/lowstate`. It is commanded joint by joint, not by a velocity: it is
 //! not driven, and has no services here (releasing the sport mode is the `go2` facade's).
 
-use std::time::Duration;
-
 use go2::{Device, Go2, Hg, HgLowState, LowLevel, LowState, Robot};
 use lowcmd_proto::F32;
 use robowire_core::cdr::CdrType;
 use serde_json::Value;
-use tokio::sync::watch;
 
-use crate::link::{Describe, Link, Observations, StateChanges, floats};
+use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
 use crate::{DeviceError, Observation};
 
@@ -169,18 +166,6 @@ impl<R: Family> Describe for LowLevel<R> {
 }
 
 impl<R: Family> Link for LowLevel<R> {
-    fn connection_events(&self) -> watch::Receiver<go2::Connection> {
-        Device::connection_events(self)
-    }
-
-    fn changes(&self) -> StateChanges {
-        StateChanges(Box::new(self.states()))
-    }
-
-    fn age(&self) -> Option<Duration> {
-        self.latest().map(|s| s.age())
-    }
-
     fn observe(&self) -> Option<Observation> {
         Some(observation::<R>(&self.latest()?.state))
     }

@@ -1,13 +1,10 @@
 //! A ZSL-1 / ZSL-1W through its HighLevel interface: odometry, IMU, joints and battery from the
 //! 500 Hz state; driven with `move`; `stand_up`, `lie_down`, `passive` as services.
 
-use std::time::Duration;
-
 use serde_json::Value;
-use tokio::sync::watch;
 use zsl::udp::{Device, HighLevel, Model, RobotState};
 
-use crate::link::{Describe, Link, Observations, StateChanges, floats};
+use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Odometry, wide, xyzw};
 use crate::{DeviceError, Observation};
 
@@ -143,18 +140,6 @@ impl Describe for HighLevel {
 }
 
 impl Link for HighLevel {
-    fn connection_events(&self) -> watch::Receiver<zsl::udp::Connection> {
-        Device::connection_events(self)
-    }
-
-    fn changes(&self) -> StateChanges {
-        StateChanges(Box::new(self.states()))
-    }
-
-    fn age(&self) -> Option<Duration> {
-        self.latest().map(|s| s.age())
-    }
-
     fn observe(&self) -> Option<Observation> {
         Some(observation(&(&self.latest()?.state).into(), self.options().model))
     }

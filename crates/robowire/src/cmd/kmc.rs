@@ -6,7 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use kmc::{BlockingUartClient, ChassisFrame, Device, Driver, DriverOptions, SerialPortOptions};
+use kmc::{BlockingUartClient, ChassisFrame, Driver, DriverOptions, SerialPortOptions};
+use robowire_devices::Describe;
 
 #[derive(Debug, Args)]
 pub(crate) struct KmcArgs {
@@ -103,22 +104,9 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
     for frame in driver.messages_until(end) {
         print_frame(&frame);
     }
-    let s = driver.stats();
+    let stats = driver.stats_line();
     driver.close().context("sending the stop burst")?;
-    println!(
-        "stopped. sent: control {} (timeout stops {}), stop burst {}, speed requests {}, battery {}, all-state {} | received {} | skipped bytes {}, rejected candidates {} | lateness p50 {} µs p99 {} µs",
-        s.control_frames_sent,
-        s.timeout_frames_sent,
-        stop_burst,
-        s.speed_requests_sent,
-        s.battery_requests_sent,
-        s.all_state_requests_sent,
-        s.frames_received,
-        s.link.decoder.skipped_bytes,
-        s.link.decoder.rejected_candidates,
-        s.control_lateness.p50_us,
-        s.control_lateness.p99_us
-    );
+    println!("stopped. stop burst {stop_burst} × (0, 0); {stats}");
     Ok(ExitCode::SUCCESS)
 }
 
