@@ -3,7 +3,7 @@
 //! commands, the watchdog, CRC faults on the wire. Conditions are awaited with a generous
 //! timeout; nothing here measures time (the stream's timing is `lowcmd-proto`'s fake-clock tests).
 
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
 
 use go2::{Connection, Device, Go2, Go2Error, JointCommand, LowLevel, LowLevelOptions, STAND_POSE_RAD};
@@ -16,7 +16,7 @@ const WAIT: Duration = Duration::from_secs(20);
 /// One 500 Hz simulator at a time (two cores).
 fn one_at_a_time() -> MutexGuard<'static, ()> {
     static TURN: Mutex<()> = Mutex::new(());
-    TURN.lock().unwrap_or_else(PoisonError::into_inner)
+    robowire_rt::lock(&TURN)
 }
 
 /// `scenario` with a simulated Go2 and a connected client, in a fresh namespace.

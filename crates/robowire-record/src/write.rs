@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
@@ -121,7 +121,7 @@ impl Recorder {
     /// A tap for the link `name` (`dog/high_level`), whose frames `description` describes: the
     /// capture names its protocol, and its frames are decoded by it for the JSON channels.
     pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
-        let mut links = self.links.lock().unwrap_or_else(PoisonError::into_inner);
+        let mut links = robowire_rt::lock(&self.links);
         links.push((name.trim_matches('/').into(), description));
         self.ring.tap(u16::try_from(links.len() - 1).unwrap_or(u16::MAX))
     }
@@ -221,7 +221,7 @@ impl WriterState {
         if let Some(c) = self.channels.get(&key) {
             return Ok(Some((c.raw, c.description)));
         }
-        let link = self.links.lock().unwrap_or_else(PoisonError::into_inner).get(usize::from(frame.link)).cloned();
+        let link = robowire_rt::lock(&self.links).get(usize::from(frame.link)).cloned();
         let Some((name, description)) = link else { return Ok(None) };
         let metadata = BTreeMap::from([
             ("link".to_string(), name.clone()),
@@ -278,7 +278,7 @@ impl WriterState {
     }
 
     fn close(&mut self) -> Result<RecordingSummary, RecordError> {
-        let links = self.links.lock().unwrap_or_else(PoisonError::into_inner).clone();
+        let links = robowire_rt::lock(&self.links).clone();
         let mut metadata = BTreeMap::from([
             ("robowire_version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
             ("command".to_string(), self.command.clone()),

@@ -8,7 +8,7 @@
 //! the one it has.
 
 use std::sync::atomic::Ordering;
-use std::sync::{Mutex, PoisonError};
+use std::sync::Mutex;
 
 use robowire_core::schedule::Time;
 use robowire_core::shm::VersionedRecord;
@@ -54,7 +54,7 @@ impl<T: FromBytes + IntoBytes + KnownLayout + Immutable> Latest<T> {
     /// Replaces the value, written at `at`; returns the time it is stamped with (`at`, or just
     /// after the previous write's stamp if that is not earlier).
     pub fn write(&self, at: Time, value: &T) -> Time {
-        let mut last = self.writers.lock().unwrap_or_else(PoisonError::into_inner);
+        let mut last = crate::lock(&self.writers);
         let version = at.as_nanos().max(*last + 1);
         *last = version;
         // The region is ours and sized for the record: this cannot fail.

@@ -2,7 +2,7 @@
 //! PD loop that moves the legs. Order and content only: the stall bound's timing is
 //! `spline_heap.rs`'s fake-clock test. One 1 kHz simulator at a time (two cores).
 
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use robowire_sim::spline::{STANDING_POSE_RAD, SplineSim, SplineSimConfig};
@@ -15,7 +15,7 @@ const WATCHDOG: Duration = Duration::from_secs(20);
 /// Held while a simulator runs: the tests of this binary take turns.
 fn one_at_a_time() -> MutexGuard<'static, ()> {
     static TURN: Mutex<()> = Mutex::new(());
-    TURN.lock().unwrap_or_else(PoisonError::into_inner)
+    robowire_rt::lock(&TURN)
 }
 
 fn sim(tag: &str) -> SplineSim {
