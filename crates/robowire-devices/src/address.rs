@@ -18,7 +18,9 @@ pub enum DeviceAddress {
     Go2(String),
     /// `hg:eth0`: a Unitree HG robot's (G1, H1-2) low-level interface on that interface.
     Hg(String),
-    /// `sim:kmc|zsl1|zsl1w|go2`: an in-process simulator and a client of it.
+    /// `spline:/spline_shm`: a ZSL-1's spline daemon on shared memory, watched.
+    Spline(String),
+    /// `sim:kmc|zsl1|zsl1w|go2|spline`: an in-process simulator and a client of it.
     Sim(SimKind),
 }
 
@@ -33,6 +35,8 @@ pub enum SimKind {
     Zsl1w,
     /// A Go2 on DDS.
     Go2,
+    /// The spline daemon on private shared memory.
+    Spline,
 }
 
 /// What kind of device an address names, whatever its link.
@@ -48,6 +52,8 @@ pub enum DeviceKind {
     Go2,
     /// A Unitree HG robot (G1, H1-2).
     Hg,
+    /// A ZSL-1's spline daemon.
+    Spline,
 }
 
 impl DeviceKind {
@@ -59,13 +65,13 @@ impl DeviceKind {
             Self::Zsl1w => "zsl1w",
             Self::Go2 => "go2",
             Self::Hg => "hg",
+            Self::Spline => "spline",
         }
     }
 }
 
 /// The addresses every error message shows as examples.
-pub const ADDRESS_EXAMPLES: &str =
-    "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, sim:kmc|zsl1|zsl1w|go2";
+pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|spline";
 
 /// Why an address was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -100,12 +106,17 @@ impl FromStr for DeviceAddress {
             "zsl1w" => Ok(Self::Zsl1w(ip()?)),
             "go2" => Ok(Self::Go2(interface()?)),
             "hg" => Ok(Self::Hg(interface()?)),
+            "spline" if rest.starts_with('/') && rest.len() > 1 && !rest[1..].contains('/') => {
+                Ok(Self::Spline(rest.into()))
+            }
+            "spline" => Err(refuse("not a shared-memory object name (/spline_shm)")),
             "sim" => Ok(Self::Sim(match rest {
                 "kmc" => SimKind::Kmc,
                 "zsl1" => SimKind::Zsl1,
                 "zsl1w" => SimKind::Zsl1w,
                 "go2" => SimKind::Go2,
-                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2)")),
+                "spline" => SimKind::Spline,
+                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, spline)")),
             })),
             _ => Err(refuse("unknown kind")),
         }
@@ -120,6 +131,7 @@ impl fmt::Display for DeviceAddress {
             Self::Zsl1w(ip) => write!(f, "zsl1w:{ip}"),
             Self::Go2(interface) => write!(f, "go2:{interface}"),
             Self::Hg(interface) => write!(f, "hg:{interface}"),
+            Self::Spline(name) => write!(f, "spline:{name}"),
             Self::Sim(kind) => write!(f, "sim:{}", kind.device().name()),
         }
     }
@@ -133,6 +145,7 @@ impl SimKind {
             Self::Zsl1 => DeviceKind::Zsl1,
             Self::Zsl1w => DeviceKind::Zsl1w,
             Self::Go2 => DeviceKind::Go2,
+            Self::Spline => DeviceKind::Spline,
         }
     }
 }
@@ -146,6 +159,7 @@ impl DeviceAddress {
             Self::Zsl1w(_) => DeviceKind::Zsl1w,
             Self::Go2(_) => DeviceKind::Go2,
             Self::Hg(_) => DeviceKind::Hg,
+            Self::Spline(_) => DeviceKind::Spline,
             Self::Sim(sim) => sim.device(),
         }
     }
@@ -167,7 +181,16 @@ mod tests {
 
     #[test]
     fn every_kind_parses_prints_back_and_bad_addresses_say_why() {
-        for text in ["kmc:/dev/ttyUSB0", "zsl1:192.168.234.1", "zsl1w:10.0.0.2", "go2:eth0", "hg:enp3s0", "sim:zsl1"] {
+        for text in [
+            "kmc:/dev/ttyUSB0",
+            "zsl1:192.168.234.1",
+            "zsl1w:10.0.0.2",
+            "go2:eth0",
+            "hg:enp3s0",
+            "spline:/spline_shm",
+            "sim:zsl1",
+            "sim:spline",
+        ] {
             let address: DeviceAddress = text.parse().unwrap();
             assert_eq!(address.to_string(), text);
         }
@@ -178,7 +201,8 @@ mod tests {
             ("kmc:", "nothing after the kind"),
             ("zsl1:robot", "not an IP address"),
             ("go2:a/b", "not a network interface name"),
-            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2)"),
+            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2, spline)"),
+            ("spline:spline_shm", "not a shared-memory object name (/spline_shm)"),
             ("tank:1", "unknown kind"),
         ] {
             let e = bad.parse::<DeviceAddress>().unwrap_err();

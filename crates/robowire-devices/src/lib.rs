@@ -7,6 +7,7 @@ mod link;
 mod observation;
 #[cfg(feature = "sim")]
 mod sim;
+mod spline;
 mod unitree;
 mod zsl;
 
@@ -70,6 +71,9 @@ pub enum DeviceError {
     /// A Unitree robot's client.
     #[error("Unitree low-level client")]
     Unitree(#[from] go2::Go2Error),
+    /// The spline daemon's shared memory.
+    #[error("spline shared memory")]
+    Spline(#[from] ::zsl::SplineError),
     /// A simulator could not start.
     #[error("the simulator of {address}")]
     Simulator {
@@ -161,6 +165,9 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
         }
         DeviceAddress::Hg(interface) => {
             Box::new(go2::LowLevel::<go2::Hg>::open(go2::LowLevelOptions::on(Some(interface), options.domain))?)
+        }
+        DeviceAddress::Spline(name) => {
+            Box::new(::zsl::spline::SplineMonitor::open(::zsl::spline::SplineMonitorOptions::new(name))?)
         }
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
     };
@@ -321,6 +328,11 @@ impl AnyDevice {
 
     /// The HG low-level client, if this is an HG robot.
     pub fn hg(&self) -> Option<&go2::LowLevel<go2::Hg>> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The spline monitor, if this is a spline daemon.
+    pub fn spline(&self) -> Option<&::zsl::spline::SplineMonitor> {
         self.link().as_any().downcast_ref()
     }
 

@@ -3,6 +3,7 @@
 use robowire_sim::dog::{DogSim, DogSimConfig};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+use robowire_sim::spline::{SplineSim, SplineSimConfig};
 
 use crate::link::Link;
 use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
@@ -17,6 +18,8 @@ pub enum Simulator {
     Dog(DogSim),
     /// A Go2 on DDS.
     Go2(Go2Sim),
+    /// The spline daemon on private shared memory.
+    Spline(SplineSim),
 }
 
 pub(crate) fn open(
@@ -44,6 +47,15 @@ pub(crate) fn open(
             .with_model(model);
             let link = zsl::udp::HighLevel::open(client)?;
             (Simulator::Dog(sim), Box::new(link))
+        }
+        SimKind::Spline => {
+            static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let tag = format!("devices-{}-{n}", std::process::id());
+            let sim = SplineSim::spawn(SplineSimConfig::private(&tag)).map_err(|e| failed(e.into()))?;
+            let options = zsl::spline::SplineMonitorOptions::new(&sim.config().spline_name);
+            let monitor = zsl::spline::SplineMonitor::open(options)?;
+            (Simulator::Spline(sim), Box::new(monitor))
         }
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");

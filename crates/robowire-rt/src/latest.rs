@@ -7,8 +7,8 @@
 //! same nanosecond are stamped a nanosecond apart, so a reader never mistakes a new value for
 //! the one it has.
 
-use std::sync::atomic::Ordering;
 use std::sync::Mutex;
+use std::sync::atomic::Ordering;
 
 use robowire_core::schedule::Time;
 use robowire_core::shm::VersionedRecord;

@@ -134,3 +134,26 @@ fn fault_bits_reach_the_client() {
     assert!(flags.faults().over_temperature);
     assert!(!JointFlags(state.joint(Leg::FrontLeft, JointIndex::Hip).flags.get()).faults().any());
 }
+
+#[test]
+fn a_monitor_sees_every_state_and_a_stall_without_taking_the_controllers_flag() {
+    use zsl::spline::{SplineMonitor, SplineMonitorOptions};
+    use zsl::udp::{Connection, Device};
+    let _turn = one_at_a_time();
+    let sim = sim("monitor");
+    let monitor = SplineMonitor::open(SplineMonitorOptions::new(&sim.config().spline_name)).unwrap();
+    let mut controller = client(&sim, WATCHDOG);
+    assert!(monitor.wait_state(WATCHDOG).is_some(), "the monitor reads fresh state");
+    controller.wait_state(WATCHDOG).expect("the controller's own flag is still raised for it");
+    assert_eq!(monitor.connection(), Connection::Connected);
+    sim.pause(true);
+    wait_until("the stall noticed", || monitor.connection() == Connection::Disconnected);
+    sim.pause(false);
+    wait_until("the daemon back", || monitor.connection() == Connection::Connected);
+    let stats = monitor.stats();
+    assert_eq!((stats.disconnects, stats.reconnects), (1, 1), "{stats:?}");
+    assert!(matches!(
+        SplineMonitor::open(SplineMonitorOptions::new("/robowire-no-such-daemon")),
+        Err(SplineError::DaemonNotRunning { .. })
+    ));
+}

@@ -9,8 +9,8 @@ use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
 /// A device and how to reach it.
 #[derive(Debug, Args)]
 pub(crate) struct DeviceArgs {
-    /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, or
-    /// sim:kmc|zsl1|zsl1w|go2 for a simulator started here.
+    /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0,
+    /// spline:/spline_shm, or sim:kmc|zsl1|zsl1w|go2|spline for a simulator started here.
     address: DeviceAddress,
     /// DDS domain (go2:, hg:, sim:go2).
     #[arg(long, default_value_t = 0)]
@@ -62,6 +62,7 @@ fn what_to_check(address: &DeviceAddress) -> &'static str {
         DeviceAddress::Go2(_) | DeviceAddress::Hg(_) => {
             "is the robot on, and is this the interface of its network (192.168.123.x)?"
         }
+        DeviceAddress::Spline(_) => "is the spline daemon running (and publishing)?",
         DeviceAddress::Sim(_) => "the simulator did not start sending",
     }
 }

@@ -51,6 +51,9 @@ pub enum SplineError {
         /// The timeout.
         timeout: Duration,
     },
+    /// A monitor's thread could not be started.
+    #[error("the monitor's thread")]
+    Thread(#[from] robowire_rt::RtError),
 }
 
 const FIELD_NAMES: [&str; 5] = ["p_des", "v_des", "kp", "kd", "t_ff"];
