@@ -5,6 +5,7 @@
 pub mod dog;
 #[cfg(feature = "go2")]
 pub mod go2;
+mod handover;
 #[cfg(any(feature = "zsl", feature = "go2"))]
 mod joints;
 #[cfg(feature = "kmc")]

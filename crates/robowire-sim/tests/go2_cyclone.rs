@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{Mutex, MutexGuard};
 
 use robowire_dds::ParticipantOptions;
 use robowire_dds::netns::in_loopback_namespace;
@@ -15,7 +15,7 @@ use serde_json::Value;
 
 fn one_at_a_time() -> MutexGuard<'static, ()> {
     static TURN: Mutex<()> = Mutex::new(());
-    TURN.lock().unwrap_or_else(PoisonError::into_inner)
+    robowire_rt::lock(&TURN)
 }
 
 /// The peers' Python, made (with the network) before entering a namespace.
