@@ -6,7 +6,7 @@
 //! answers a command that changes something at once. A thread runs a small tokio runtime that
 //! receives commands on both ports and hands them over in a lock-free queue, waking the stream
 //! for a command that differs from the one before. The handle's requests and snapshots go
-//! through [`crate::handover`]: the stream takes no lock.
+//! through the crate's `handover` module: the stream takes no lock.
 
 use std::io;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};

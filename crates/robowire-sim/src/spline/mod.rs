@@ -3,7 +3,7 @@
 //! and the missed ones counted) that consumes commands like the vendor daemon, drives a PD joint
 //! model, publishes motor state and an IMU sample every cycle, and measures its own lateness.
 //! The loop takes no lock: it owns the model and its faults, takes the handle's requests through
-//! [`crate::handover`], and publishes through seqlocks and atomics.
+//! the crate's `handover` module, and publishes through seqlocks and atomics.
 //!
 //! [`SplineDaemon`] and [`ImuWriter`] ([`daemon`]) are the device side of the shared memory,
 //! usable by any daemon.
