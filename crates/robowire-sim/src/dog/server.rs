@@ -508,10 +508,14 @@ impl Job for StateStream {
     }
 
     fn run(&mut self, now: Time) {
-        let taken = self.handover.requests.take(|request| match request {
-            Request::Inject(fault) => self.dog.inject(fault),
-            Request::ClearFaults => self.dog.clear_faults(),
-            Request::SetBatteryPercent(percent) => self.dog.set_battery_percent(percent),
+        let mut requested = false;
+        let taken = self.handover.requests.take(|request| {
+            requested = true;
+            match request {
+                Request::Inject(fault) => self.dog.inject(fault),
+                Request::ClearFaults => self.dog.clear_faults(),
+                Request::SetBatteryPercent(percent) => self.dog.set_battery_percent(percent),
+            }
         });
         while let Some(command) = self.handover.commands.pop() {
             match command {
@@ -537,7 +541,7 @@ impl Job for StateStream {
             self.publish();
             self.send_high_level();
             self.send_low_level();
-        } else {
+        } else if requested {
             self.publish();
         }
         self.handover.requests.confirm(taken);
