@@ -15,15 +15,19 @@ use std::f32::consts::PI;
 use std::io;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use crossbeam_queue::ArrayQueue;
 use kmc_proto::{
     AfFrame, AllState, BatteryVoltage, ChassisFrame, DecoderCounters, HostFrame, HostFrameDecoder, MAX_FRAME_LEN,
     ParamId, PcControl, Rw, VehicleSpeed,
 };
+use robowire_rt::lock;
 use robowire_serial::{Pty, PtyDevice};
+
+use crate::handover::{Published, Requests};
 
 /// Simulator settings.
 #[derive(Debug, Clone)]
@@ -136,23 +140,39 @@ pub struct Received {
 /// How many received frames [`ChassisSim::received`] keeps.
 pub const RECEIVED_LOG_LEN: usize = 16_384;
 
+/// What the API asks of the simulator's thread.
 #[derive(Debug)]
-struct Shared {
+enum Request {
+    Fault(Fault),
+    /// A new line to plug in (after a hang-up).
+    Plug(Pty),
+}
+
+/// What the simulator's thread publishes after each round.
+#[derive(Debug, Clone, Copy, Default)]
+struct View {
     state: ChassisState,
     stats: ChassisSimStats,
-    received: VecDeque<Received>,
-    garbage_pending: usize,
-    drop_pending: u32,
-    hang_up: bool,
-    /// Replaced by the thread when a re-plug opens a new pty.
-    slave_path: PathBuf,
-    new_pty: Option<Pty>,
+}
+
+/// What the simulator's thread shares with the handle, none of it a lock the thread takes.
+#[derive(Debug)]
+struct Handover {
+    requests: Requests<Request>,
+    view: Published<View>,
+    /// Frames as they arrive; the handle moves them into its log (the oldest replaced when the
+    /// handle does not read).
+    received: ArrayQueue<Received>,
 }
 
 /// A running simulated chassis. Dropping it stops the simulator and removes its symlink.
 #[derive(Debug)]
 pub struct ChassisSim {
-    shared: Arc<Mutex<Shared>>,
+    handover: Arc<Handover>,
+    /// The current pty's path: the handle replaces the line, so it knows it.
+    pty_path: Mutex<PathBuf>,
+    /// The last [`RECEIVED_LOG_LEN`] frames, oldest first, as the handle collected them.
+    received: Mutex<VecDeque<Received>>,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     link: Option<PathBuf>,
@@ -161,32 +181,28 @@ pub struct ChassisSim {
 /// The device end of the line, with the chassis's decoder.
 type Line = PtyDevice<HostFrameDecoder>;
 
-fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
-    shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-}
+/// Requests the thread has not taken yet (a fault a round; the API waits for each).
+const REQUESTS: usize = 16;
 
 impl ChassisSim {
     /// Opens a pty and starts the simulator on its own thread.
     pub fn spawn(config: ChassisSimConfig) -> io::Result<Self> {
         let line = Line::open(HostFrameDecoder::new, config.link.clone())?;
-        let shared = Arc::new(Mutex::new(Shared {
-            state: ChassisState { battery_volts: config.battery_initial_volts, ..ChassisState::default() },
-            stats: ChassisSimStats::default(),
-            received: VecDeque::with_capacity(RECEIVED_LOG_LEN),
-            garbage_pending: 0,
-            drop_pending: 0,
-            hang_up: false,
-            slave_path: line.pty_path().to_path_buf(),
-            new_pty: None,
-        }));
+        let state = ChassisState { battery_volts: config.battery_initial_volts, ..ChassisState::default() };
+        let handover = Arc::new(Handover {
+            requests: Requests::new(REQUESTS),
+            view: Published::new(&View { state, ..View::default() }),
+            received: ArrayQueue::new(RECEIVED_LOG_LEN),
+        });
+        let pty_path = Mutex::new(line.pty_path().to_path_buf());
         let stop = Arc::new(AtomicBool::new(false));
         let link = config.link.clone();
         let thread = std::thread::Builder::new().name("kmc-chassis-sim".into()).spawn({
-            let shared = shared.clone();
+            let handover = handover.clone();
             let stop = stop.clone();
-            move || Model::new(config).run(line, &shared, &stop)
+            move || Model::new(config, state).run(line, &handover, &stop)
         })?;
-        Ok(Self { shared, stop, thread: Some(thread), link })
+        Ok(Self { handover, pty_path, received: Mutex::new(VecDeque::new()), stop, thread: Some(thread), link })
     }
 
     /// The path a client opens: the symlink if configured, else the pty (`/dev/pts/N`).
@@ -196,42 +212,43 @@ impl ChassisSim {
 
     /// The current pty's device path.
     pub fn pty_path(&self) -> PathBuf {
-        lock(&self.shared).slave_path.clone()
+        lock(&self.pty_path).clone()
     }
 
-    /// Injects a fault.
+    /// Injects a fault; in force when this returns.
     pub fn inject(&self, fault: Fault) {
-        let mut s = lock(&self.shared);
-        match fault {
-            Fault::Garbage { bytes } => s.garbage_pending += bytes,
-            Fault::DropResponses { count } => s.drop_pending += count,
-            Fault::HangUp => s.hang_up = true,
-        }
+        self.handover.requests.call(Request::Fault(fault), || {});
     }
 
     /// After a [`Fault::HangUp`]: plugs a new pty in and points the symlink at it.
     pub fn replug(&self) -> io::Result<PathBuf> {
         let pty = Pty::open()?;
         let path = pty.slave_path().to_path_buf();
-        let mut s = lock(&self.shared);
-        s.slave_path = path.clone();
-        s.new_pty = Some(pty);
+        *lock(&self.pty_path) = path.clone();
+        self.handover.requests.call(Request::Plug(pty), || {});
         Ok(path)
     }
 
     /// The modelled state.
     pub fn state(&self) -> ChassisState {
-        lock(&self.shared).state
+        self.handover.view.read().state
     }
 
     /// Counters.
     pub fn stats(&self) -> ChassisSimStats {
-        lock(&self.shared).stats
+        self.handover.view.read().stats
     }
 
     /// The last [`RECEIVED_LOG_LEN`] frames received, oldest first.
     pub fn received(&self) -> Vec<Received> {
-        lock(&self.shared).received.iter().copied().collect()
+        let mut log = lock(&self.received);
+        while let Some(frame) = self.handover.received.pop() {
+            if log.len() == RECEIVED_LOG_LEN {
+                log.pop_front();
+            }
+            log.push_back(frame);
+        }
+        log.iter().copied().collect()
     }
 }
 
@@ -253,75 +270,115 @@ const POLL_INTERVAL: Duration = Duration::from_millis(5);
 /// Longest a response write may block on a client that does not read.
 const WRITE_TIMEOUT: Duration = Duration::from_millis(500);
 
-/// The physics and the protocol logic; owned by the simulator thread.
+/// The physics and the protocol logic, with the state, counters and pending faults: owned by
+/// the simulator's thread.
 struct Model {
     config: ChassisSimConfig,
+    state: ChassisState,
+    stats: ChassisSimStats,
+    garbage_pending: usize,
+    drop_pending: u32,
     last_update: Instant,
     last_control: Option<Instant>,
     wheel_position_deg: [f32; 2],
     rng: u64,
+    /// A round's frames, answers and bytes out (kept to reuse their memory).
+    frames: Vec<HostFrame>,
+    responses: Vec<ChassisFrame>,
+    out: Vec<u8>,
 }
 
 impl Model {
-    fn new(config: ChassisSimConfig) -> Self {
+    fn new(config: ChassisSimConfig, state: ChassisState) -> Self {
         let rng = config.seed | 1;
-        Self { config, last_update: Instant::now(), last_control: None, wheel_position_deg: [0.0; 2], rng }
+        Self {
+            config,
+            state,
+            stats: ChassisSimStats::default(),
+            garbage_pending: 0,
+            drop_pending: 0,
+            last_update: Instant::now(),
+            last_control: None,
+            wheel_position_deg: [0.0; 2],
+            rng,
+            frames: Vec::new(),
+            responses: Vec::new(),
+            out: Vec::new(),
+        }
     }
 
-    fn run(mut self, mut line: Line, shared: &Mutex<Shared>, stop: &AtomicBool) {
+    fn run(mut self, mut line: Line, handover: &Handover, stop: &AtomicBool) {
         while !stop.load(Ordering::Relaxed) {
-            {
-                let mut s = lock(shared);
-                if std::mem::take(&mut s.hang_up) {
-                    s.stats.hang_ups += 1;
-                    line.hang_up();
+            self.frames.clear();
+            // A read error other than "no client yet" leaves the line as it is; try again.
+            let _ = line.receive(POLL_INTERVAL, |frame| self.frames.push(frame));
+            // Faults asked for until now apply to this round's answers.
+            let taken = handover.requests.take(|request| self.apply(request, &mut line));
+            let now = Instant::now();
+            self.advance(now);
+            self.responses.clear();
+            for i in 0..self.frames.len() {
+                let frame = self.frames[i];
+                // The oldest is replaced when the handle does not collect them.
+                let _ = handover.received.force_push(Received { at: now, frame });
+                if let Some(response) = self.handle(frame, now) {
+                    self.responses.push(response);
                 }
-                if let Some(new) = s.new_pty.take()
-                    && line.plug_in(new).is_err()
-                {
+            }
+            self.stats.decoder = line.counters().decoder;
+            self.emit_responses();
+            // Published before the answers go out: a client that got one sees its effect.
+            handover.view.publish(&View { state: self.state, stats: self.stats });
+            handover.requests.confirm(taken);
+            if !self.out.is_empty() {
+                // A client that does not read: the answer is lost, as on a real line.
+                let _ = line.send(&self.out, WRITE_TIMEOUT);
+            }
+        }
+    }
+
+    fn apply(&mut self, request: Request, line: &mut Line) {
+        match request {
+            Request::Fault(Fault::Garbage { bytes }) => {
+                self.garbage_pending = self.garbage_pending.saturating_add(bytes)
+            }
+            Request::Fault(Fault::DropResponses { count }) => {
+                self.drop_pending = self.drop_pending.saturating_add(count)
+            }
+            Request::Fault(Fault::HangUp) => {
+                self.stats.hang_ups += 1;
+                line.hang_up();
+            }
+            Request::Plug(pty) => {
+                if line.plug_in(pty).is_err() {
                     // The symlink could not be pointed at the new line: stay unplugged.
                     line.hang_up();
                 }
             }
-            let mut frames = Vec::new();
-            // A read error other than "no client yet" leaves the line as it is; try again.
-            let _ = line.receive(POLL_INTERVAL, |frame| frames.push(frame));
-            let now = Instant::now();
-            let mut responses: Vec<ChassisFrame> = Vec::new();
-            let mut s = lock(shared);
-            self.advance(&mut s, now);
-            for frame in frames {
-                if s.received.len() == RECEIVED_LOG_LEN {
-                    s.received.pop_front();
-                }
-                s.received.push_back(Received { at: now, frame });
-                if let Some(response) = self.handle(&mut s, frame, now) {
-                    responses.push(response);
-                }
+        }
+    }
+
+    /// This round's answers as bytes in `out`, after the garbage and without the dropped ones.
+    fn emit_responses(&mut self) {
+        self.out.clear();
+        if !self.responses.is_empty() && self.garbage_pending > 0 {
+            let count = std::mem::take(&mut self.garbage_pending);
+            for _ in 0..count {
+                let byte = self.garbage_byte();
+                self.out.push(byte);
             }
-            s.stats.decoder = line.counters().decoder;
-            let mut out = Vec::new();
-            if !responses.is_empty() && s.garbage_pending > 0 {
-                let count = std::mem::take(&mut s.garbage_pending);
-                out.extend((0..count).map(|_| self.garbage_byte()));
-                s.stats.garbage_bytes_sent += count as u64;
+            self.stats.garbage_bytes_sent += count as u64;
+        }
+        for response in &self.responses {
+            if self.drop_pending > 0 {
+                self.drop_pending -= 1;
+                self.stats.responses_dropped += 1;
+                continue;
             }
-            for response in responses {
-                if s.drop_pending > 0 {
-                    s.drop_pending -= 1;
-                    s.stats.responses_dropped += 1;
-                    continue;
-                }
-                let mut frame = [0u8; MAX_FRAME_LEN];
-                if let Ok(len) = response.emit(&mut frame) {
-                    out.extend_from_slice(&frame[..len]);
-                    s.stats.responses_sent += 1;
-                }
-            }
-            drop(s);
-            if !out.is_empty() {
-                // A client that does not read: the answer is lost, as on a real line.
-                let _ = line.send(&out, WRITE_TIMEOUT);
+            let mut frame = [0u8; MAX_FRAME_LEN];
+            if let Ok(len) = response.emit(&mut frame) {
+                self.out.extend_from_slice(&frame[..len]);
+                self.stats.responses_sent += 1;
             }
         }
     }
@@ -340,18 +397,18 @@ impl Model {
     }
 
     /// Integrates the model up to `now`.
-    fn advance(&mut self, s: &mut Shared, now: Instant) {
+    fn advance(&mut self, now: Instant) {
         let dt = now.saturating_duration_since(self.last_update).as_secs_f32();
         self.last_update = now;
         if let (Some(limit), Some(last)) = (self.config.command_watchdog, self.last_control)
             && now.saturating_duration_since(last) > limit
-            && s.state.commanded_velocity_mps != 0.0
+            && self.state.commanded_velocity_mps != 0.0
         {
-            s.state.commanded_velocity_mps = 0.0;
-            s.state.commanded_curvature_per_m = 0.0;
-            s.stats.watchdog_stops += 1;
+            self.state.commanded_velocity_mps = 0.0;
+            self.state.commanded_curvature_per_m = 0.0;
+            self.stats.watchdog_stops += 1;
         }
-        let st = &mut s.state;
+        let st = &mut self.state;
         let tau = self.config.speed_time_constant.as_secs_f32().max(1e-3);
         let previous = st.speed_mps;
         st.speed_mps = st.commanded_velocity_mps + (previous - st.commanded_velocity_mps) * (-dt / tau).exp();
@@ -365,53 +422,53 @@ impl Model {
         st.battery_volts = (st.battery_volts - self.config.battery_drain_volts_per_s * load * dt).max(0.0);
     }
 
-    fn handle(&mut self, s: &mut Shared, frame: HostFrame, now: Instant) -> Option<ChassisFrame> {
+    fn handle(&mut self, frame: HostFrame, now: Instant) -> Option<ChassisFrame> {
         match frame {
             HostFrame::PcControl(PcControl { velocity_mps, curvature_per_m }) => {
-                s.stats.control_frames += 1;
-                s.state.commanded_velocity_mps = velocity_mps;
-                s.state.commanded_curvature_per_m = curvature_per_m;
+                self.stats.control_frames += 1;
+                self.state.commanded_velocity_mps = velocity_mps;
+                self.state.commanded_curvature_per_m = curvature_per_m;
                 self.last_control = Some(now);
                 None
             }
             HostFrame::VehicleSpeedRequest => {
-                s.stats.speed_requests += 1;
-                Some(ChassisFrame::VehicleSpeed(VehicleSpeed { speed_mps: s.state.speed_mps }))
+                self.stats.speed_requests += 1;
+                Some(ChassisFrame::VehicleSpeed(VehicleSpeed { speed_mps: self.state.speed_mps }))
             }
-            HostFrame::Af(request) => self.handle_af(s, &request),
+            HostFrame::Af(request) => self.handle_af(&request),
         }
     }
 
-    fn handle_af(&mut self, s: &mut Shared, request: &AfFrame) -> Option<ChassisFrame> {
+    fn handle_af(&mut self, request: &AfFrame) -> Option<ChassisFrame> {
         let motor = request.motor_id();
         match request.rw() {
             Rw::Read => {
-                s.stats.af_reads += 1;
+                self.stats.af_reads += 1;
                 match request.ids() {
                     [ParamId::BatteryVoltage] => Some(ChassisFrame::BatteryVoltage(BatteryVoltage {
                         motor_id: motor,
-                        volts: s.state.battery_volts,
+                        volts: self.state.battery_volts,
                     })),
-                    [ParamId::AllState] => Some(ChassisFrame::AllState(self.all_state(s, motor))),
+                    [ParamId::AllState] => Some(ChassisFrame::AllState(self.all_state(motor))),
                     _ => {
-                        s.stats.unanswered_reads += 1;
+                        self.stats.unanswered_reads += 1;
                         None
                     }
                 }
             }
             Rw::Write => {
-                s.stats.af_writes += 1;
+                self.stats.af_writes += 1;
                 for (i, id) in request.ids().iter().enumerate() {
                     let value = request.slot_f32(i).unwrap_or(0.0);
                     let m = usize::from(motor.min(1));
                     match id {
-                        ParamId::SpeedErpm => s.state.speed_erpm[m] = value,
-                        ParamId::ServoPulseUs => s.state.servo_pulse_us[m] = value,
+                        ParamId::SpeedErpm => self.state.speed_erpm[m] = value,
+                        ParamId::ServoPulseUs => self.state.servo_pulse_us[m] = value,
                         ParamId::SystemReset => {
-                            s.stats.resets += 1;
-                            s.state.commanded_velocity_mps = 0.0;
-                            s.state.commanded_curvature_per_m = 0.0;
-                            s.state.speed_mps = 0.0;
+                            self.stats.resets += 1;
+                            self.state.commanded_velocity_mps = 0.0;
+                            self.state.commanded_curvature_per_m = 0.0;
+                            self.state.speed_mps = 0.0;
                         }
                         ParamId::AllState | ParamId::BatteryVoltage => {}
                     }
@@ -421,11 +478,11 @@ impl Model {
         }
     }
 
-    fn all_state(&self, s: &Shared, motor: u8) -> AllState {
+    fn all_state(&self, motor: u8) -> AllState {
         let m = usize::from(motor.min(1));
-        let wheel = wheel_speed_mps(&s.state, m);
+        let wheel = wheel_speed_mps(&self.state, m);
         let speed_rpm = wheel / (2.0 * PI * WHEEL_RADIUS_M) * 60.0;
-        let accel = (s.state.commanded_velocity_mps - s.state.speed_mps).abs()
+        let accel = (self.state.commanded_velocity_mps - self.state.speed_mps).abs()
             / self.config.speed_time_constant.as_secs_f32().max(1e-3);
         AllState {
             motor_id: motor,
@@ -434,7 +491,7 @@ impl Model {
             position_deg: self.wheel_position_deg[m],
             speed_rpm,
             current_a: 0.4 + 0.8 * wheel.abs() + 1.5 * accel,
-            temperature_c: 30.0 + 2.0 * s.state.speed_mps.abs(),
+            temperature_c: 30.0 + 2.0 * self.state.speed_mps.abs(),
             error_code: 0,
             reserved: [0.0; 3],
         }

@@ -5,9 +5,13 @@
 pub mod dog;
 #[cfg(feature = "go2")]
 pub mod go2;
+#[cfg(any(feature = "kmc", feature = "zsl", feature = "go2"))]
+mod handover;
 #[cfg(any(feature = "zsl", feature = "go2"))]
 mod joints;
 #[cfg(feature = "kmc")]
 pub mod kmc;
+#[cfg(feature = "replay")]
+pub mod replay;
 #[cfg(feature = "zsl")]
 pub mod spline;

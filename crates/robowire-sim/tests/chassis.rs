@@ -1,6 +1,8 @@
 //! The chassis simulator from the host end of the serial transport, as a driver sees it:
 //! requests answered, faults injected on the line, an unplugged and re-plugged adapter.
 
+mod hammer;
+
 use std::time::Duration;
 
 use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME_LEN, PcControl};
@@ -87,4 +89,29 @@ fn an_unplugged_adapter_is_seen_and_a_replug_reopened_at_the_stable_path() {
         drop(sim);
         assert!(!link_path.exists(), "the simulator removes its symlink");
     });
+}
+
+#[test]
+fn requests_are_answered_while_the_api_is_hammered() {
+    let sim = ChassisSim::spawn(ChassisSimConfig::default()).unwrap();
+    let api = || {
+        let _ = (sim.stats(), sim.state(), sim.received().len(), sim.pty_path());
+        // Faults that change nothing, through the same hand-over as any other.
+        sim.inject(Fault::Garbage { bytes: 0 });
+        sim.inject(Fault::DropResponses { count: 0 });
+    };
+    let ((), calls) = hammer::while_hammering(api, || {
+        runtime().block_on(async {
+            let mut link =
+                SerialLink::open(sim.path(), &SerialPortOptions::default(), ChassisFrameDecoder::new()).unwrap();
+            for _ in 0..200 {
+                send(&mut link, HostFrame::VehicleSpeedRequest).await;
+                assert!(matches!(recv(&mut link).await, ChassisFrame::VehicleSpeed(_)));
+            }
+        });
+    });
+    assert!(calls > 0, "the API ran meanwhile");
+    let stats = sim.stats();
+    assert_eq!((stats.speed_requests, stats.responses_sent, stats.responses_dropped), (200, 200, 0), "{stats:?}");
+    assert_eq!(sim.received().len(), 200);
 }

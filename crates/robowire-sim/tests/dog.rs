@@ -1,12 +1,14 @@
 //! The dog simulator from the client end of the UDP transport, with the ZSL-1 client codec:
 //! strict state, answers at once to a changed command, injected faults seen on the wire.
 
-use std::time::Duration;
+mod hammer;
+
+use std::time::{Duration, Instant};
 
 use robowire_sim::dog::{DogFault, DogSim, DogSimConfig};
 use robowire_udp::{Peer, UdpError, UdpLink};
 use zsl_proto::codec::{ClientCodec, StateDecoding};
-use zsl_proto::udp::{ControlMode, DatagramError, HighLevelCommand, HighLevelState, Model};
+use zsl_proto::udp::{ControlMode, DatagramError, HighLevelCommand, HighLevelState, Model, ReturnCode};
 
 const WATCHDOG: Duration = Duration::from_secs(10);
 
@@ -53,9 +55,9 @@ async fn faults_show_on_the_wire() {
     let mut link = client(&sim).await;
     until(&mut link, HighLevelCommand::default(), |_| true).await;
 
-    sim.inject(DogFault::ErrorWord(zsl_proto::udp::ReturnCode::MotorFault));
+    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
     let faulted = until(&mut link, HighLevelCommand::default(), |s| s.error().is_some()).await;
-    assert_eq!(faulted.error(), Some(zsl_proto::udp::ReturnCode::MotorFault));
+    assert_eq!(faulted.error(), Some(ReturnCode::MotorFault));
     sim.clear_faults();
 
     sim.inject(DogFault::Garbage);
@@ -78,4 +80,40 @@ async fn faults_show_on_the_wire() {
     assert!(tokio::time::timeout(Duration::from_millis(100), link.recv()).await.is_err(), "a silent dog");
     sim.clear_faults();
     until(&mut link, HighLevelCommand::default(), |_| true).await;
+}
+
+#[test]
+fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
+    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let api = || {
+        let _ = sim.snapshot();
+        sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+        sim.set_battery_percent(50.0);
+        sim.clear_faults();
+    };
+    let before = sim.snapshot();
+    let (after, calls) = hammer::while_hammering(api, || {
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        runtime.block_on(async {
+            let mut link = client(&sim).await;
+            let start = Instant::now();
+            loop {
+                // A command now and then: the dog streams to whoever commands it.
+                link.send(&HighLevelCommand::default()).await.unwrap();
+                let _ = tokio::time::timeout(Duration::from_millis(20), link.recv()).await;
+                let now = sim.snapshot();
+                if now.cycles >= before.cycles + 500 && now.high_level.states_sent >= 250 {
+                    return now;
+                }
+                assert!(start.elapsed() < WATCHDOG, "the stream stalled: {now:?}");
+            }
+        })
+    });
+    assert!(calls > 0, "the API ran meanwhile");
+    let (ran, missed) = (after.cycles - before.cycles, after.missed_cycles - before.missed_cycles);
+    assert!(missed < ran / 2, "{missed} ticks skipped while {ran} ran");
+    // The hammer's last call was a clear, after the battery was set: both in force.
+    let last = sim.snapshot().dog;
+    assert_eq!(last.faults(), Default::default());
+    assert_eq!(last.battery_percent().ceil(), 50.0);
 }

@@ -2,6 +2,8 @@
 //! handshake and the versioned IMU record, as `zsl-proto` lays them out and `robowire-shm`
 //! implements them, without the `zsl` facade.
 
+mod hammer;
+
 use std::time::{Duration, Instant};
 
 use robowire_shm::{MappedRegion, SharedRegion};
@@ -59,4 +61,31 @@ fn the_daemon_takes_commands_and_publishes_state_and_imu() {
     let read = imu.read_versioned(&IMU_RECORD, sample.as_mut_bytes(), 16).unwrap();
     assert!(read.version > 0, "the timestamp is the version");
     assert_eq!(sample.acc[2].get(), 9.81);
+}
+
+#[test]
+fn the_loop_keeps_its_cycles_while_the_api_is_hammered() {
+    let sim = SplineSim::spawn(SplineSimConfig::private("sim-hammer")).unwrap();
+    let api = || {
+        let _ = (sim.stats(), sim.state());
+        // Requests that change nothing, through the same hand-over as any other.
+        sim.pause(false);
+        sim.inject_fault(Leg::FrontLeft, JointIndex::Knee, 0);
+    };
+    let before = sim.stats();
+    let (after, calls) = hammer::while_hammering(api, || {
+        let deadline = Instant::now() + Duration::from_secs(20);
+        loop {
+            let now = sim.stats();
+            if now.cycles >= before.cycles + 1000 {
+                return now;
+            }
+            assert!(Instant::now() < deadline, "the loop stalled: {now:?}");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    });
+    assert!(calls > 0, "the API ran meanwhile");
+    let (ran, missed) = (after.cycles - before.cycles, after.missed_cycles - before.missed_cycles);
+    assert!(missed < ran / 2, "{missed} cycles skipped while {ran} ran");
+    assert!(after.daemon.states_published - before.daemon.states_published >= ran, "a state every cycle");
 }

@@ -1,27 +1,32 @@
 //! [`DogSim`]: the [`DogModel`] on the two UDP ports of the ZSL-1, through `robowire-udp`'s
 //! device side and the ZSL-1 dog codecs, so that the transport is exercised from both ends.
 //!
-//! A thread runs a small tokio runtime that receives commands on both ports and answers a
-//! command that changes something at once; robowire's runner streams state to each client every
-//! `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted).
+//! The dog lives on its state stream (robowire's runner): it sends state to each client every
+//! `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted) and
+//! answers a command that changes something at once. A thread runs a small tokio runtime that
+//! receives commands on both ports and hands them over in a lock-free queue, waking the stream
+//! for a command that differs from the one before. The handle's requests and snapshots go
+//! through the crate's `handover` module: the stream takes no lock.
 
 use std::io;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use crossbeam_queue::ArrayQueue;
 use robowire_core::DatagramCodec;
 use robowire_core::schedule::{Periodic, Time};
 use robowire_core::timing::LatenessSummary;
-use robowire_rt::runner::{Job, Runner, RunnerOptions};
-use robowire_rt::stats::{SharedLateness, micros};
+use robowire_rt::runner::{Job, Runner, RunnerOptions, Waker};
+use robowire_rt::stats::{Counter, SharedLateness, micros};
 use robowire_udp::{Peer, UdpError, UdpLink, UdpReceiver, UdpSender};
 use tokio::sync::watch;
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
-use zsl_proto::udp::{HIGH_LEVEL_PORT, LOW_LEVEL_PORT, Model};
+use zsl_proto::udp::{HIGH_LEVEL_PORT, HighLevelCommand, LOW_LEVEL_PORT, LowLevelCommand, Model};
 
 use super::model::{DogFault, DogModel, Faults};
+use crate::handover::{Published, Requests, StreamStats};
 
 /// Simulator settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,6 +81,9 @@ pub struct PortStats {
     pub commands: u64,
     /// Datagrams that failed strict decoding (counted, ignored).
     pub invalid: u64,
+    /// Valid commands dropped because the state stream had not taken the ones before them (it
+    /// stalled for longer than its hand-over holds).
+    pub dropped: u64,
     /// State datagrams sent.
     pub states_sent: u64,
     /// Junk datagrams sent (garbage fault).
@@ -104,91 +112,103 @@ pub struct DogSnapshot {
     pub state_lateness: LatenessSummary,
 }
 
-/// One port: its sending half and counters.
-struct Port<C> {
-    sender: UdpSender<C>,
-    stats: PortStats,
-    /// When the last valid command arrived (the kernel's stamp, or the monotonic clock).
-    last_command: Option<Duration>,
+/// A valid command, as the receive task hands it to the state stream.
+#[derive(Debug, Clone, Copy)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "the queue's slots are allocated once; a boxed command would be freed on the stream thread"
+)]
+enum Command {
+    High(HighLevelCommand, Model),
+    Low(LowLevelCommand),
 }
 
-impl<C: DatagramCodec> Port<C> {
-    fn new(sender: UdpSender<C>, client: Option<SocketAddr>) -> Self {
-        Self { sender, stats: PortStats { client, ..PortStats::default() }, last_command: None }
-    }
+/// What the API asks of the state stream.
+#[derive(Debug, Clone, Copy)]
+enum Request {
+    Inject(DogFault),
+    ClearFaults,
+    SetBatteryPercent(f32),
+}
 
-    /// A valid command arrived at `stamp` (the kernel's arrival stamp: the interval on the wire,
-    /// whatever the receiving thread's scheduling; without one, now); records |interval −
-    /// `period`| in `jitter`.
-    fn on_command(&mut self, period: Duration, jitter: &SharedLateness<4096>, stamp: Option<Duration>) {
-        let at = stamp.unwrap_or_else(|| Duration::from_nanos(robowire_rt::monotonic_ns()));
-        self.stats.commands += 1;
-        if let Some(last) = self.last_command.replace(at) {
-            jitter.record(micros(at.saturating_sub(last).abs_diff(period)));
+/// The counters of one port, each written by one thread (the receive task: commands, invalid,
+/// dropped, jitter; the state stream: states and garbage sent).
+#[derive(Debug, Default)]
+struct PortCounters {
+    commands: Counter,
+    invalid: Counter,
+    dropped: Counter,
+    states_sent: Counter,
+    garbage_sent: Counter,
+    jitter: SharedLateness<4096>,
+}
+
+impl PortCounters {
+    fn stats(&self, client: Option<SocketAddr>) -> PortStats {
+        PortStats {
+            commands: self.commands.get(),
+            invalid: self.invalid.get(),
+            dropped: self.dropped.get(),
+            states_sent: self.states_sent.get(),
+            garbage_sent: self.garbage_sent.get(),
+            client,
+            command_jitter: self.jitter.summary(),
         }
     }
-
-    fn stats(&self, jitter: &SharedLateness<4096>) -> PortStats {
-        PortStats { client: self.sender.destination(), command_jitter: jitter.summary(), ..self.stats }
-    }
 }
 
-struct Shared {
+/// What the state stream publishes: the robot and whom each port answers.
+#[derive(Debug, Clone)]
+struct View {
     dog: DogModel,
-    high: Port<HighLevelDogCodec>,
-    low: Port<LowLevelDogCodec>,
-    period: Duration,
-    cycles: u64,
-    missed_cycles: u64,
+    high_level_client: Option<SocketAddr>,
+    low_level_client: Option<SocketAddr>,
 }
 
-/// Timing statistics, kept out of the model's lock: each ring has one writer, and a reader
-/// sorts its copy without holding up the state stream.
-#[derive(Default)]
-struct Timing {
-    state_lateness: SharedLateness<4096>,
-    high_level_jitter: SharedLateness<4096>,
-    low_level_jitter: SharedLateness<4096>,
+/// What the state stream shares with the receive task and the handle, none of it a lock the
+/// stream takes.
+#[derive(Debug)]
+struct Handover {
+    /// Commands in arrival order: each may change what the dog does.
+    commands: ArrayQueue<Command>,
+    requests: Requests<Request>,
+    view: Published<View>,
+    stream: StreamStats<4096>,
+    high_level: PortCounters,
+    low_level: PortCounters,
 }
 
-fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
-    shared.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-}
+/// Commands the receive task may hand over before the stream takes them: a second of both
+/// ports at 500 Hz.
+const COMMANDS: usize = 1024;
+/// Requests the stream has not taken yet (the API waits for each).
+const REQUESTS: usize = 16;
 
 /// Junk the garbage fault sends: longer than any state, so no decoder accepts it.
 const GARBAGE: [u8; 600] = [0xEE; 600];
 
-impl<C: DatagramCodec> Port<C> {
-    /// Sends `state` (or junk, or nothing, as `faults` say) to the port's client, if it has one.
-    fn send_state(&mut self, faults: Faults, state: impl FnOnce() -> C::Outgoing) {
-        if faults.silence || self.sender.destination().is_none() {
-            return;
-        }
-        if faults.garbage {
-            self.stats.garbage_sent += u64::from(self.sender.send_bytes_now(&GARBAGE).is_ok());
-        } else {
-            self.stats.states_sent += u64::from(self.sender.send_now(&state()).is_ok());
-        }
+/// Sends `state` (or junk, or nothing, as `faults` say) to the port's client, if it has one.
+fn send_state<C: DatagramCodec>(
+    sender: &mut UdpSender<C>,
+    counters: &PortCounters,
+    faults: Faults,
+    state: impl FnOnce() -> C::Outgoing,
+) {
+    if faults.silence || sender.destination().is_none() {
+        return;
     }
-}
-
-impl Shared {
-    fn send_high_level(&mut self) {
-        let dog = &self.dog;
-        self.high.send_state(dog.faults(), || dog.high_level_state());
-    }
-
-    fn send_low_level(&mut self) {
-        let dog = &self.dog;
-        self.low.send_state(dog.faults(), || dog.low_level_state());
+    if faults.garbage {
+        counters.garbage_sent.add(u64::from(sender.send_bytes_now(&GARBAGE).is_ok()));
+    } else {
+        counters.states_sent.add(u64::from(sender.send_now(&state()).is_ok()));
     }
 }
 
 /// The dog on two UDP ports, on its own threads; stopped on drop.
 pub struct DogSim {
-    shared: Arc<Mutex<Shared>>,
-    timing: Arc<Timing>,
+    handover: Arc<Handover>,
     stream: Option<Runner<StateStream>>,
+    waker: Waker,
     stop_receiving: watch::Sender<bool>,
     receiver: Option<JoinHandle<()>>,
     high_level_addr: SocketAddr,
@@ -204,10 +224,11 @@ impl std::fmt::Debug for DogSim {
     }
 }
 
+type Senders = (UdpSender<HighLevelDogCodec>, UdpSender<LowLevelDogCodec>);
 type Receivers = (UdpReceiver<HighLevelDogCodec>, UdpReceiver<LowLevelDogCodec>);
 
 /// Binds both ports inside `runtime`.
-fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<(Shared, Receivers)> {
+fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<(Senders, Receivers)> {
     let reply = Peer::Any { reply_to: config.client };
     let bind_error = |port: u16, e: UdpError<zsl_proto::udp::DatagramError>| {
         let kind = match &e {
@@ -229,15 +250,7 @@ fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<
         low.set_tap(config.low_level_tap.clone());
         let (high_tx, high_rx) = high.into_split();
         let (low_tx, low_rx) = low.into_split();
-        let shared = Shared {
-            dog: DogModel::new(config.model),
-            high: Port::new(high_tx, config.client),
-            low: Port::new(low_tx, config.client),
-            period: config.state_period,
-            cycles: 0,
-            missed_cycles: 0,
-        };
-        Ok((shared, (high_rx, low_rx)))
+        Ok(((high_tx, low_tx), (high_rx, low_rx)))
     })
 }
 
@@ -255,10 +268,19 @@ impl DogSim {
     /// Binds both ports and starts the robot lying down.
     pub fn spawn(config: DogSimConfig) -> io::Result<Self> {
         let (started_tx, started) = std::sync::mpsc::sync_channel(1);
+        let (waker_tx, waker_rx) = std::sync::mpsc::sync_channel::<Waker>(1);
         let (stop_receiving, mut stop_rx) = watch::channel(false);
-        let timing = Arc::new(Timing::default());
+        let dog = DogModel::new(config.model);
+        let handover = Arc::new(Handover {
+            commands: ArrayQueue::new(COMMANDS),
+            requests: Requests::new(REQUESTS),
+            view: Published::new(&View { dog: dog.clone(), high_level_client: None, low_level_client: None }),
+            stream: StreamStats::default(),
+            high_level: PortCounters::default(),
+            low_level: PortCounters::default(),
+        });
         let receiver = std::thread::Builder::new().name("dog-sim-rx".into()).spawn({
-            let (config, timing) = (config.clone(), timing.clone());
+            let (config, handover) = (config.clone(), handover.clone());
             move || {
                 let setup = || -> io::Result<_> {
                     if let Some(cpu) = config.cpu {
@@ -266,40 +288,42 @@ impl DogSim {
                             .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
                     }
                     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
-                    let (shared, receivers) = bind(&runtime, &config)?;
-                    Ok((runtime, Arc::new(Mutex::new(shared)), receivers))
+                    let (senders, receivers) = bind(&runtime, &config)?;
+                    Ok((runtime, senders, receivers))
                 };
-                let (runtime, shared, (high, low)) = match setup() {
+                let (runtime, senders, (high, low)) = match setup() {
                     Ok(ok) => ok,
                     Err(e) => {
                         let _ = started_tx.send(Err(e));
                         return;
                     }
                 };
-                let _ = started_tx.send(Ok(shared.clone()));
-                runtime.block_on(receive(shared, &timing, high, low, &mut stop_rx));
+                let _ = started_tx.send(Ok(senders));
+                // The stream's waker, once it runs (none: it did not start).
+                let Ok(waker) = waker_rx.recv() else { return };
+                let receive = Receive { handover: &handover, waker, period: config.state_period };
+                runtime.block_on(receive.run(high, low, &mut stop_rx));
             }
         })?;
-        let shared = started.recv().map_err(|_| io::Error::other("the dog simulator thread died"))??;
-        let (high_level_addr, low_level_addr) = {
-            let s = lock(&shared);
-            (s.high.sender.local_addr()?, s.low.sender.local_addr()?)
-        };
+        let (high, low) = started.recv().map_err(|_| io::Error::other("the dog simulator thread died"))??;
+        let (high_level_addr, low_level_addr) = (high.local_addr()?, low.local_addr()?);
         let job = StateStream {
-            shared: shared.clone(),
-            timing: timing.clone(),
+            dog,
+            high,
+            low,
+            handover: handover.clone(),
             grid: Periodic::new(robowire_rt::now(), config.state_period),
             last_step: None,
         };
-        let stream = Runner::spawn(
-            RunnerOptions::placed("dog-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }),
-            job,
-        )
-        .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
+        let placement = robowire_rt::Placement { cpu: config.cpu, ..Default::default() };
+        let stream = Runner::spawn(RunnerOptions::placed("dog-sim-state", placement), job)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
+        let waker = stream.waker();
+        let _ = waker_tx.send(waker.clone());
         Ok(Self {
-            shared,
-            timing,
+            handover,
             stream: Some(stream),
+            waker,
             stop_receiving,
             receiver: Some(receiver),
             high_level_addr,
@@ -317,31 +341,38 @@ impl DogSim {
         self.low_level_addr
     }
 
-    /// Injects a fault.
+    /// Hands `request` to the state stream; returns once it is in force.
+    fn call(&self, request: Request) {
+        self.handover.requests.call(request, || self.waker.wake());
+    }
+
+    /// Injects a fault; in force when this returns.
     pub fn inject(&self, fault: DogFault) {
-        lock(&self.shared).dog.inject(fault);
+        self.call(Request::Inject(fault));
     }
 
     /// Clears every fault.
     pub fn clear_faults(&self) {
-        lock(&self.shared).dog.clear_faults();
+        self.call(Request::ClearFaults);
     }
 
     /// Sets the battery level, %.
     pub fn set_battery_percent(&self, percent: f32) {
-        lock(&self.shared).dog.set_battery_percent(percent);
+        self.call(Request::SetBatteryPercent(percent));
     }
 
     /// The robot and the counters now.
     pub fn snapshot(&self) -> DogSnapshot {
-        let s = lock(&self.shared);
+        let h = &self.handover;
+        let view = h.view.read();
+        let stream = h.stream.summary();
         DogSnapshot {
-            dog: s.dog.clone(),
-            high_level: s.high.stats(&self.timing.high_level_jitter),
-            low_level: s.low.stats(&self.timing.low_level_jitter),
-            cycles: s.cycles,
-            missed_cycles: s.missed_cycles,
-            state_lateness: self.timing.state_lateness.summary(),
+            dog: view.dog,
+            high_level: h.high_level.stats(view.high_level_client),
+            low_level: h.low_level.stats(view.low_level_client),
+            cycles: stream.cycles,
+            missed_cycles: stream.missed,
+            state_lateness: stream.lateness,
         }
     }
 }
@@ -358,59 +389,92 @@ impl Drop for DogSim {
     }
 }
 
-/// Receives commands on both ports until told to stop; a command that changes what the dog was
-/// told to do is answered at once, before the socket is drained further (low latency for the
-/// client's acknowledgement).
-async fn receive(
-    shared: Arc<Mutex<Shared>>,
-    timing: &Timing,
-    mut high: UdpReceiver<HighLevelDogCodec>,
-    mut low: UdpReceiver<LowLevelDogCodec>,
-    stop: &mut watch::Receiver<bool>,
-) {
-    // Arrival as the network stack saw it: without the stamps, the intervals are the receiving
-    // thread's wake-ups. Best effort.
-    let _ = (high.enable_arrival_stamps(), low.enable_arrival_stamps());
-    loop {
-        tokio::select! {
-            _ = stop.changed() => return,
-            received = high.recv_stamped() => {
-                let mut s = lock(&shared);
-                match received {
+/// The receive task: counts and hands every valid command to the state stream in arrival order,
+/// and wakes the stream for one that differs from the port's previous command, so that a
+/// command that changes what the dog does is answered at once (the stream answers it before
+/// taking the next). A repeated command is taken at the next tick.
+struct Receive<'a> {
+    handover: &'a Handover,
+    waker: Waker,
+    period: Duration,
+}
+
+impl Receive<'_> {
+    async fn run(
+        self,
+        mut high: UdpReceiver<HighLevelDogCodec>,
+        mut low: UdpReceiver<LowLevelDogCodec>,
+        stop: &mut watch::Receiver<bool>,
+    ) {
+        // Arrival as the network stack saw it: without the stamps, the intervals are the
+        // receiving thread's wake-ups. Best effort.
+        let _ = (high.enable_arrival_stamps(), low.enable_arrival_stamps());
+        let h = self.handover;
+        let (mut high_port, mut low_port) = (Arrivals::default(), Arrivals::default());
+        loop {
+            tokio::select! {
+                _ = stop.changed() => return,
+                received = high.recv_stamped() => match received {
                     Ok(((command, model), _, stamp)) => {
-                        let period = s.period;
-                        s.high.on_command(period, &timing.high_level_jitter, stamp);
-                        if s.dog.on_high_level(&command, model) {
-                            s.send_high_level();
-                        }
+                        let changed = high_port.arrived(&h.high_level, self.period, stamp, (command, model));
+                        self.hand_over(&h.high_level, Command::High(command, model), changed);
                     }
-                    Err(UdpError::Decode(_)) => s.high.stats.invalid += 1,
+                    Err(UdpError::Decode(_)) => h.high_level.invalid.add(1),
                     // Socket errors are counted by the link.
                     Err(_) => {}
-                }
-            }
-            received = low.recv_stamped() => {
-                let mut s = lock(&shared);
-                match received {
+                },
+                received = low.recv_stamped() => match received {
                     Ok(((command, _), _, stamp)) => {
-                        let period = s.period;
-                        s.low.on_command(period, &timing.low_level_jitter, stamp);
-                        if s.dog.on_low_level(&command) {
-                            s.send_low_level();
-                        }
+                        let changed = low_port.arrived(&h.low_level, self.period, stamp, command);
+                        self.hand_over(&h.low_level, Command::Low(command), changed);
                     }
-                    Err(UdpError::Decode(_)) => s.low.stats.invalid += 1,
+                    Err(UdpError::Decode(_)) => h.low_level.invalid.add(1),
                     Err(_) => {}
-                }
+                },
             }
+        }
+    }
+
+    fn hand_over(&self, counters: &PortCounters, command: Command, changed: bool) {
+        if self.handover.commands.push(command).is_err() {
+            counters.dropped.add(1);
+        } else if changed {
+            self.waker.wake();
         }
     }
 }
 
-/// The state stream: steps the dog and sends state on each tick of the grid.
+/// What the receive task remembers of one port's commands.
+#[derive(Debug, Default)]
+struct Arrivals<T> {
+    /// When the last valid command arrived (the kernel's stamp, or the monotonic clock).
+    at: Option<Duration>,
+    last: Option<T>,
+}
+
+impl<T: PartialEq> Arrivals<T> {
+    /// A valid command arrived at `stamp` (the kernel's arrival stamp: the interval on the wire,
+    /// whatever the receiving thread's scheduling; without one, now): counted, |interval −
+    /// `period`| recorded. Whether it differs from the port's previous one.
+    fn arrived(&mut self, counters: &PortCounters, period: Duration, stamp: Option<Duration>, command: T) -> bool {
+        let at = stamp.unwrap_or_else(|| Duration::from_nanos(robowire_rt::monotonic_ns()));
+        counters.commands.add(1);
+        if let Some(last) = self.at.replace(at) {
+            counters.jitter.record(micros(at.saturating_sub(last).abs_diff(period)));
+        }
+        let previous = self.last.replace(command);
+        previous != self.last
+    }
+}
+
+/// The state stream: owns the dog and the sending halves; applies the API's requests and the
+/// commands as they come, answers a command that changed something at once, and steps the dog
+/// and sends state on each tick of the grid.
 struct StateStream {
-    shared: Arc<Mutex<Shared>>,
-    timing: Arc<Timing>,
+    dog: DogModel,
+    high: UdpSender<HighLevelDogCodec>,
+    low: UdpSender<LowLevelDogCodec>,
+    handover: Arc<Handover>,
     grid: Periodic,
     last_step: Option<Time>,
 }
@@ -418,20 +482,68 @@ struct StateStream {
 /// Longest step of the model, s: after a stall the dog does not jump.
 const MAX_STEP_S: f32 = 0.05;
 
+impl StateStream {
+    fn publish(&self) {
+        self.handover.view.publish(&View {
+            dog: self.dog.clone(),
+            high_level_client: self.high.destination(),
+            low_level_client: self.low.destination(),
+        });
+    }
+
+    fn send_high_level(&mut self) {
+        let dog = &self.dog;
+        send_state(&mut self.high, &self.handover.high_level, dog.faults(), || dog.high_level_state());
+    }
+
+    fn send_low_level(&mut self) {
+        let dog = &self.dog;
+        send_state(&mut self.low, &self.handover.low_level, dog.faults(), || dog.low_level_state());
+    }
+}
+
 impl Job for StateStream {
     fn next_run(&mut self) -> Option<Time> {
         Some(self.grid.deadline())
     }
 
     fn run(&mut self, now: Time) {
-        let Some(tick) = self.grid.poll(now) else { return };
-        let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
-        self.timing.state_lateness.record(micros(tick.lateness));
-        let mut s = lock(&self.shared);
-        s.missed_cycles += tick.skipped;
-        s.dog.step(dt.min(MAX_STEP_S));
-        s.cycles += 1;
-        s.send_high_level();
-        s.send_low_level();
+        let mut requested = false;
+        let taken = self.handover.requests.take(|request| {
+            requested = true;
+            match request {
+                Request::Inject(fault) => self.dog.inject(fault),
+                Request::ClearFaults => self.dog.clear_faults(),
+                Request::SetBatteryPercent(percent) => self.dog.set_battery_percent(percent),
+            }
+        });
+        while let Some(command) = self.handover.commands.pop() {
+            match command {
+                Command::High(command, model) => {
+                    if self.dog.on_high_level(&command, model) {
+                        // Published first: a client that got the answer sees its effect.
+                        self.publish();
+                        self.send_high_level();
+                    }
+                }
+                Command::Low(command) => {
+                    if self.dog.on_low_level(&command) {
+                        self.publish();
+                        self.send_low_level();
+                    }
+                }
+            }
+        }
+        if let Some(tick) = self.grid.poll(now) {
+            let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
+            self.handover.stream.record(&tick, true);
+            self.dog.step(dt.min(MAX_STEP_S));
+            self.publish();
+            self.send_high_level();
+            self.send_low_level();
+        } else if requested {
+            self.publish();
+        }
+        self.handover.requests.confirm(taken);
     }
 }

@@ -16,23 +16,25 @@
 mod model;
 mod services;
 
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use lowcmd_proto::api::{motion_switcher, sport};
 use lowcmd_proto::{LowCmd, LowState, Message, go2};
 use robowire_core::cdr::CdrType;
-use robowire_core::schedule::{Periodic, Time};
+use robowire_core::schedule::{Periodic, Tick, Time};
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, Participant, ParticipantOptions, Reader, StatsHandle, TopicStats, Writer};
-use robowire_rt::runner::{Job, Runner, RunnerOptions};
-use robowire_rt::stats::{Counter, SharedLateness, micros};
+use robowire_rt::runner::{Job, Runner, RunnerOptions, Waker};
+use robowire_rt::stats::{Counter, SharedLateness};
+use robowire_rt::{Latest, lock};
 use tokio::sync::watch;
 
 pub use model::{COMMAND_HOLD_S, Go2Body, JOINTS, LYING_POSE_RAD, STAND_POSE_RAD};
+
+use crate::handover::{Requests, StreamStats};
 
 /// The sport mode that owns the motors at boot.
 pub const BOOT_SPORT_MODE: &str = "normal";
@@ -115,34 +117,46 @@ pub struct Go2Snapshot {
     pub command_jitter: LatenessSummary,
 }
 
-/// What the state stream, the receive task and the services share (a simulator: one lock).
-struct Shared {
-    body: Go2Body,
-    sport_mode: String,
-    silent: bool,
-    bit_flip_every: u32,
-    log: Vec<String>,
-    /// The sport mode was said to ignore LowCmds (once per ownership).
-    ignore_logged: bool,
-    last_command: Option<Time>,
-}
-
-#[derive(Default)]
-struct Stats {
+/// What the state stream shares with the services thread and the handle, none of it a lock the
+/// stream takes.
+#[derive(Debug)]
+struct Handover {
+    requests: Requests<Request>,
+    /// The last accepted LowCmd, written by the services thread.
+    command: Latest<LowCmd>,
+    /// The state the stream sent last (for an immediate answer to a LowCmd).
+    state: Latest<LowState>,
+    /// Joint positions, rad, motor order, as the stream last stepped them.
+    joints: Latest<[f32; JOINTS]>,
+    stream: StreamStats<4096>,
+    corrupted: Counter,
+    /// The services thread's counters.
     accepted: Counter,
     ignored: Counter,
     bad_head: Counter,
-    requests: Counter,
-    corrupted: Counter,
-    lateness: SharedLateness<4096>,
+    requests_answered: Counter,
     jitter: SharedLateness<4096>,
 }
 
-fn lock(shared: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
-    shared.lock().unwrap_or_else(PoisonError::into_inner)
+/// What the handle asks of the state stream.
+#[derive(Debug, Clone, Copy)]
+enum Request {
+    Inject(Go2Fault),
+    ClearFaults,
 }
 
-impl Shared {
+/// Requests the stream has not taken yet (the handle waits for each).
+const REQUESTS: usize = 16;
+
+/// What the user is told: the sport mode owning the motors and the log. Written by the services
+/// thread when a mode changes and by the handle; never by the state stream.
+#[derive(Debug)]
+struct Report {
+    sport_mode: String,
+    log: Vec<String>,
+}
+
+impl Report {
     fn say(&mut self, line: impl Into<String>) {
         self.log.push(line.into());
     }
@@ -150,11 +164,12 @@ impl Shared {
 
 /// A running simulated Go2; stopped on drop.
 pub struct Go2Sim {
-    shared: Arc<Mutex<Shared>>,
-    stats: Arc<Stats>,
+    handover: Arc<Handover>,
+    report: Arc<Mutex<Report>>,
     lowstate: StatsHandle,
     lowcmd: StatsHandle,
     stream: Option<Runner<StateStream>>,
+    waker: Waker,
     stop: watch::Sender<bool>,
     services: Option<JoinHandle<()>>,
     _participant: Arc<Participant>,
@@ -185,18 +200,28 @@ impl Go2Sim {
     /// Joins the domain, starts the services, the LowCmd reader and the 500 Hz state stream.
     pub fn spawn(config: Go2SimConfig) -> Result<Self, Go2SimError> {
         let participant = Arc::new(Participant::new(config.participant.clone())?);
-        let shared = Arc::new(Mutex::new(Shared {
-            body: Go2Body::new(),
+        let body = Go2Body::new();
+        let handover = Arc::new(Handover {
+            requests: Requests::new(REQUESTS),
+            command: Latest::new(),
+            state: Latest::new(),
+            joints: Latest::new(),
+            stream: StreamStats::default(),
+            corrupted: Counter::default(),
+            accepted: Counter::default(),
+            ignored: Counter::default(),
+            bad_head: Counter::default(),
+            requests_answered: Counter::default(),
+            jitter: SharedLateness::new(),
+        });
+        handover.joints.write(robowire_rt::now(), &body.joint_positions());
+        let report = Arc::new(Mutex::new(Report {
             sport_mode: BOOT_SPORT_MODE.into(),
-            silent: false,
-            bit_flip_every: 0,
             log: vec![format!("booted lying down; sport mode \"{BOOT_SPORT_MODE}\" owns the motors")],
-            ignore_logged: false,
-            last_command: None,
         }));
-        let stats = Arc::new(Stats::default());
-        let writer = participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)?;
-        let corrupt = participant.writer::<BitFlipped>(LowState::TOPIC, Qos::WRITER)?;
+        // The stream's writers never wait: a full send window is a dropped sample, counted.
+        let writer = participant.writer::<LowState>(LowState::TOPIC, Qos::STREAM_WRITER)?;
+        let corrupt = participant.writer::<BitFlipped>(LowState::TOPIC, Qos::STREAM_WRITER)?;
         let lowstate = writer.stats_handle();
         let reader = participant.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER)?;
         let lowcmd = reader.stats_handle();
@@ -204,34 +229,35 @@ impl Go2Sim {
             config.answer_lowcmd.then(|| participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)).transpose()?;
         let switcher = services::service_server(&participant, motion_switcher::SERVICE)?;
         let sport = services::service_server(&participant, sport::SERVICE)?;
-        let (stop, stop_rx) = watch::channel(false);
-        let services = std::thread::Builder::new()
-            .name("go2-sim-services".into())
-            .spawn({
-                let (shared, stats, period) = (shared.clone(), stats.clone(), config.state_period);
-                let endpoints = services::Endpoints { lowcmd: reader, answers, switcher, sport };
-                move || services::run(shared, stats, endpoints, period, stop_rx)
-            })
-            .map_err(Go2SimError::Services)?;
         let job = StateStream {
-            shared: shared.clone(),
-            stats: stats.clone(),
+            body,
+            wire: WireFaults::default(),
+            handover: handover.clone(),
             writer,
             corrupt,
             grid: Periodic::new(robowire_rt::now(), config.state_period),
             period_ms: u32::try_from(config.state_period.as_millis()).unwrap_or(u32::MAX).max(1),
             last_step: None,
-            sent: AtomicU32::new(0),
+            seen_command: None,
+            sent: 0,
         };
-        let stream = Runner::spawn(
-            RunnerOptions::placed("go2-sim-state", robowire_rt::Placement { cpu: config.cpu, ..Default::default() }),
-            job,
-        )?;
+        let placement = robowire_rt::Placement { cpu: config.cpu, ..Default::default() };
+        let stream = Runner::spawn(RunnerOptions::placed("go2-sim-state", placement), job)?;
+        let (stop, stop_rx) = watch::channel(false);
+        let services = std::thread::Builder::new()
+            .name("go2-sim-services".into())
+            .spawn({
+                let (handover, report, period) = (handover.clone(), report.clone(), config.state_period);
+                let endpoints = services::Endpoints { lowcmd: reader, answers, switcher, sport };
+                move || services::run(&handover, &report, endpoints, period, stop_rx)
+            })
+            .map_err(Go2SimError::Services)?;
         Ok(Self {
-            shared,
-            stats,
+            handover,
+            report,
             lowstate,
             lowcmd,
+            waker: stream.waker(),
             stream: Some(stream),
             stop,
             services: Some(services),
@@ -239,53 +265,42 @@ impl Go2Sim {
         })
     }
 
-    /// Injects a fault.
+    /// Injects a fault; in force when this returns.
     pub fn inject(&self, fault: Go2Fault) {
-        let mut s = lock(&self.shared);
-        match fault {
-            Go2Fault::Silence => s.silent = true,
-            Go2Fault::MotorFault { motor } => s.body.set_motor_fault(motor, true),
-            Go2Fault::BitFlips { every } => s.bit_flip_every = every.max(1),
-        }
-        s.say(format!("fault injected: {fault:?}"));
+        self.handover.requests.call(Request::Inject(fault), || self.waker.wake());
+        lock(&self.report).say(format!("fault injected: {fault:?}"));
     }
 
     /// Clears every fault.
     pub fn clear_faults(&self) {
-        let mut s = lock(&self.shared);
-        s.silent = false;
-        s.bit_flip_every = 0;
-        for motor in 0..JOINTS {
-            s.body.set_motor_fault(motor, false);
-        }
-        s.say("faults cleared");
+        self.handover.requests.call(Request::ClearFaults, || self.waker.wake());
+        lock(&self.report).say("faults cleared");
     }
 
     /// The log lines since the last call (what the robot did that a user should know).
     pub fn take_log(&self) -> Vec<String> {
-        std::mem::take(&mut lock(&self.shared).log)
+        std::mem::take(&mut lock(&self.report).log)
     }
 
     /// The simulator now.
     pub fn snapshot(&self) -> Go2Snapshot {
         let reader = self.lowcmd.get();
-        let s = lock(&self.shared);
-        let st = &self.stats;
+        let h = &self.handover;
         Go2Snapshot {
-            sport_mode: s.sport_mode.clone(),
-            joints_rad: s.body.joint_positions(),
+            sport_mode: lock(&self.report).sport_mode.clone(),
+            joints_rad: h.joints.read().map_or(LYING_POSE_RAD, |(_, q)| q),
             lowcmd: LowCmdCounters {
-                accepted: st.accepted.get(),
-                ignored_sport_mode: st.ignored.get(),
-                bad_head: st.bad_head.get(),
+                accepted: h.accepted.get(),
+                ignored_sport_mode: h.ignored.get(),
+                bad_head: h.bad_head.get(),
                 bad_crc: reader.checksum_errors,
                 malformed: reader.decode_errors,
             },
             lowstate: self.lowstate.get(),
-            corrupted_states: st.corrupted.get(),
-            requests: st.requests.get(),
-            state_lateness: st.lateness.summary(),
-            command_jitter: st.jitter.summary(),
+            corrupted_states: h.corrupted.get(),
+            requests: h.requests_answered.get(),
+            state_lateness: h.stream.summary().lateness,
+            command_jitter: h.jitter.summary(),
         }
     }
 }
@@ -329,21 +344,74 @@ impl CdrType for BitFlipped {
     }
 }
 
-/// The 500 Hz state stream.
+/// The 500 Hz state stream: owns the body and the faults, takes the handle's requests and the
+/// latest accepted LowCmd, steps the body and writes `rt/lowstate` without ever waiting.
 struct StateStream {
-    shared: Arc<Mutex<Shared>>,
-    stats: Arc<Stats>,
+    body: Go2Body,
+    wire: WireFaults,
+    handover: Arc<Handover>,
     writer: Writer<LowState>,
     corrupt: Writer<BitFlipped>,
     grid: Periodic,
     /// The tick's step per slot, ms.
     period_ms: u32,
     last_step: Option<Time>,
-    sent: AtomicU32,
+    /// The stamp of the LowCmd the body follows.
+    seen_command: Option<Time>,
+    sent: u32,
 }
 
 /// Longest step of the model: after a stall the body does not jump.
 const MAX_STEP_S: f32 = 0.05;
+
+/// The faults of `rt/lowstate` itself.
+#[derive(Debug, Clone, Copy, Default)]
+struct WireFaults {
+    silent: bool,
+    /// Every n-th state with a bit flipped; 0: none.
+    bit_flip_every: u32,
+}
+
+/// Applies a request of the handle to the body and the wire.
+fn apply(body: &mut Go2Body, wire: &mut WireFaults, request: Request) {
+    match request {
+        Request::Inject(Go2Fault::Silence) => wire.silent = true,
+        Request::Inject(Go2Fault::MotorFault { motor }) => body.set_motor_fault(motor, true),
+        Request::Inject(Go2Fault::BitFlips { every }) => wire.bit_flip_every = every.max(1),
+        Request::ClearFaults => {
+            *wire = WireFaults::default();
+            for motor in 0..JOINTS {
+                body.set_motor_fault(motor, false);
+            }
+        }
+    }
+}
+
+impl StateStream {
+    /// One tick: step, publish, send.
+    fn tick(&mut self, now: Time, tick: &Tick) {
+        let h = &*self.handover;
+        h.stream.record(tick, true);
+        let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
+        self.body.step(dt.min(MAX_STEP_S));
+        let slots = u32::try_from(tick.skipped + 1).unwrap_or(u32::MAX);
+        self.body.advance_tick(self.period_ms.saturating_mul(slots));
+        let state = self.body.low_state();
+        h.state.write(now, &state);
+        h.joints.write(now, &self.body.joint_positions());
+        if self.wire.silent {
+            return;
+        }
+        self.sent = self.sent.wrapping_add(1);
+        // A refused write is counted by the writer; the next tick writes again.
+        if self.wire.bit_flip_every > 0 && self.sent.is_multiple_of(self.wire.bit_flip_every) {
+            h.corrupted.add(1);
+            let _ = self.corrupt.try_write(BitFlipped { state, bit: self.sent as usize * 7919 });
+        } else {
+            let _ = self.writer.try_write(state);
+        }
+    }
+}
 
 impl Job for StateStream {
     fn next_run(&mut self) -> Option<Time> {
@@ -351,60 +419,21 @@ impl Job for StateStream {
     }
 
     fn run(&mut self, now: Time) {
-        let Some(tick) = self.grid.poll(now) else { return };
-        self.stats.lateness.record(micros(tick.lateness));
-        let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
-        let (state, silent, flip_every) = {
-            let mut s = lock(&self.shared);
-            s.body.step(dt.min(MAX_STEP_S));
-            let slots = u32::try_from(tick.skipped + 1).unwrap_or(u32::MAX);
-            s.body.advance_tick(self.period_ms.saturating_mul(slots));
-            (s.body.low_state(), s.silent, s.bit_flip_every)
-        };
-        if silent {
-            return;
+        let taken = self.handover.requests.take(|request| apply(&mut self.body, &mut self.wire, request));
+        if let Some((at, command)) = self.handover.command.read_newer(self.seen_command) {
+            self.seen_command = Some(at);
+            self.body.command(&command);
         }
-        let n = self.sent.fetch_add(1, Ordering::Relaxed) + 1;
-        // A failed write is counted by the writer; the next tick writes again.
-        if flip_every > 0 && n.is_multiple_of(flip_every) {
-            self.stats.corrupted.add(1);
-            let _ = self.corrupt.write(BitFlipped { state, bit: n as usize * 7919 });
-        } else {
-            let _ = self.writer.write(state);
+        if let Some(tick) = self.grid.poll(now) {
+            self.tick(now, &tick);
         }
+        self.handover.requests.confirm(taken);
     }
 }
 
 /// Whether a LowCmd has the header the Go2 expects.
 fn head_ok(cmd: &LowCmd) -> bool {
     cmd.head == go2::HEAD && cmd.level_flag == go2::LEVEL_LOW
-}
-
-/// Applies one decoded LowCmd (arrived at `now`); the state right after it, if accepted.
-fn on_lowcmd(shared: &Mutex<Shared>, stats: &Stats, period: Duration, cmd: &LowCmd, now: Time) -> Option<LowState> {
-    let mut s = lock(shared);
-    if !head_ok(cmd) {
-        stats.bad_head.add(1);
-        return None;
-    }
-    if !s.sport_mode.is_empty() {
-        stats.ignored.add(1);
-        if !s.ignore_logged {
-            s.ignore_logged = true;
-            let mode = s.sport_mode.clone();
-            s.say(format!(
-                "LowCmd ignored: sport mode \"{mode}\" owns the motors (release it with motion_switcher ReleaseMode); \
-                 further ones are counted"
-            ));
-        }
-        return None;
-    }
-    stats.accepted.add(1);
-    if let Some(last) = s.last_command.replace(now) {
-        stats.jitter.record(micros(now.saturating_duration_since(last).abs_diff(period)));
-    }
-    s.body.command(cmd);
-    Some(s.body.low_state())
 }
 
 /// `Reader<LowCmd>` for the services module.

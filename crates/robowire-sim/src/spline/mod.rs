@@ -2,7 +2,8 @@
 //! robowire's runner (absolute deadlines, coarse sleep then a short spin, a late cycle run once
 //! and the missed ones counted) that consumes commands like the vendor daemon, drives a PD joint
 //! model, publishes motor state and an IMU sample every cycle, and measures its own lateness.
-//! The loop takes no lock: what it shares with the handle is atomics and a seqlock.
+//! The loop takes no lock: it owns the model and its faults, takes the handle's requests through
+//! the crate's `handover` module, and publishes through seqlocks and atomics.
 //!
 //! [`SplineDaemon`] and [`ImuWriter`] ([`daemon`]) are the device side of the shared memory,
 //! usable by any daemon.
@@ -10,14 +11,13 @@
 pub mod daemon;
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::time::Duration;
 
 use robowire_core::schedule::{Periodic, Time};
 use robowire_core::timing::LatenessSummary;
 use robowire_rt::Latest;
-use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions};
-use robowire_rt::stats::{Counter, SharedLateness, micros};
+use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions, Waker};
+use robowire_rt::stats::Counter;
 use robowire_shm::CreateOptions;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 use zsl_proto::shm::{
@@ -27,6 +27,7 @@ use zsl_proto::shm::{
 
 pub use daemon::{CommandUpdate, DaemonError, ImuWriter, SplineDaemon, SplineDaemonCounters};
 
+use crate::handover::{Requests, StreamStats};
 use crate::joints::{JointModel, PdTarget};
 
 /// Joint angles of the lying pose: abad, hip, knee (rad); the foot joint stays at 0.
@@ -101,18 +102,25 @@ pub enum SplineSimError {
     Thread(#[from] robowire_rt::RtError),
 }
 
-/// What the loop shares with the handle: written by the loop without a lock.
-#[derive(Debug, Default)]
-struct Shared {
-    cycles: Counter,
-    missed_cycles: Counter,
+/// What the loop shares with the handle, none of it a lock the loop takes.
+#[derive(Debug)]
+struct Handover {
+    requests: Requests<Request>,
+    stream: StreamStats<16384>,
     imu_samples: Counter,
     daemon: Latest<DaemonCounterWords>,
-    lateness: SharedLateness<16384>,
     state: Latest<SplineStateBlock>,
-    fault_bits: [[AtomicU32; 4]; 4],
-    paused: AtomicBool,
 }
+
+/// What the handle asks of the loop.
+#[derive(Debug, Clone, Copy)]
+enum Request {
+    Pause(bool),
+    Fault { leg: Leg, joint: JointIndex, bits: u32 },
+}
+
+/// Requests the loop has not taken yet (the handle waits for each).
+const REQUESTS: usize = 16;
 
 /// [`SplineDaemonCounters`] as the seqlock carries them.
 #[derive(Debug, Clone, Copy, FromBytes, IntoBytes, KnownLayout, Immutable)]
@@ -137,8 +145,9 @@ impl From<DaemonCounterWords> for SplineDaemonCounters {
 #[derive(Debug)]
 pub struct SplineSim {
     config: SplineSimConfig,
-    shared: Arc<Shared>,
+    handover: Arc<Handover>,
     runner: Option<Runner<DaemonLoop>>,
+    waker: Waker,
 }
 
 impl SplineSim {
@@ -146,7 +155,13 @@ impl SplineSim {
     pub fn spawn(config: SplineSimConfig) -> Result<Self, SplineSimError> {
         let daemon = SplineDaemon::create(&config.spline_name, &config.create)?;
         let imu = ImuWriter::create(&config.imu_name, &config.create)?;
-        let shared = Arc::new(Shared::default());
+        let handover = Arc::new(Handover {
+            requests: Requests::new(REQUESTS),
+            stream: StreamStats::default(),
+            imu_samples: Counter::default(),
+            daemon: Latest::new(),
+            state: Latest::new(),
+        });
         let now = robowire_rt::now();
         let job = DaemonLoop {
             daemon,
@@ -154,11 +169,14 @@ impl SplineSim {
             model: JointModel::at(LYING_POSE_RAD),
             grid: Periodic::new(now + config.period, config.period),
             dt_s: config.period.as_secs_f32(),
-            shared: shared.clone(),
+            paused: false,
+            fault_bits: [[0; 4]; 4],
+            handover: handover.clone(),
         };
         let options = RunnerOptions { spin: config.spin, ..RunnerOptions::named("spline-sim") };
         let runner = Runner::spawn(options, job)?;
-        Ok(Self { config, shared, runner: Some(runner) })
+        let waker = runner.waker();
+        Ok(Self { config, handover, runner: Some(runner), waker })
     }
 
     /// The configuration (object names).
@@ -168,29 +186,36 @@ impl SplineSim {
 
     /// Counters and lateness.
     pub fn stats(&self) -> SplineSimStats {
-        let s = &self.shared;
+        let h = &self.handover;
+        let stream = h.stream.summary();
         SplineSimStats {
-            cycles: s.cycles.get(),
-            missed_cycles: s.missed_cycles.get(),
-            lateness: s.lateness.summary(),
-            daemon: s.daemon.read().map(|(_, c)| c.into()).unwrap_or_default(),
-            imu_samples: s.imu_samples.get(),
+            cycles: stream.cycles,
+            missed_cycles: stream.missed,
+            lateness: stream.lateness,
+            daemon: h.daemon.read().map(|(_, c)| c.into()).unwrap_or_default(),
+            imu_samples: h.imu_samples.get(),
         }
     }
 
     /// The state published last.
     pub fn state(&self) -> SplineStateBlock {
-        self.shared.state.read().map(|(_, state)| state).unwrap_or_default()
+        self.handover.state.read().map(|(_, state)| state).unwrap_or_default()
     }
 
     /// Fault: a hung daemon (no commands consumed, no state or IMU published) while `paused`.
+    /// In force when this returns.
     pub fn pause(&self, paused: bool) {
-        self.shared.paused.store(paused, Ordering::Relaxed);
+        self.call(Request::Pause(paused));
     }
 
-    /// Fault: sets fault bits (1..5 of [`JointFlags`]) on a joint's state.
+    /// Fault: sets fault bits (1..5 of [`JointFlags`]) on a joint's state, from the next state
+    /// published on.
     pub fn inject_fault(&self, leg: Leg, joint: JointIndex, bits: u32) {
-        self.shared.fault_bits[leg.index()][joint as usize].store(bits & 0x3E, Ordering::Relaxed);
+        self.call(Request::Fault { leg, joint, bits: bits & 0x3E });
+    }
+
+    fn call(&self, request: Request) {
+        self.handover.requests.call(request, || self.waker.wake());
     }
 }
 
@@ -250,7 +275,11 @@ struct DaemonLoop {
     model: JointModel,
     grid: Periodic,
     dt_s: f32,
-    shared: Arc<Shared>,
+    /// A hung daemon: nothing consumed or published.
+    paused: bool,
+    /// Fault bits per joint, `[leg][joint]`.
+    fault_bits: [[u32; 4]; 4],
+    handover: Arc<Handover>,
 }
 
 impl Job for DaemonLoop {
@@ -259,19 +288,23 @@ impl Job for DaemonLoop {
     }
 
     fn run(&mut self, now: Time) {
+        let h = &self.handover;
+        let taken = h.requests.take(|request| match request {
+            Request::Pause(paused) => self.paused = paused,
+            Request::Fault { leg, joint, bits } => self.fault_bits[leg.index()][joint as usize] = bits,
+        });
+        // Requests take effect from the next cycle's state on (pausing: nothing more published).
+        h.requests.confirm(taken);
         let Some(tick) = self.grid.poll(now) else { return };
-        let s = &self.shared;
-        s.missed_cycles.add(tick.skipped);
-        if s.paused.load(Ordering::Relaxed) {
+        h.stream.record(&tick, !self.paused);
+        if self.paused {
             return;
         }
-        s.lateness.record(micros(tick.lateness));
         // Fresh, repeated or cleared: the daemon's command is what the motors get. (Region
         // errors cannot happen: the object is ours and large enough.)
         let _update: Result<CommandUpdate, _> = self.daemon.take_command();
         self.model.step_command(self.daemon.command(), self.dt_s);
-        let fault_bits = s.fault_bits.each_ref().map(|leg| leg.each_ref().map(|bits| bits.load(Ordering::Relaxed)));
-        let state = self.model.state(self.daemon.command(), &fault_bits);
+        let state = self.model.state(self.daemon.command(), &self.fault_bits);
         let _ = self.daemon.publish_state(&state);
         let record = NavImu {
             timestamp_ns: now.as_nanos().into(),
@@ -281,9 +314,8 @@ impl Job for DaemonLoop {
                 q: [1.0, 0.0, 0.0, 0.0].map(Into::into),
             },
         };
-        s.imu_samples.add(u64::from(self.imu.publish(&record).is_ok()));
-        s.state.write(now, &state);
-        s.daemon.write(now, &self.daemon.counters().into());
-        s.cycles.add(1);
+        h.imu_samples.add(u64::from(self.imu.publish(&record).is_ok()));
+        h.state.write(now, &state);
+        h.daemon.write(now, &self.daemon.counters().into());
     }
 }

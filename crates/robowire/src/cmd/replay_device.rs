@@ -1,16 +1,15 @@
 //! `robowire replay --as-device`: the device side of a capture played back to a live client over
 //! the same transport, so that a session seen once on a robot can be replayed on a desk. Today:
-//! the ZSL-1's UDP links (HighLevel on 43997, LowLevel on 43900).
+//! the ZSL-1's UDP links (HighLevel on 43997, LowLevel on 43900). This picks the device's frames
+//! out of the capture; `robowire_sim::replay::DatagramReplay` plays them.
 
 use std::net::{IpAddr, SocketAddr};
 use std::process::ExitCode;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::Context;
 use robowire_record::{LinkDescription, RecordedFrame};
-use robowire_udp::{Peer, UdpLink};
+use robowire_sim::replay::{DatagramReplay, Pace};
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
 use zsl_proto::description::{DESCRIPTIONS, LOW_LEVEL};
 use zsl_proto::udp::{AnyDatagram, HIGH_LEVEL_PORT, LOW_LEVEL_PORT};
@@ -24,7 +23,8 @@ fn is_device_frame(frame: &RecordedFrame) -> bool {
         )
 }
 
-/// Plays the device frames of `link` (default: the first link that has any) on `bind`.
+/// Plays the device frames of `link` (default: the first link that has any) on `bind`, at the
+/// recorded pace scaled by `speed` (`None`: as fast as possible).
 pub(crate) fn run(
     frames: &[RecordedFrame],
     link: Option<&str>,
@@ -41,67 +41,47 @@ pub(crate) fn run(
     };
     let states: Vec<&RecordedFrame> = frames.iter().filter(|f| f.link == link && is_device_frame(f)).collect();
     let first = states.first().with_context(|| format!("link {link} has no device frames"))?;
+    let offsets =
+        states.iter().map(|s| (Duration::from_nanos(s.unix_ns.saturating_sub(first.unix_ns)), s.bytes.clone()));
+    let pace = speed.map_or(Pace::Fast, |speed| Pace::Recorded { speed });
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
         if first.protocol.protocol() == LOW_LEVEL.protocol() {
-            play(SocketAddr::new(bind, LOW_LEVEL_PORT), LowLevelDogCodec::default(), &link, &states, speed).await
+            play(SocketAddr::new(bind, LOW_LEVEL_PORT), LowLevelDogCodec::default(), offsets, &link, pace).await
         } else {
-            play(SocketAddr::new(bind, HIGH_LEVEL_PORT), HighLevelDogCodec::default(), &link, &states, speed).await
+            play(SocketAddr::new(bind, HIGH_LEVEL_PORT), HighLevelDogCodec::default(), offsets, &link, pace).await
         }
     })
 }
 
+/// Binds `addr` with the device's `codec`, waits for a client's first command and plays `frames`
+/// (offset from the first, bytes) to it.
 async fn play<C>(
     addr: SocketAddr,
     codec: C,
+    frames: impl IntoIterator<Item = (Duration, Vec<u8>)>,
     link: &str,
-    states: &[&RecordedFrame],
-    speed: Option<f64>,
+    pace: Pace,
 ) -> anyhow::Result<ExitCode>
 where
     C: robowire_core::DatagramCodec + Clone + Send + 'static,
-    C::Incoming: Send,
-    C::Error: std::fmt::Display + Send,
+    C::Error: std::fmt::Display,
 {
-    let udp = UdpLink::bind(addr, Peer::Any { reply_to: None }, codec)
-        .await
-        .map_err(|e| anyhow::anyhow!("binding {addr}: {e}"))?;
+    let mut device =
+        DatagramReplay::bind(addr, codec, frames).await.map_err(|e| anyhow::anyhow!("binding {addr}: {e}"))?;
     println!("{addr}");
-    eprintln!("replay: {} device frames of {link} on {addr}; waiting for a client's first command", states.len());
-    let (mut sender, mut receiver) = udp.into_split();
+    eprintln!("replay: {} device frames of {link} on {addr}; waiting for a client's first command", device.frames());
     let client = loop {
-        match receiver.recv_from().await {
-            Ok((_, from)) => break from,
+        match device.first_command().await {
+            Ok(from) => break from,
             Err(e) => eprintln!("replay: ignored a datagram: {e}"),
         }
     };
-    let commands = Arc::new(AtomicU64::new(1));
-    let counting = tokio::spawn({
-        let commands = commands.clone();
-        async move {
-            while receiver.recv().await.is_ok() {
-                commands.fetch_add(1, Ordering::Relaxed);
-            }
-        }
-    });
     eprintln!("replay: client {client}; playing");
-    let start = Instant::now();
-    let t0 = states[0].unix_ns;
-    let mut sent = 0u64;
-    for state in states {
-        if let Some(speed) = speed {
-            let due = Duration::from_nanos(((state.unix_ns - t0) as f64 / speed) as u64);
-            tokio::time::sleep_until(tokio::time::Instant::from_std(start + due)).await;
-        }
-        if sender.send_bytes_now(&state.bytes).is_ok() {
-            sent += 1;
-        }
-    }
-    counting.abort();
+    let summary = device.play(pace).await?;
     eprintln!(
-        "replay: sent {sent} of {} device frames to {client}; received {} commands",
-        states.len(),
-        commands.load(Ordering::Relaxed)
+        "replay: sent {} of {} device frames to {client}; received {} commands",
+        summary.sent, summary.frames, summary.commands
     );
     Ok(ExitCode::SUCCESS)
 }
