@@ -9,6 +9,7 @@ pub mod crc;
 #[doc(hidden)]
 pub mod decode_roundtrip;
 mod error;
+pub mod field;
 pub mod go2;
 pub mod hg;
 pub mod layout;
@@ -21,6 +22,7 @@ pub mod stream;
 
 pub use cdr::CdrEncoding;
 pub use error::DecodeError;
+pub use field::{FieldError, FieldPlace, FieldValue};
 pub use go2::{BmsCmd, BmsState, ImuState, LowCmd, LowState, MotorCmd, MotorState};
 pub use hg::{HgImuState, HgLowCmd, HgLowState, HgMotorCmd, HgMotorState};
 pub use message::{CrcCheck, MAX_IMAGE_LEN, Message, Unverified};
