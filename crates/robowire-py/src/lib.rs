@@ -1,6 +1,6 @@
 //! robowire for Python: the `robowire._native` extension behind the `robowire` package
-//! (`python/robowire`). Importing it starts no thread and opens nothing: the runtime starts
-//! with the first client or simulator.
+//! (`python/robowire`). Importing it starts no thread and opens nothing: each client and
+//! simulator starts its own threads when it is opened, and stops them when it is closed.
 
 mod errors;
 mod go2;
