@@ -12,6 +12,7 @@ use zsl::udp::{CallError, Latched};
 pub(crate) use high_level::{Zsl1HighLevel, Zsl1wHighLevel};
 pub(crate) use low_level::Zsl1LowLevel;
 pub(crate) use motor::{JointArray, MotorCommand, MotorState};
+pub(crate) use session::connect_error;
 
 use crate::errors::{Kind, error};
 
