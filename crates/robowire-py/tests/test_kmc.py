@@ -49,8 +49,9 @@ def test_with_block_sends_the_stop_burst_even_on_an_exception(chassis):
             wait_until(lambda: chassis.state()["commanded_velocity_mps"] == 0.25)
             raise RuntimeError("in the block")
     assert not driver.is_running
-    last = chassis.received()[-3:]
-    assert last == [{"frame": "pc_control", "velocity_mps": 0.0, "curvature_per_m": 0.0}] * 3
+    # The burst is on the line when stop() returns; the simulator reads it on its own thread.
+    stop = {"frame": "pc_control", "velocity_mps": 0.0, "curvature_per_m": 0.0}
+    wait_until(lambda: chassis.received()[-3:] == [stop] * 3)
     assert chassis.state()["commanded_velocity_mps"] == 0.0
 
 
