@@ -42,10 +42,17 @@ def test_spline_daemon_with_client_pause_and_faults():
     with robowire.sim.Spline() as daemon:
         assert daemon.spline_name.startswith("/robowire-py-")
         joints = robowire.spline.SplineClient(daemon.spline_name)
-        joints.write_command([[0.0, 0.72, -1.45, 0.0]] * 4, kp=30.0, kd=1.0)
+        pose = [[0.0, 0.72, -1.45, 0.0]] * 4
+        joints.write_command(pose, kp=30.0, kd=1.0)
         state = wait_until(lambda: joints.try_read_state())
         assert len(state["p_rad"]) == 4 and len(state["p_rad"][0]) == 4
-        wait_until(lambda: abs(joints.wait_state(0.1)["p_rad"][2][1] - 0.72) < 0.02)
+
+        def at_the_pose():
+            # Refreshed like a client's loop: the daemon clears a command not renewed within 10 cycles.
+            joints.write_command(pose, kp=30.0, kd=1.0)
+            return abs(joints.wait_state(0.1)["p_rad"][2][1] - 0.72) < 0.02
+
+        wait_until(at_the_pose)
         with pytest.raises(robowire.ArgumentError, match="finite"):
             joints.write_command(float("nan"))
         with pytest.raises(robowire.ArgumentError, match="16"):
