@@ -47,7 +47,7 @@ impl Scalar {
 }
 
 /// What a field holds.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {
     /// A primitive.
     Scalar(Scalar),
@@ -58,7 +58,7 @@ pub enum Shape {
 }
 
 /// One field of the struct image.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Field {
     /// IDL name (the Rust field's name for padding).
     pub name: &'static str,
@@ -99,8 +99,9 @@ impl Field {
     }
 }
 
-/// An IDL struct: its C size and its fields (padding included) in memory order.
-#[derive(Debug)]
+/// An IDL struct: its C size and its fields (padding included) in memory order. Two layouts are
+/// equal when their names, sizes and fields are (the Go2 and HG `MotorCmd_` are not).
+#[derive(Debug, PartialEq, Eq)]
 pub struct StructLayout {
     /// IDL name, e.g. `MotorCmd_`.
     pub name: &'static str,

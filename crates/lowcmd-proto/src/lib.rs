@@ -11,6 +11,7 @@ pub mod decode_roundtrip;
 #[cfg(feature = "serde")]
 pub mod description;
 mod error;
+pub mod field;
 pub mod go2;
 pub mod hg;
 pub mod layout;
@@ -23,6 +24,7 @@ pub mod stream;
 
 pub use cdr::CdrEncoding;
 pub use error::DecodeError;
+pub use field::{FieldError, FieldPlace, FieldValue};
 pub use go2::{BmsCmd, BmsState, ImuState, LowCmd, LowState, MotorCmd, MotorState};
 pub use hg::{HgImuState, HgLowCmd, HgLowState, HgMotorCmd, HgMotorState};
 pub use message::{CrcCheck, MAX_IMAGE_LEN, Message, Unverified};

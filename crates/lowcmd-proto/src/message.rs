@@ -5,6 +5,7 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use crate::cdr::CdrEncoding;
 use crate::crc::crc32_words_in_place;
+use crate::field::{FieldError, FieldPlace, FieldValue};
 use crate::layout::{PadRange, StructLayout, padding_count, padding_mask, padding_ranges};
 use crate::plan::{CdrPlan, PlanError, header_count, plan_body_len, plan_headers, plan_runs, run_count};
 use crate::{DecodeError, go2, hg};
@@ -80,6 +81,18 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
         for (byte, mask) in self.as_mut_bytes().iter_mut().zip(Self::PADDING_MASK) {
             *byte &= *mask;
         }
+    }
+
+    /// The scalar field `path` names (`"motor_cmd[3].q"`, `"imu_state.rpy[0]"`, `"head[1]"`; see
+    /// [`FieldPlace::path`]).
+    fn field(&self, path: &str) -> Result<FieldValue, FieldError> {
+        FieldPlace::of::<Self>().path(path)?.get(self.as_bytes())
+    }
+
+    /// Writes the scalar field `path` names; `value` must be of the field's IDL type. Only that
+    /// field's bytes change (a written `crc` is overwritten again by every encoder).
+    fn set_field(&mut self, path: &str, value: FieldValue) -> Result<(), FieldError> {
+        FieldPlace::of::<Self>().path(path)?.set(self.as_mut_bytes(), value)
     }
 
     /// The `crc` field (the last 4 bytes).

@@ -15,7 +15,7 @@ use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
 use zerocopy::IntoBytes;
 
 use crate::layout::{Field, Scalar, Shape, StructLayout};
-use crate::{HgLowCmd, HgLowState, LowCmd, LowState, MAX_IMAGE_LEN, Message};
+use crate::{FieldValue, HgLowCmd, HgLowState, LowCmd, LowState, MAX_IMAGE_LEN, Message};
 
 /// The struct at `base` of `image`, described by `layout`.
 struct StructView<'a> {
@@ -47,23 +47,25 @@ impl FieldView<'_> {
         let at = self.base + i * self.field.stride();
         match self.field.shape {
             Shape::Scalar(scalar) => {
-                let b = self.image.get(at..at + scalar.size()).unwrap_or(&[0; 4][..scalar.size()]);
-                let word = |n: usize| {
-                    let mut w = [0u8; 4];
-                    w[..n].copy_from_slice(&b[..n]);
-                    w
-                };
-                match scalar {
-                    Scalar::U8 => s.serialize_u8(b[0]),
-                    Scalar::U16 => s.serialize_u16(u16::from_le_bytes([b[0], b[1]])),
-                    Scalar::I16 => s.serialize_i16(i16::from_le_bytes([b[0], b[1]])),
-                    Scalar::U32 => s.serialize_u32(u32::from_le_bytes(word(4))),
-                    Scalar::I32 => s.serialize_i32(i32::from_le_bytes(word(4))),
-                    Scalar::F32 => Float(f32::from_le_bytes(word(4))).serialize(s),
-                }
+                let bytes = self.image.get(at..at + scalar.size()).unwrap_or_default();
+                FieldValue::from_le_bytes(scalar, bytes).serialize(s)
             }
             Shape::Struct(layout) => StructView { layout, image: self.image, base: at }.serialize(s),
             Shape::Pad => s.serialize_unit(),
+        }
+    }
+}
+
+/// A value as its IDL type: an integer, or a float in robowire-core's one JSON form.
+impl Serialize for FieldValue {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match *self {
+            Self::U8(v) => s.serialize_u8(v),
+            Self::U16(v) => s.serialize_u16(v),
+            Self::I16(v) => s.serialize_i16(v),
+            Self::U32(v) => s.serialize_u32(v),
+            Self::I32(v) => s.serialize_i32(v),
+            Self::F32(v) => Float(v).serialize(s),
         }
     }
 }
@@ -275,36 +277,27 @@ impl<'de> DeserializeSeed<'de> for ElementSeed<'_, '_> {
             Shape::Scalar(scalar) => scalar,
         };
         let At { image, offset, path } = self.at;
-        let bytes = d.deserialize_any(ScalarVisitor { scalar, path })?;
+        let value = d.deserialize_any(ScalarVisitor { scalar, path })?;
         if let Some(dst) = image.get_mut(offset..offset + scalar.size()) {
-            dst.copy_from_slice(&bytes[..scalar.size()]);
+            value.write_le_bytes(dst);
         }
         Ok(())
     }
 }
 
-/// A scalar, range-checked; its little-endian bytes, widened to 4.
+/// A scalar, range-checked.
 struct ScalarVisitor<'p> {
     scalar: Scalar,
     path: Path<'p>,
 }
 
 impl ScalarVisitor<'_> {
-    fn integer<E: de::Error>(self, v: i128) -> Result<[u8; 4], E> {
-        let out_of_range = || E::custom(format_args!("{}: {v} does not fit {}", self.path, self.scalar.idl_name()));
-        let widen = |b: &[u8]| {
-            let mut w = [0u8; 4];
-            w[..b.len()].copy_from_slice(b);
-            w
-        };
-        Ok(match self.scalar {
-            Scalar::U8 => widen(&u8::try_from(v).map_err(|_| out_of_range())?.to_le_bytes()),
-            Scalar::U16 => widen(&u16::try_from(v).map_err(|_| out_of_range())?.to_le_bytes()),
-            Scalar::I16 => widen(&i16::try_from(v).map_err(|_| out_of_range())?.to_le_bytes()),
-            Scalar::U32 => u32::try_from(v).map_err(|_| out_of_range())?.to_le_bytes(),
-            Scalar::I32 => i32::try_from(v).map_err(|_| out_of_range())?.to_le_bytes(),
-            Scalar::F32 => (v as f32).to_le_bytes(),
-        })
+    fn integer<E: de::Error>(self, v: i128) -> Result<FieldValue, E> {
+        if self.scalar == Scalar::F32 {
+            return Ok(FieldValue::F32(v as f32));
+        }
+        let value = i64::try_from(v).ok().and_then(|v| FieldValue::from_i64(self.scalar, v).ok());
+        value.ok_or_else(|| E::custom(format_args!("{}: {v} does not fit {}", self.path, self.scalar.idl_name())))
     }
 
     fn wrong_type<E: de::Error>(&self, found: &dyn fmt::Display) -> E {
@@ -314,33 +307,33 @@ impl ScalarVisitor<'_> {
 }
 
 impl Visitor<'_> for ScalarVisitor<'_> {
-    type Value = [u8; 4];
+    type Value = FieldValue;
 
     fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "a {} for {}", self.scalar.idl_name(), self.path)
     }
 
-    fn visit_i64<E: de::Error>(self, v: i64) -> Result<[u8; 4], E> {
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<FieldValue, E> {
         self.integer(i128::from(v))
     }
 
-    fn visit_u64<E: de::Error>(self, v: u64) -> Result<[u8; 4], E> {
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<FieldValue, E> {
         self.integer(i128::from(v))
     }
 
     // The exact f32 written as f64 converts back exactly; other numbers round to nearest.
-    fn visit_f64<E: de::Error>(self, v: f64) -> Result<[u8; 4], E> {
-        if self.scalar == Scalar::F32 { Ok((v as f32).to_le_bytes()) } else { Err(self.wrong_type(&v)) }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<FieldValue, E> {
+        FieldValue::from_f64(self.scalar, v).map_err(|_| self.wrong_type(&v))
     }
 
-    fn visit_str<E: de::Error>(self, v: &str) -> Result<[u8; 4], E> {
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<FieldValue, E> {
         match robowire_core::serde_f32::from_non_finite_name(v) {
-            Some(f) if self.scalar == Scalar::F32 => Ok(f.to_le_bytes()),
+            Some(f) if self.scalar == Scalar::F32 => Ok(FieldValue::F32(f)),
             _ => Err(self.wrong_type(&format_args!("{v:?}"))),
         }
     }
 
-    fn visit_bool<E: de::Error>(self, v: bool) -> Result<[u8; 4], E> {
+    fn visit_bool<E: de::Error>(self, v: bool) -> Result<FieldValue, E> {
         Err(self.wrong_type(&v))
     }
 }

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use go2::{Connection, Go2, Go2Error, Hg, JointCommand, LowLevel, LowLevelOptions};
+use go2::{Connection, Device, Go2, Go2Error, Hg, JointCommand, LowLevel, LowLevelOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -30,13 +30,12 @@ macro_rules! with_client {
     };
 }
 
-fn raise(e: Go2Error) -> PyErr {
+/// A `Go2Error` as the exception a Python user expects.
+pub(crate) fn raise(e: Go2Error) -> PyErr {
     match &e {
         Go2Error::Command(_) | Go2Error::Option { .. } => error(Kind::Argument, chain(&e)),
         Go2Error::Refused { service, api_id, code } => service_error(chain(&e), service, *api_id, *code),
-        Go2Error::Dds(robowire_dds::DdsError::NoAnswer { service, api_id, .. }) => {
-            service_error(chain(&e), service, *api_id, -1)
-        }
+        Go2Error::Service { service, api_id, .. } => service_error(chain(&e), service, *api_id, -1),
         Go2Error::NotReleased { .. } | Go2Error::Unexpected { .. } => {
             service_error(chain(&e), "motion_switcher", 0, -1)
         }
@@ -114,13 +113,8 @@ impl Go2LowLevel {
             ..LowLevelOptions::on(interface, domain)
         };
         let (client, robot) = match robot {
-            "go2" => (
-                Client::Go2(Arc::new(runtime::block_on(py, LowLevel::<Go2>::connect(options))?.map_err(raise)?)),
-                "go2",
-            ),
-            "hg" => {
-                (Client::Hg(Arc::new(runtime::block_on(py, LowLevel::<Hg>::connect(options))?.map_err(raise)?)), "hg")
-            }
+            "go2" => (Client::Go2(Arc::new(py.detach(|| LowLevel::<Go2>::open(options)).map_err(raise)?)), "go2"),
+            "hg" => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(raise)?)), "hg"),
             other => return Err(error(Kind::Argument, format!("robot = {other:?}: \"go2\" or \"hg\""))),
         };
         Ok(Self { client: Owned::new("Go2 client", client), robot })
@@ -219,10 +213,10 @@ impl Go2LowLevel {
         }
         match client {
             Client::Go2(c) => {
-                Ok(Bound::new(py, PyLowState::from_message(&c.state().ok_or_else(none)?.state))?.into_any())
+                Ok(Bound::new(py, PyLowState::from_message(&c.latest().ok_or_else(none)?.state))?.into_any())
             }
             Client::Hg(c) => {
-                Ok(Bound::new(py, PyHgLowState::from_message(&c.state().ok_or_else(none)?.state))?.into_any())
+                Ok(Bound::new(py, PyHgLowState::from_message(&c.latest().ok_or_else(none)?.state))?.into_any())
             }
         }
     }
@@ -230,7 +224,7 @@ impl Go2LowLevel {
     /// Seconds since the latest state arrived (`None` before the first).
     #[getter]
     fn state_age_s(&self) -> PyResult<Option<f64>> {
-        Ok(with_client!(self.client()?, |c| c.state().map(|s| s.age.as_secs_f64())))
+        Ok(with_client!(self.client()?, |c| c.latest().map(|s| s.age().as_secs_f64())))
     }
 
     /// Waits up to `timeout_s` for the next state and returns it; raises `TimeoutError` if
@@ -277,6 +271,7 @@ impl Go2LowLevel {
             "damping_sent" => s.damping_sent,
             "command_timeouts" => s.command_timeouts,
             "missed_ticks" => s.missed_ticks,
+            "write_drops" => s.write_drops,
             "lost_by_tick" => s.lost_by_tick,
             "late_by_tick" => s.late_by_tick,
             "disconnects" => s.disconnects,

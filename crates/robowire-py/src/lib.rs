@@ -1,7 +1,8 @@
 //! robowire for Python: the `robowire._native` extension behind the `robowire` package
-//! (`python/robowire`). Importing it starts no thread and opens nothing: the runtime starts
-//! with the first client or simulator.
+//! (`python/robowire`). Importing it starts no thread and opens nothing: each client and
+//! simulator starts its own threads when it is opened, and stops them when it is closed.
 
+mod device;
 mod errors;
 mod go2;
 mod kmc;
@@ -25,5 +26,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     unitree::register(m)?;
     go2::register(m)?;
     spline::register(m)?;
+    device::register(m)?;
     Ok(())
 }

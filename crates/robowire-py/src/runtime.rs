@@ -1,5 +1,7 @@
-//! The one tokio runtime behind every client and simulator, started on first use (importing
-//! `robowire` starts nothing), and the blocking waits: the GIL released, Ctrl-C honoured.
+//! The blocking waits of every class: the GIL released, Ctrl-C honoured. The facades open, latch
+//! and close on the caller's thread and run their own threads; what is left here is waiting for
+//! a future (a state, a service's answer) with a timer, on a runtime with no thread of its own:
+//! the waiting caller drives it (importing `robowire` starts nothing).
 
 use std::future::Future;
 use std::sync::OnceLock;
@@ -12,32 +14,20 @@ use crate::errors::{Kind, error};
 /// How long a blocking wait runs without looking for a signal (Ctrl-C).
 const SIGNAL_SLICE: Duration = Duration::from_millis(50);
 
-static RUNTIME: OnceLock<tokio::runtime::Runtime> = OnceLock::new();
+static TIMER: OnceLock<tokio::runtime::Runtime> = OnceLock::new();
 
-/// The runtime (one I/O thread, `robowire-io`), started on first use.
-pub(crate) fn runtime() -> PyResult<&'static tokio::runtime::Runtime> {
-    if let Some(runtime) = RUNTIME.get() {
+/// A timer-only runtime, made on first use; whichever thread waits drives it (several may at
+/// once).
+fn timer() -> PyResult<&'static tokio::runtime::Runtime> {
+    if let Some(runtime) = TIMER.get() {
         return Ok(runtime);
     }
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(1)
-        .thread_name("robowire-io")
-        .enable_all()
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
         .build()
-        .map_err(|e| error(Kind::Error, format!("cannot start robowire's I/O thread: {e}")))?;
+        .map_err(|e| error(Kind::Error, format!("cannot make robowire's timer: {e}")))?;
     // Two threads racing here: the loser's runtime is dropped unused.
-    Ok(RUNTIME.get_or_init(|| runtime))
-}
-
-/// Runs a future that does not wait on anything slow (binding a socket, starting a thread) to
-/// completion on the runtime, with the GIL released.
-pub(crate) fn block_on<F>(py: Python<'_>, future: F) -> PyResult<F::Output>
-where
-    F: Future + Send,
-    F::Output: Send,
-{
-    let runtime = runtime()?;
-    Ok(py.detach(|| runtime.block_on(future)))
+    Ok(TIMER.get_or_init(|| runtime))
 }
 
 /// Waits for `future` up to `timeout` (`None`: for ever) with the GIL released, looking for
@@ -47,11 +37,9 @@ where
     F: Future + Send,
     F::Output: Send,
 {
-    let runtime = runtime()?;
+    let timer = timer()?;
     let mut future = std::pin::pin!(future);
-    wait_sliced(py, timeout, |slice| {
-        runtime.block_on(async { tokio::time::timeout(slice, future.as_mut()).await.ok() })
-    })
+    wait_sliced(py, timeout, |slice| timer.block_on(async { tokio::time::timeout(slice, future.as_mut()).await.ok() }))
 }
 
 /// Calls `attempt(slice)` with the GIL released until it returns `Some` or `timeout` has passed
@@ -89,19 +77,4 @@ pub(crate) fn seconds(name: &str, value: f64) -> PyResult<Duration> {
 /// An optional timeout in seconds (`None`: no limit).
 pub(crate) fn timeout(name: &str, value: Option<f64>) -> PyResult<Option<Duration>> {
     value.map(|v| seconds(name, v)).transpose()
-}
-
-/// Runs a future that normally completes at once (the facades' calls that only latch a
-/// command) here, without a thread switch; on the runtime if it ever has to wait.
-pub(crate) fn now<F>(py: Python<'_>, future: F) -> PyResult<F::Output>
-where
-    F: Future + Send,
-    F::Output: Send,
-{
-    let mut future = std::pin::pin!(future);
-    let mut context = std::task::Context::from_waker(std::task::Waker::noop());
-    match future.as_mut().poll(&mut context) {
-        std::task::Poll::Ready(output) => Ok(output),
-        std::task::Poll::Pending => block_on(py, future),
-    }
 }

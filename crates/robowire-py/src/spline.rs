@@ -66,10 +66,17 @@ pub(crate) struct PySplineClient {
 #[pymethods]
 impl PySplineClient {
     /// Opens the spline object `name`. Raises `NoStateError` if no daemon created it.
+    /// `stall_after_s`: how long without fresh state while waiting makes the daemon stalled
+    /// (`None`: the facade's 10 ms, the daemon's period being 1 ms).
     #[new]
-    #[pyo3(signature = (name = "/spline_shm"))]
-    fn new(name: &str) -> PyResult<Self> {
+    #[pyo3(signature = (name = "/spline_shm", *, stall_after_s = None))]
+    fn new(name: &str, stall_after_s: Option<f64>) -> PyResult<Self> {
+        let stall_after = runtime::timeout("stall_after_s", stall_after_s)?;
         let client = SplineClient::open(name).map_err(raise)?;
+        let client = match stall_after {
+            Some(bound) => client.with_stall_after(bound),
+            None => client,
+        };
         Ok(Self { client: Owned::new("spline client", client) })
     }
 
@@ -125,7 +132,7 @@ impl PySplineClient {
         }
     }
 
-    /// No fresh state for longer than the stall bound (10 ms) while polling.
+    /// No fresh state for longer than the stall bound (`stall_after_s`) while polling.
     #[getter]
     fn is_stalled(&self) -> PyResult<bool> {
         self.client.with(|c| c.is_stalled())

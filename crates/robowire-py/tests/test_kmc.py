@@ -49,8 +49,9 @@ def test_with_block_sends_the_stop_burst_even_on_an_exception(chassis):
             wait_until(lambda: chassis.state()["commanded_velocity_mps"] == 0.25)
             raise RuntimeError("in the block")
     assert not driver.is_running
-    last = chassis.received()[-3:]
-    assert last == [{"frame": "pc_control", "velocity_mps": 0.0, "curvature_per_m": 0.0}] * 3
+    # The burst is on the line when stop() returns; the simulator reads it on its own thread.
+    stop = {"frame": "pc_control", "velocity_mps": 0.0, "curvature_per_m": 0.0}
+    wait_until(lambda: chassis.received()[-3:] == [stop] * 3)
     assert chassis.state()["commanded_velocity_mps"] == 0.0
 
 
@@ -131,3 +132,55 @@ def test_uart_client_one_frame_at_a_time(chassis):
     with pytest.raises(robowire.ClosedError):
         client.request_vehicle_speed()
     assert {"frame": "pc_control", "velocity_mps": 0.25, "curvature_per_m": 0.0} in chassis.received()
+
+
+def test_the_chassis_state_speed_battery_motors_and_odometry(chassis):
+    with kmc.Driver(chassis.path, poll_battery=True, poll_allstate=True) as driver:
+        assert isinstance(driver.wait_state(timeout_s=3.0), kmc.ChassisState)
+        assert driver.connection == "connected" and driver.state_age_s >= 0.0
+
+        def moved():
+            driver.set_command(0.5, 0.0)
+            return driver.state().odometry.x_m > 0.01
+
+        wait_until(moved)
+        state = wait_until(lambda: (lambda s: s if s.battery and all(s.motors) else None)(driver.state()))
+        assert 20.0 < state.battery.volts < 26.0
+        assert [m.motor_id for m in state.motors] == [0, 1]
+        assert isinstance(state.speed_mps, float) and isinstance(state.odometry, kmc.Odometry)
+    assert driver.connection == "stopped"
+    with pytest.raises(robowire.ClosedError, match="start"):
+        driver.state()
+
+
+def test_stop_closes_the_port_and_start_opens_it_again(chassis):
+    driver = kmc.Driver(chassis.path)
+    with pytest.raises(robowire.ClosedError, match="start"):
+        driver.set_command(0.1, 0.0)
+    driver.start()
+    driver.start()  # already streaming: nothing
+    driver.set_command(0.25, 0.0)
+    wait_until(lambda: chassis.state()["commanded_velocity_mps"] == 0.25)
+    driver.stop()
+    assert not driver.is_running and driver.link_state == "stopped"
+    wait_until(lambda: chassis.state()["commanded_velocity_mps"] == 0.0)  # the stop burst
+    driver.start()
+    driver.set_command(0.125, 0.0)
+    wait_until(lambda: chassis.state()["commanded_velocity_mps"] == 0.125)
+    driver.close()
+    with pytest.raises(robowire.ClosedError):
+        driver.start()
+
+
+def test_set_command_timeout_now_and_for_the_next_start(chassis):
+    driver = kmc.Driver(chassis.path)
+    driver.set_command_timeout(0.05)
+    with driver:
+        driver.set_command(0.5, 0.0)
+        wait_until(lambda: driver.stats()["command_timeouts"] >= 1)
+        driver.set_command_timeout(0.08)
+        driver.set_command(0.5, 0.0)
+        wait_until(lambda: driver.stats()["command_timeouts"] >= 2)
+        for bad in (0.0, 7200.0, math.nan):
+            with pytest.raises(robowire.ArgumentError):
+                driver.set_command_timeout(bad)

@@ -41,11 +41,20 @@ def test_dog_free_ports_and_a_taken_port(ip):
 def test_spline_daemon_with_client_pause_and_faults():
     with robowire.sim.Spline() as daemon:
         assert daemon.spline_name.startswith("/robowire-py-")
-        joints = robowire.spline.SplineClient(daemon.spline_name)
-        joints.write_command([[0.0, 0.72, -1.45, 0.0]] * 4, kp=30.0, kd=1.0)
+        # This test is not about stalls: a bound a loaded machine cannot cross by starving the
+        # daemon's thread (pause() below still ends in TimeoutError).
+        joints = robowire.spline.SplineClient(daemon.spline_name, stall_after_s=1.0)
+        pose = [[0.0, 0.72, -1.45, 0.0]] * 4
+        joints.write_command(pose, kp=30.0, kd=1.0)
         state = wait_until(lambda: joints.try_read_state())
         assert len(state["p_rad"]) == 4 and len(state["p_rad"][0]) == 4
-        wait_until(lambda: abs(joints.wait_state(0.1)["p_rad"][2][1] - 0.72) < 0.02)
+
+        def at_the_pose():
+            # Refreshed like a client's loop: the daemon clears a command not renewed within 10 cycles.
+            joints.write_command(pose, kp=30.0, kd=1.0)
+            return abs(joints.wait_state(0.1)["p_rad"][2][1] - 0.72) < 0.02
+
+        wait_until(at_the_pose)
         with pytest.raises(robowire.ArgumentError, match="finite"):
             joints.write_command(float("nan"))
         with pytest.raises(robowire.ArgumentError, match="16"):
@@ -75,3 +84,15 @@ def test_chassis_faults_and_stats():
         assert chassis.state()["battery_volts"] == pytest.approx(25.2, abs=0.01)
     with pytest.raises(robowire.ArgumentError):
         robowire.sim.Chassis(battery_initial_volts=float("nan"))
+
+
+def test_a_paused_daemon_is_reported_stalled_after_the_clients_bound():
+    with robowire.sim.Spline() as daemon:
+        with pytest.raises(robowire.ArgumentError, match="stall_after_s"):
+            robowire.spline.SplineClient(daemon.spline_name, stall_after_s=-1.0)
+        with robowire.spline.SplineClient(daemon.spline_name, stall_after_s=0.02) as joints:
+            daemon.pause()
+            with pytest.raises(robowire.NoStateError, match="stalled"):
+                for _ in range(3):  # a state published before the pause may still be fresh
+                    joints.wait_state(1.0)
+            assert joints.is_stalled and joints.counters()["stalls"] == 1

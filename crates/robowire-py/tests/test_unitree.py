@@ -72,6 +72,9 @@ def test_fields_are_live_views():
     assert LowCmd.zeroed().motor_cmd[0].q == 0.0
     assert LowCmd(gpio=3).gpio == 3
     assert "motor_cmd" in dir(cmd)
+    assert cmd.motor_cmd[-1] == cmd.motor_cmd[19] and cmd.motor_cmd[3] != cmd.motor_cmd[4]
+    cmd.motor_cmd[5] = cmd.motor_cmd[3]
+    assert cmd.motor_cmd[5] == cmd.motor_cmd[3] and cmd.motor_cmd[5].kp == 60.0
     copy = cmd.copy()
     copy.motor_cmd[3].q = 0.0
     assert cmd.motor_cmd[3].q == 0.5
@@ -91,6 +94,12 @@ def test_bad_values_raise_and_change_nothing():
         cmd.motor_cmd[0].nope = 1
     with pytest.raises(IndexError):
         cmd.motor_cmd[20]
+    with pytest.raises(IndexError):
+        cmd.motor_cmd[-21]
+    with pytest.raises(robowire.ArgumentError, match="MotorCmd_"):
+        cmd.motor_cmd[0] = HgLowCmd().motor_cmd[0]  # a G1 motor is not a Go2 motor
+    with pytest.raises(robowire.ArgumentError, match="has no field"):
+        cmd.motor_cmd[0] = {"nope": 1}
     assert cmd == LowCmd()
 
 

@@ -111,20 +111,34 @@ def hexes(datagrams):
     return [d.hex() for d in datagrams]
 
 
+def and_the_stop_burst(vendor_wire, our_wire):
+    """robowire's datagrams as far as the vendor's went, and the rest: what closing sent (the
+    script ends without closing; robowire's client sends its stop burst as it goes, the vendor's
+    nothing)."""
+    return our_wire[: len(vendor_wire)], our_wire[len(vendor_wire) :]
+
+
 def test_high_level_same_codes_getters_and_datagrams(vendor_python, ip):
     (vendor, vendor_wire), (ours, our_wire) = side_by_side("high", 43997, high_level_state(), ip)
     assert ours == vendor
     assert vendor["move during two-leg stand"] == 0x3007 and vendor["move too slow"] == 0x3013
-    assert hexes(our_wire) == hexes(vendor_wire)
+    same, stop = and_the_stop_burst(vendor_wire, our_wire)
+    assert hexes(same) == hexes(vendor_wire)
     assert len(vendor_wire) >= 15  # idle, every accepted call, every cleared action
+    # The stop: the last mode kept, every velocity and rate zero, no action.
+    assert [(struct.unpack_from("<6f", d, 4), d[28:32]) for d in stop] == [((0.0,) * 6, b"\0\0" + vendor_wire[-1][30:32])]
 
 
 def test_low_level_same_codes_getters_and_datagrams(vendor_python, ip):
     (vendor, vendor_wire), (ours, our_wire) = side_by_side("low", 43900, low_level_state(), ip)
     assert ours == vendor
     assert (vendor["sendMotorCmd"], vendor["sendMotorCmd knee 0"]) == (0, -1)
-    assert hexes(our_wire) == hexes(vendor_wire)
+    same, stop = and_the_stop_burst(vendor_wire, our_wire)
+    assert hexes(same) == hexes(vendor_wire)
     assert [len(d) for d in vendor_wire] == [248, 248]  # idle, then the command
+    # The stop: the last command with its velocity targets (bytes 52..100) zeroed.
+    last = vendor_wire[-1]
+    assert [(d[:52], d[52:100], d[100:244]) for d in stop] == [(last[:52], bytes(48), last[100:244])]
 
 
 def test_nan_is_where_robowire_differs_on_purpose(vendor_python, ip):

@@ -93,7 +93,8 @@ impl Default for DriverOptions {
 }
 
 impl DriverOptions {
-    fn validate(&self) -> Result<(), KmcError> {
+    /// Refuses an option out of range, as [`Driver::open`] does before it opens anything.
+    pub fn validate(&self) -> Result<(), KmcError> {
         let bad = |name: &'static str, reason: String| Err(KmcError::Option { name, reason });
         for (name, hz) in
             [("control_rate_hz", self.control_rate_hz), ("vehicle_speed_rate_hz", self.vehicle_speed_rate_hz)]

@@ -6,11 +6,14 @@
 - :mod:`robowire.unitree`: Unitree LowCmd/LowState (Go2 and HG), struct image and CDR.
 - :mod:`robowire.go2`: the Go2's low-level interface over DDS.
 - :mod:`robowire.sim`: every simulator, in-process, as a context manager.
+- :func:`robowire.open`: any device by its address (``kmc:/dev/ttyUSB0``, ``zsl1:IP``,
+  ``go2:eth0``, ``sim:zsl1``, …) as a :class:`robowire.Device` of one shape.
 
 Importing robowire starts no thread and opens nothing.
 """
 
 from ._native import __version__
+from .device import Device, open
 from .errors import (
     ArgumentError,
     BindError,
@@ -26,6 +29,8 @@ from .errors import (
 
 __all__ = [
     "__version__",
+    "open",
+    "Device",
     "Error",
     "ArgumentError",
     "ClosedError",

@@ -2,7 +2,8 @@
 
 - :class:`Driver`: the vendor's streaming driver (its options and defaults): the latched
   command at 100 Hz, speed polls, a command timeout that stops the chassis, a stop burst on
-  ``stop()`` and at the end of a ``with`` block.
+  ``stop()`` and at the end of a ``with`` block; the chassis's latest :class:`ChassisState`
+  (speed, battery, motors, :class:`Odometry`).
 - :class:`UartClient`: one frame at a time, no threads.
 
 Frames from the chassis arrive as :class:`VehicleSpeed`, :class:`BatteryVoltage`,
@@ -12,16 +13,27 @@ Frames from the chassis arrive as :class:`VehicleSpeed`, :class:`BatteryVoltage`
 >>> with robowire.sim.Chassis() as chassis, robowire.kmc.Driver(chassis.path) as driver:
 ...     driver.set_command(0.5, 0.0)
 ...     speed = next(f for f in driver.messages(timeout_s=2.0) if isinstance(f, robowire.kmc.VehicleSpeed))
->>> isinstance(speed.speed_mps, float)
-True
+...     state = driver.wait_state(timeout_s=2.0)
+>>> isinstance(speed.speed_mps, float), isinstance(state.odometry.x_m, float)
+(True, True)
 """
 
 from dataclasses import dataclass
-from typing import Tuple
+from typing import Optional, Tuple
 
 from ._native import Driver, Messages, UartClient
 
-__all__ = ["Driver", "UartClient", "Messages", "VehicleSpeed", "BatteryVoltage", "MotorState", "AfResponse"]
+__all__ = [
+    "Driver",
+    "UartClient",
+    "Messages",
+    "VehicleSpeed",
+    "BatteryVoltage",
+    "MotorState",
+    "AfResponse",
+    "ChassisState",
+    "Odometry",
+]
 
 
 @dataclass(frozen=True)
@@ -75,3 +87,34 @@ class AfResponse:
     """Parameter IDs."""
     slots: Tuple[bytes, ...]
     """One 4-byte slot per ID, in wire order."""
+
+
+@dataclass(frozen=True)
+class Odometry:
+    """x, y and heading integrated from the speed reports and the commanded curvature, since the
+    driver started."""
+
+    x_m: float
+    """x, m."""
+    y_m: float
+    """y, m."""
+    heading_rad: float
+    """Heading, rad, in (-π, π]."""
+    speed_mps: float
+    """Forward speed, m/s."""
+    yaw_rate_radps: float
+    """Yaw rate, rad/s."""
+
+
+@dataclass(frozen=True)
+class ChassisState:
+    """The chassis as the driver last heard it: the latest of each report, and the odometry."""
+
+    speed_mps: Optional[float]
+    """The latest ``0xB3`` speed report, m/s (``None`` before the first)."""
+    battery: Optional[BatteryVoltage]
+    """The latest battery report."""
+    motors: Tuple[Optional[MotorState], Optional[MotorState]]
+    """The latest all-state report of motors 0 and 1."""
+    odometry: Odometry
+    """Pose and velocities."""

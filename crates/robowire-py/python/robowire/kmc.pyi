@@ -5,7 +5,17 @@ from typing import Any, Dict, Iterator, Optional, Tuple, Union
 
 from typing_extensions import Self
 
-__all__ = ["Driver", "UartClient", "Messages", "VehicleSpeed", "BatteryVoltage", "MotorState", "AfResponse"]
+__all__ = [
+    "Driver",
+    "UartClient",
+    "Messages",
+    "VehicleSpeed",
+    "BatteryVoltage",
+    "MotorState",
+    "AfResponse",
+    "ChassisState",
+    "Odometry",
+]
 
 @dataclass(frozen=True)
 class VehicleSpeed:
@@ -33,6 +43,21 @@ class AfResponse:
     rw: str
     ids: Tuple[int, ...]
     slots: Tuple[bytes, ...]
+
+@dataclass(frozen=True)
+class Odometry:
+    x_m: float
+    y_m: float
+    heading_rad: float
+    speed_mps: float
+    yaw_rate_radps: float
+
+@dataclass(frozen=True)
+class ChassisState:
+    speed_mps: Optional[float]
+    battery: Optional[BatteryVoltage]
+    motors: Tuple[Optional[MotorState], Optional[MotorState]]
+    odometry: Odometry
 
 Frame = Union[VehicleSpeed, BatteryVoltage, MotorState, AfResponse]
 
@@ -64,16 +89,28 @@ class Driver:
     @property
     def port(self) -> str: ...
     def start(self) -> None:
-        """Opens the port and starts streaming; raises PortError."""
+        """Opens the port and starts streaming (nothing if it streams already); raises PortError."""
     def stop(self) -> None:
-        """Stop burst, then both threads end; idempotent."""
+        """Stop burst, then both threads end and the port closes; idempotent; start() opens it again."""
     @property
     def is_running(self) -> bool: ...
     @property
     def link_state(self) -> str:
         """stopped, connected or disconnected."""
-    def set_command(self, velocity_mps: float, yaw_rate_radps: float) -> None: ...
+    @property
+    def connection(self) -> str:
+        """stopped, waiting, connected or disconnected (no frame for 500 ms)."""
+    def set_command(self, velocity_mps: float, yaw_rate_radps: float) -> None:
+        """Raises ArgumentError (NaN, inf), ClosedError unless started."""
     def set_command_curvature(self, velocity_mps: float, curvature_per_m: float) -> None: ...
+    def set_command_timeout(self, timeout_s: float) -> None:
+        """0.001-3600 s, now and for the next start(); raises ArgumentError."""
+    def state(self) -> ChassisState:
+        """Raises NoStateError before the first frame."""
+    @property
+    def state_age_s(self) -> Optional[float]: ...
+    def wait_state(self, timeout_s: float = 3.0) -> ChassisState:
+        """Raises TimeoutError."""
     def try_pop_message(self) -> Optional[Frame]: ...
     def wait_message(self, timeout_s: float = 1.0) -> Optional[Frame]: ...
     def messages(self, timeout_s: Optional[float] = None) -> Messages: ...

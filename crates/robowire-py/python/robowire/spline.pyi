@@ -9,7 +9,8 @@ __all__ = ["SplineClient", "ImuReader"]
 _Joints = Union[float, Sequence[float], Sequence[Sequence[float]]]
 
 class SplineClient:
-    def __init__(self, name: str = "/spline_shm") -> None: ...
+    def __init__(self, name: str = "/spline_shm", *, stall_after_s: Optional[float] = None) -> None:
+        """stall_after_s: no fresh state for this long while waiting raises NoStateError (None: 10 ms)."""
     def write_command(
         self,
         p_des: _Joints,

@@ -80,7 +80,7 @@ macro_rules! message_class {
             }
 
             fn from_image(image: Image) -> Self {
-                Self { view: StructView { image, layout: <$msg as Message>::FIELDS, base: 0, path: $name.into() } }
+                Self { view: StructView::message::<$msg>(image, $name) }
             }
 
             pub(crate) fn message(&self) -> $msg {

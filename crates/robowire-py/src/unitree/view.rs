@@ -1,10 +1,13 @@
-//! Live views into a message's struct image, driven by `lowcmd-proto`'s field tables: a
-//! nested struct (`cmd.motor_cmd[3]`) or an array (`cmd.motor_cmd`, `state.imu_state.rpy`)
-//! reads and writes the message's bytes, so `cmd.motor_cmd[3].q = 0.5` changes `cmd`.
+//! Live views into a message's struct image: a nested struct (`cmd.motor_cmd[3]`) or an array
+//! (`cmd.motor_cmd`, `state.imu_state.rpy`) reads and writes the message's bytes, so
+//! `cmd.motor_cmd[3].q = 0.5` changes `cmd`. Where a field lies, its type and its range come from
+//! `lowcmd_proto::field`; this module turns its places and values into Python objects.
 
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use lowcmd_proto::layout::{Field, Scalar, Shape, StructLayout};
+use lowcmd_proto::field::{Element, PlaceKind};
+use lowcmd_proto::layout::{Scalar, StructLayout};
+use lowcmd_proto::{FieldError, FieldPlace, FieldValue, Message};
 use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::{PyAttributeError, PyIndexError};
 use pyo3::prelude::*;
@@ -19,89 +22,68 @@ pub(crate) fn lock(image: &Image) -> MutexGuard<'_, Vec<u8>> {
     image.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// The IDL field `name` of `layout`.
-pub(crate) fn field(layout: &'static StructLayout, name: &str) -> Option<&'static Field> {
-    layout.idl_fields().find(|f| f.name == name)
+/// A field error as an `ArgumentError` naming the field.
+fn argument(path: &str, e: FieldError) -> PyErr {
+    error(Kind::Argument, format!("{path}: {e}"))
 }
 
-fn read_scalar<'py>(py: Python<'py>, scalar: Scalar, bytes: &[u8]) -> PyResult<Bound<'py, PyAny>> {
-    let b = |n: usize| -> [u8; 4] {
-        let mut w = [0u8; 4];
-        w[..n].copy_from_slice(&bytes[..n]);
-        w
-    };
+/// A scalar as Python's `int` or `float`.
+fn to_py(py: Python<'_>, value: FieldValue) -> PyResult<Bound<'_, PyAny>> {
+    match value {
+        FieldValue::U8(v) => v.into_bound_py_any(py),
+        FieldValue::U16(v) => v.into_bound_py_any(py),
+        FieldValue::I16(v) => v.into_bound_py_any(py),
+        FieldValue::U32(v) => v.into_bound_py_any(py),
+        FieldValue::I32(v) => v.into_bound_py_any(py),
+        FieldValue::F32(v) => f64::from(v).into_bound_py_any(py),
+    }
+}
+
+/// A Python number as a value of `scalar`: a float field takes any number (NaN and infinities
+/// too: the codec carries them; a client's command check refuses them), an integer field an
+/// `int` (a `float` raises `TypeError`) within its type's range.
+fn from_py(path: &str, scalar: Scalar, value: &Bound<'_, PyAny>) -> PyResult<FieldValue> {
     match scalar {
-        Scalar::U8 => bytes[0].into_bound_py_any(py),
-        Scalar::U16 => u16::from_le_bytes([bytes[0], bytes[1]]).into_bound_py_any(py),
-        Scalar::I16 => i16::from_le_bytes([bytes[0], bytes[1]]).into_bound_py_any(py),
-        Scalar::U32 => u32::from_le_bytes(b(4)).into_bound_py_any(py),
-        Scalar::I32 => i32::from_le_bytes(b(4)).into_bound_py_any(py),
-        Scalar::F32 => f64::from(f32::from_le_bytes(b(4))).into_bound_py_any(py),
+        Scalar::F32 => FieldValue::from_f64(scalar, value.extract()?),
+        _ => FieldValue::from_i64(scalar, value.extract()?),
     }
+    .map_err(|e| argument(path, e))
 }
 
-/// The bytes of `value` as `scalar`: floats any (NaN and infinities too: the codec carries
-/// them; a client's command check refuses them), integers within the type's range.
-fn scalar_bytes(path: &str, scalar: Scalar, value: &Bound<'_, PyAny>) -> PyResult<([u8; 4], usize)> {
-    let int = |min: i64, max: i64| -> PyResult<i64> {
-        let v: i64 = value.extract()?;
-        if (min..=max).contains(&v) {
-            Ok(v)
-        } else {
-            Err(error(Kind::Argument, format!("{path} = {v} is outside the {} range {min}..={max}", scalar.idl_name())))
+/// What lies at `place`: a value, or a live view of a struct or an array.
+fn read<'py>(py: Python<'py>, image: &Image, place: FieldPlace, path: String) -> PyResult<Bound<'py, PyAny>> {
+    match place.kind() {
+        PlaceKind::Scalar(_) => {
+            let value = place.get(&lock(image)).map_err(|e| argument(&path, e))?;
+            to_py(py, value)
         }
-    };
-    let mut out = [0u8; 4];
-    let n = scalar.size();
-    match scalar {
-        Scalar::U8 => out[0] = int(0, 0xff)? as u8,
-        Scalar::U16 => out[..2].copy_from_slice(&(int(0, 0xffff)? as u16).to_le_bytes()),
-        Scalar::I16 => out[..2].copy_from_slice(&(int(-0x8000, 0x7fff)? as i16).to_le_bytes()),
-        Scalar::U32 => out.copy_from_slice(&(int(0, 0xffff_ffff)? as u32).to_le_bytes()),
-        Scalar::I32 => out.copy_from_slice(&(int(-0x8000_0000, 0x7fff_ffff)? as i32).to_le_bytes()),
-        Scalar::F32 => out.copy_from_slice(&(value.extract::<f64>()? as f32).to_le_bytes()),
-    }
-    Ok((out, n))
-}
-
-/// Element `i` of `field` at `base` (`base` is the array's start): a value, or a view.
-fn element<'py>(
-    py: Python<'py>,
-    image: &Image,
-    field: &'static Field,
-    base: usize,
-    i: usize,
-    path: String,
-) -> PyResult<Bound<'py, PyAny>> {
-    let at = base + i * field.stride();
-    match field.shape {
-        Shape::Scalar(scalar) => {
-            let bytes = lock(image);
-            read_scalar(py, scalar, &bytes[at..at + scalar.size()])
+        PlaceKind::Struct(layout) => StructView { image: image.clone(), place, layout, path }.into_bound_py_any(py),
+        PlaceKind::Array { element, len } => {
+            ArrayView { image: image.clone(), place, element, len, path }.into_bound_py_any(py)
         }
-        Shape::Struct(layout) => StructView { image: image.clone(), layout, base: at, path }.into_bound_py_any(py),
-        Shape::Pad => Ok(py.None().into_bound(py)),
     }
 }
 
-/// Writes `value` into element `i` of `field` at `base`.
-fn set_element(
-    image: &Image,
-    field: &'static Field,
-    base: usize,
-    i: usize,
-    value: &Bound<'_, PyAny>,
-    path: &str,
-) -> PyResult<()> {
-    let at = base + i * field.stride();
-    match field.shape {
-        Shape::Scalar(scalar) => {
-            let (bytes, n) = scalar_bytes(path, scalar, value)?;
-            lock(image)[at..at + n].copy_from_slice(&bytes[..n]);
+/// Writes `value` at `place`: a value, a struct (from a view of one or a dict of some of its
+/// fields), or an array from a sequence of its exact length.
+fn write(image: &Image, place: FieldPlace, value: &Bound<'_, PyAny>, path: &str) -> PyResult<()> {
+    match place.kind() {
+        PlaceKind::Scalar(scalar) => {
+            let value = from_py(path, scalar, value)?;
+            place.set(&mut lock(image), value).map_err(|e| argument(path, e))
+        }
+        PlaceKind::Struct(layout) => assign_struct(image, place, layout, value, path),
+        PlaceKind::Array { len, .. } => {
+            let items: Vec<Bound<'_, PyAny>> = value.try_iter()?.collect::<PyResult<_>>()?;
+            if items.len() != len {
+                return Err(error(Kind::Argument, format!("{path} has {len} elements, {} given", items.len())));
+            }
+            for (i, item) in items.iter().enumerate() {
+                let element = place.index(i).map_err(|e| argument(path, e))?;
+                write(image, element, item, &format!("{path}[{i}]"))?;
+            }
             Ok(())
         }
-        Shape::Struct(layout) => assign_struct(image, layout, at, value, path),
-        Shape::Pad => Ok(()),
     }
 }
 
@@ -109,94 +91,72 @@ fn set_element(
 /// fields (the others kept).
 fn assign_struct(
     image: &Image,
+    place: FieldPlace,
     layout: &'static StructLayout,
-    base: usize,
     value: &Bound<'_, PyAny>,
     path: &str,
 ) -> PyResult<()> {
     if let Ok(view) = value.cast::<StructView>() {
         let other = view.get();
-        if !std::ptr::eq(other.layout, layout) {
-            return Err(error(Kind::Argument, format!("{path} is a {}, not a {}", layout.name, other.layout.name)));
-        }
-        let bytes = lock(&other.image)[other.base..other.base + layout.size].to_vec();
-        lock(image)[base..base + layout.size].copy_from_slice(&bytes);
-        return Ok(());
+        // A copy first: the other view may share this image (and its lock).
+        let source = lock(&other.image).clone();
+        return place.copy_from(&mut lock(image), &other.place, &source).map_err(|e| argument(path, e));
     }
     let Ok(dict) = value.cast::<PyDict>() else {
         return Err(error(Kind::Argument, format!("{path}: assign a {} or a dict of its fields", layout.name)));
     };
     for (key, item) in dict.iter() {
         let name: String = key.extract()?;
-        let f = field(layout, &name)
-            .ok_or_else(|| error(Kind::Argument, format!("{path} ({}) has no field {name:?}", layout.name)))?;
-        assign_field(image, f, base + f.offset, &item, &format!("{path}.{name}"))?;
+        let field = place.field(&name).map_err(|e| match e {
+            FieldError::UnknownField { .. } => {
+                error(Kind::Argument, format!("{path} ({}) has no field {name:?}", layout.name))
+            }
+            e => argument(path, e),
+        })?;
+        write(image, field, &item, &format!("{path}.{name}"))?;
     }
     Ok(())
 }
 
-/// Writes a whole field: a value, a struct, or an array from a sequence of its exact length.
-pub(crate) fn assign_field(
-    image: &Image,
-    f: &'static Field,
-    at: usize,
-    value: &Bound<'_, PyAny>,
-    path: &str,
-) -> PyResult<()> {
-    let Some(count) = f.count else { return set_element(image, f, at, 0, value, path) };
-    let items: Vec<Bound<'_, PyAny>> = value.try_iter()?.collect::<PyResult<_>>()?;
-    if items.len() != count {
-        return Err(error(Kind::Argument, format!("{path} has {count} elements, {} given", items.len())));
-    }
-    for (i, item) in items.iter().enumerate() {
-        set_element(image, f, at, i, item, &format!("{path}[{i}]"))?;
-    }
-    Ok(())
-}
-
-/// Reads a whole field: a value, or a view of a struct or an array.
-pub(crate) fn read_field<'py>(
-    py: Python<'py>,
-    image: &Image,
-    f: &'static Field,
-    at: usize,
-    path: String,
-) -> PyResult<Bound<'py, PyAny>> {
-    match f.count {
-        None => element(py, image, f, at, 0, path),
-        Some(_) => ArrayView { image: image.clone(), field: f, base: at, path }.into_bound_py_any(py),
-    }
-}
-
-/// A nested struct of a message (`MotorCmd_`, `IMUState_`, …): its IDL fields as attributes.
+/// A nested struct of a message (`MotorCmd_`, `IMUState_`, …), or the message itself: its IDL
+/// fields as attributes.
 #[pyclass(module = "robowire.unitree", frozen)]
 pub(crate) struct StructView {
     pub(crate) image: Image,
-    pub(crate) layout: &'static StructLayout,
-    pub(crate) base: usize,
-    pub(crate) path: String,
+    place: FieldPlace,
+    layout: &'static StructLayout,
+    path: String,
 }
 
 impl StructView {
+    /// The whole message `M` in `image`; `name` starts the paths in error messages.
+    pub(crate) fn message<M: Message>(image: Image, name: &str) -> Self {
+        Self { image, place: FieldPlace::of::<M>(), layout: M::FIELDS, path: name.into() }
+    }
+
     /// The IDL field `name`, or an `AttributeError` listing the struct's fields.
-    fn lookup(&self, name: &str) -> PyResult<&'static Field> {
-        field(self.layout, name).ok_or_else(|| {
-            PyAttributeError::new_err(format!(
+    fn lookup(&self, name: &str) -> PyResult<FieldPlace> {
+        self.place.field(name).map_err(|e| match e {
+            FieldError::UnknownField { .. } => PyAttributeError::new_err(format!(
                 "{} has no field {name:?} (fields: {})",
                 self.layout.name,
                 names(self.layout)
-            ))
+            )),
+            e => argument(&self.path, e),
         })
     }
 
     pub(crate) fn get_field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let f = self.lookup(name)?;
-        read_field(py, &self.image, f, self.base + f.offset, format!("{}.{name}", self.path))
+        read(py, &self.image, self.lookup(name)?, format!("{}.{name}", self.path))
     }
 
     pub(crate) fn set_field(&self, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let f = self.lookup(name)?;
-        assign_field(&self.image, f, self.base + f.offset, value, &format!("{}.{name}", self.path))
+        write(&self.image, self.lookup(name)?, value, &format!("{}.{name}", self.path))
+    }
+
+    /// The struct's bytes (a copy: comparing two views of one image takes its lock once each).
+    fn bytes(&self) -> Vec<u8> {
+        self.place.bytes(&lock(&self.image)).map(<[u8]>::to_vec).unwrap_or_default()
     }
 
     /// The struct's fields as plain Python values (nested dicts and lists).
@@ -226,7 +186,7 @@ fn plain<'py>(py: Python<'py>, value: Bound<'py, PyAny>) -> PyResult<Bound<'py, 
 }
 
 /// `"mode, q, dq, …"`.
-pub(crate) fn names(layout: &StructLayout) -> String {
+fn names(layout: &StructLayout) -> String {
     layout.idl_fields().map(|f| f.name).collect::<Vec<_>>().join(", ")
 }
 
@@ -258,9 +218,7 @@ impl StructView {
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
         other.cast::<StructView>().is_ok_and(|o| {
             let o = o.get();
-            std::ptr::eq(o.layout, self.layout)
-                && lock(&o.image)[o.base..o.base + o.layout.size].to_vec()
-                    == lock(&self.image)[self.base..self.base + self.layout.size]
+            o.place.kind() == self.place.kind() && o.bytes() == self.bytes()
         })
     }
 
@@ -274,26 +232,40 @@ impl StructView {
 #[pyclass(module = "robowire.unitree", frozen, sequence)]
 pub(crate) struct ArrayView {
     image: Image,
-    field: &'static Field,
-    base: usize,
+    place: FieldPlace,
+    element: Element,
+    len: usize,
     path: String,
 }
 
 impl ArrayView {
     fn len(&self) -> usize {
-        self.field.len()
+        self.len
     }
 
+    /// Python's index (negative counts from the end) as an element's, or an `IndexError`.
     fn index(&self, index: isize) -> PyResult<usize> {
-        let n = self.len() as isize;
+        let n = self.len as isize;
         let i = if index < 0 { index + n } else { index };
-        usize::try_from(i).ok().filter(|i| *i < self.len()).ok_or_else(|| {
-            PyIndexError::new_err(format!("{}[{index}]: index out of range ({} elements)", self.path, n))
-        })
+        usize::try_from(i)
+            .ok()
+            .filter(|&i| self.place.index(i).is_ok())
+            .ok_or_else(|| PyIndexError::new_err(format!("{}[{index}]: index out of range ({n} elements)", self.path)))
     }
 
+    /// Where element `i` lies.
+    fn element(&self, i: usize) -> PyResult<FieldPlace> {
+        self.place.index(i).map_err(|e| PyIndexError::new_err(format!("{}[{i}]: {e}", self.path)))
+    }
+
+    /// Element `i`: a value, or a view.
     fn item<'py>(&self, py: Python<'py>, i: usize) -> PyResult<Bound<'py, PyAny>> {
-        element(py, &self.image, self.field, self.base, i, format!("{}[{i}]", self.path))
+        read(py, &self.image, self.element(i)?, format!("{}[{i}]", self.path))
+    }
+
+    /// Writes element `i`.
+    fn set_item(&self, i: usize, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        write(&self.image, self.element(i)?, value, &format!("{}[{i}]", self.path))
     }
 
     fn slice(&self, slice: &Bound<'_, PySlice>) -> PyResult<Vec<usize>> {
@@ -340,12 +312,12 @@ impl ArrayView {
                 ));
             }
             for (i, v) in picked.into_iter().zip(values) {
-                set_element(&self.image, self.field, self.base, i, &v, &format!("{}[{i}]", self.path))?;
+                self.set_item(i, &v)?;
             }
             return Ok(());
         }
         let i = self.index(index.extract()?)?;
-        set_element(&self.image, self.field, self.base, i, value, &format!("{}[{i}]", self.path))
+        self.set_item(i, value)
     }
 
     fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -382,7 +354,7 @@ impl ArrayView {
         dtype: Option<&Bound<'py, PyAny>>,
         copy: Option<bool>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let Shape::Scalar(scalar) = self.field.shape else {
+        let Element::Scalar(scalar) = self.element else {
             return Err(error(Kind::Argument, format!("{} holds structs; it has no numeric array", self.path)));
         };
         if copy == Some(false) {

@@ -6,7 +6,6 @@ use pyo3::prelude::*;
 use zsl::udp::{HighLevel, Model};
 
 use super::session::Session;
-use crate::runtime;
 
 type Floats = Vec<f64>;
 
@@ -50,23 +49,24 @@ macro_rules! high_level_class {
                 self.session.is_connected()
             }
 
-            /// Stand up (mode 1). 0 queued; 0x3007 refused (moving in mode 18/21, or not
-            /// acknowledged 11 times in a row); the robot's error word if it reports one.
-            fn standUp(&self, py: Python<'_>) -> PyResult<u32> {
+            /// Stand up (mode 1). 0 queued; 0x3007 refused while moving in mode 18/21 (nothing
+            /// sent), or sent but not acknowledged by the robot 11 calls in a row; the robot's
+            /// error word if it reports one. `last_error` says which.
+            fn standUp(&self) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                Ok(self.session.code(runtime::now(py, c.stand_up())?))
+                Ok(self.session.code(c.stand_up()))
             }
 
             /// Lie down, joints locked (mode 51). Codes as `standUp`.
-            fn lieDown(&self, py: Python<'_>) -> PyResult<u32> {
+            fn lieDown(&self) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                Ok(self.session.code(runtime::now(py, c.lie_down())?))
+                Ok(self.session.code(c.lie_down()))
             }
 
             /// Motors damped (mode 0). Refused only by the robot's error word.
-            fn passive(&self, py: Python<'_>) -> PyResult<u32> {
+            fn passive(&self) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                Ok(self.session.code(runtime::now(py, c.passive())?))
+                Ok(self.session.code(c.passive()))
             }
 
             /// Walk at `vx` m/s forward, `vy` m/s left, `yaw_rate` rad/s; latched until
@@ -75,15 +75,15 @@ macro_rules! high_level_class {
             /// out of range, NaN or infinite (nothing sent; the vendor sends NaN); 0x3007 lying
             /// down or during a two-leg stand.
             #[pyo3(name = "move")]
-            fn move_(&self, py: Python<'_>, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
+            fn move_(&self, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                Ok(self.session.code(runtime::now(py, c.move_velocity(vx, vy, yaw_rate))?))
+                Ok(self.session.code(c.move_velocity(vx, vy, yaw_rate)))
             }
 
             /// Shake hands (mode 1, action 11, sent for 6 datagrams). 0x3007 while moving.
-            fn shakeHand(&self, py: Python<'_>) -> PyResult<u32> {
+            fn shakeHand(&self) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                Ok(self.session.code(runtime::now(py, c.shake_hand())?))
+                Ok(self.session.code(c.shake_hand()))
             }
 
             /// Body attitude rates, each |value| ≤ 0.6 (rad/s, rad/s, rad/s, m/s). The
@@ -93,15 +93,13 @@ macro_rules! high_level_class {
             /// above 1 rad.
             fn attitudeControl(
                 &self,
-                py: Python<'_>,
                 yaw_vel: f32,
                 roll_vel: f32,
                 pitch_vel: f32,
                 height_vel: f32,
             ) -> PyResult<u32> {
                 let c = self.session.running()?.client;
-                let call = c.attitude_control(yaw_vel, roll_vel, pitch_vel, height_vel);
-                Ok(self.session.code(runtime::now(py, call)?))
+                Ok(self.session.code(c.attitude_control(yaw_vel, roll_vel, pitch_vel, height_vel)))
             }
 
             /// Orientation quaternion w, x, y, z. Raises `NoStateError` without state (the
@@ -209,36 +207,35 @@ high_level_class! {
     /// picked up again when it returns.
     Zsl1HighLevel, "robowire.zsl1", Model::Zsl1, {
         /// Jump (mode 21, action 5, sent for 6 datagrams). 0x3007 lying down or moving.
-        fn jump(&self, py: Python<'_>) -> PyResult<u32> {
+        fn jump(&self) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.jump())?))
+            Ok(self.session.code(c.jump()))
         }
 
         /// Jump forward (mode 21, action 6). Codes as `jump`.
-        fn frontJump(&self, py: Python<'_>) -> PyResult<u32> {
+        fn frontJump(&self) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.front_jump())?))
+            Ok(self.session.code(c.front_jump()))
         }
 
         /// Backflip (mode 21, action 2). Codes as `jump`.
-        fn backflip(&self, py: Python<'_>) -> PyResult<u32> {
+        fn backflip(&self) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.backflip())?))
+            Ok(self.session.code(c.backflip()))
         }
 
         /// Stand on the hind legs (sticky until `cancelTwoLegStand`) moving at `vx` m/s
         /// (|vx| 0 or 0.2–0.5) and `yaw_rate` rad/s (0 or 0.2–1.0).
-        fn twoLegStand(&self, py: Python<'_>, vx: f32, yaw_rate: f32) -> PyResult<u32> {
+        fn twoLegStand(&self, vx: f32, yaw_rate: f32) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.two_leg_stand(vx, yaw_rate))?))
+            Ok(self.session.code(c.two_leg_stand(vx, yaw_rate)))
         }
 
         /// End a two-leg stand (mode 21, action 0). Returns nothing, like the vendor's; raises
         /// `robowire.Error` if the client stopped on the robot's SDK-mismatch flag.
-        fn cancelTwoLegStand(&self, py: Python<'_>) -> PyResult<()> {
+        fn cancelTwoLegStand(&self) -> PyResult<()> {
             let c = self.session.running()?.client;
-            let outcome = runtime::now(py, c.cancel_two_leg_stand())?;
-            super::unit(&self.session, outcome)
+            super::unit(&self.session, c.cancel_two_leg_stand())
         }
     }
 }
@@ -249,29 +246,27 @@ high_level_class! {
     /// stand). Commands carry the ZSL-1W magic 0x5AA6.
     Zsl1wHighLevel, "robowire.zsl1w", Model::Zsl1W, {
         /// Crawl (mode 18, action 17, sticky until `cancelCrawl`); `move`'s ranges.
-        fn crawl(&self, py: Python<'_>, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
+        fn crawl(&self, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.crawl(vx, vy, yaw_rate))?))
+            Ok(self.session.code(c.crawl(vx, vy, yaw_rate)))
         }
 
         /// Climb (mode 18, action 16, sticky until `cancelClimb`); `move`'s ranges.
-        fn climb(&self, py: Python<'_>, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
+        fn climb(&self, vx: f32, vy: f32, yaw_rate: f32) -> PyResult<u32> {
             let c = self.session.running()?.client;
-            Ok(self.session.code(runtime::now(py, c.climb(vx, vy, yaw_rate))?))
+            Ok(self.session.code(c.climb(vx, vy, yaw_rate)))
         }
 
         /// End a crawl (mode 18, action 0). Returns nothing, like the vendor's.
-        fn cancelCrawl(&self, py: Python<'_>) -> PyResult<()> {
+        fn cancelCrawl(&self) -> PyResult<()> {
             let c = self.session.running()?.client;
-            let outcome = runtime::now(py, c.cancel_crawl())?;
-            super::unit(&self.session, outcome)
+            super::unit(&self.session, c.cancel_crawl())
         }
 
         /// End a climb (the same datagram as `cancelCrawl`).
-        fn cancelClimb(&self, py: Python<'_>) -> PyResult<()> {
+        fn cancelClimb(&self) -> PyResult<()> {
             let c = self.session.running()?.client;
-            let outcome = runtime::now(py, c.cancel_climb())?;
-            super::unit(&self.session, outcome)
+            super::unit(&self.session, c.cancel_climb())
         }
 
         /// Foot/wheel joint angles, legs FR, FL, RR, RL.

@@ -6,7 +6,6 @@ use zsl::udp::{LowLevel, Model};
 
 use super::motor::{MotorCommand, MotorState};
 use super::session::Session;
-use crate::runtime;
 
 type Floats = Vec<f64>;
 
@@ -47,10 +46,9 @@ impl Zsl1LowLevel {
     /// nothing changed (the previous command keeps streaming): a position outside the vendor's
     /// bounds (abad −0.7…0.7, hip −1.15…3.0, knee −2.9…−0.65 rad), or any NaN or infinite value
     /// (the vendor sends NaN). `last_error` says which.
-    fn sendMotorCmd(&self, py: Python<'_>, cmd: &MotorCommand) -> PyResult<i32> {
+    fn sendMotorCmd(&self, cmd: &MotorCommand) -> PyResult<i32> {
         let c = self.session.running()?.client;
-        let outcome = runtime::now(py, c.send_motor_command(&cmd.to_facade()))?;
-        Ok(if self.session.code(outcome) == 0 { 0 } else { -1 })
+        Ok(if self.session.accepted(c.send_motor_command(&cmd.to_facade())).is_ok() { 0 } else { -1 })
     }
 
     /// The twelve motors (a new `MotorState` per call). Raises `NoStateError` without state.

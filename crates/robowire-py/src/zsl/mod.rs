@@ -7,18 +7,18 @@ mod motor;
 mod session;
 
 use pyo3::prelude::*;
-use zsl::udp::CallError;
+use zsl::udp::{CallError, Latched};
 
 pub(crate) use high_level::{Zsl1HighLevel, Zsl1wHighLevel};
 pub(crate) use low_level::Zsl1LowLevel;
 pub(crate) use motor::{JointArray, MotorCommand, MotorState};
+pub(crate) use session::connect_error;
 
 use crate::errors::{Kind, error};
 
 /// A call the vendor declares `void`: nothing, or an exception with the reason.
-fn unit<T: session::Facade>(session: &session::Session<T>, outcome: Result<(), CallError>) -> PyResult<()> {
-    session.remember(outcome.as_ref().err().map(ToString::to_string));
-    outcome.map_err(|e| error(Kind::Error, e))
+fn unit<T: session::Facade>(session: &session::Session<T>, outcome: Result<Latched, CallError>) -> PyResult<()> {
+    session.accepted(outcome.map(drop)).map_err(|e| error(Kind::Error, e))
 }
 
 /// Adds the classes to the extension module.

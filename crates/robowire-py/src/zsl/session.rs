@@ -8,30 +8,28 @@ use std::time::Duration;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use zsl::udp::{self as facade, CallError, ClientOptions, ClientStats, ConnectError, Connection, Model};
+use zsl::udp::{
+    self as facade, CallError, ClientOptions, ClientStats, ConnectError, Connection, Device, Latched, Model, ReturnCode,
+};
 
 use crate::errors::{Kind, chain, error};
 use crate::runtime;
 use crate::stats::{dict, lateness};
 
 /// A ZSL-1 UDP client of the `zsl` facade.
-pub(crate) trait Facade: Send + Sync + Sized + 'static {
+pub(crate) trait Facade:
+    Device<Stats = ClientStats, Error = std::convert::Infallible> + Send + Sync + Sized + 'static
+{
     /// The vendor's name, for messages.
     const NAME: &'static str;
     /// Options for `initRobot(local_ip, local_port, dog_ip)`.
     fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions;
     /// Binds and starts streaming.
-    fn connect(options: ClientOptions) -> impl Future<Output = Result<Self, ConnectError>> + Send;
-    /// Stops streaming and closes the socket.
-    fn close(self) -> impl Future<Output = ()> + Send;
-    /// Waits for the first state.
+    fn open(options: ClientOptions) -> Result<Self, ConnectError>;
+    /// Waits for the first state (any executor).
     fn wait_connected(&self, timeout: Duration) -> impl Future<Output = bool> + Send;
-    /// The connection now.
-    fn connection(&self) -> Connection;
     /// The bound address.
     fn local_addr(&self) -> SocketAddr;
-    /// Counters.
-    fn stats(&self) -> ClientStats;
 }
 
 macro_rules! facade {
@@ -41,23 +39,14 @@ macro_rules! facade {
             fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions {
                 $options(local, port, dog)
             }
-            fn connect(options: ClientOptions) -> impl Future<Output = Result<Self, ConnectError>> + Send {
-                <$t>::connect(options)
-            }
-            fn close(self) -> impl Future<Output = ()> + Send {
-                <$t>::close(self)
+            fn open(options: ClientOptions) -> Result<Self, ConnectError> {
+                <$t>::open(options)
             }
             fn wait_connected(&self, timeout: Duration) -> impl Future<Output = bool> + Send {
                 <$t>::wait_connected(self, timeout)
             }
-            fn connection(&self) -> Connection {
-                <$t>::connection(self)
-            }
             fn local_addr(&self) -> SocketAddr {
                 <$t>::local_addr(self)
-            }
-            fn stats(&self) -> ClientStats {
-                <$t>::stats(self)
             }
         }
     };
@@ -65,6 +54,15 @@ macro_rules! facade {
 
 facade!(facade::HighLevel, "HighLevel", ClientOptions::high_level);
 facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level);
+
+/// A `ConnectError` as the exception a Python user expects; `what` says who failed.
+pub(crate) fn connect_error(what: &str, e: &ConnectError) -> PyErr {
+    match e {
+        ConnectError::Link(_) => error(Kind::Bind, format!("{what}: {}", chain(e))),
+        ConnectError::Option { .. } => error(Kind::Argument, chain(e)),
+        _ => error(Kind::Error, format!("{what}: {}", chain(e))),
+    }
+}
 
 /// A running client and whom it talks to.
 pub(crate) struct Running<T> {
@@ -104,11 +102,8 @@ impl<T: Facade> Session<T> {
         self.close(py)?;
         let options = T::options(local, port, dog).with_model(self.model);
         let dog = options.dog;
-        let client = runtime::block_on(py, T::connect(options))?.map_err(|e| match &e {
-            ConnectError::Link(_) => error(Kind::Bind, format!("{}.initRobot: {}", T::NAME, chain(&e))),
-            ConnectError::Option { .. } => error(Kind::Argument, chain(&e)),
-            _ => error(Kind::Error, format!("{}.initRobot: {}", T::NAME, chain(&e))),
-        })?;
+        let client =
+            py.detach(|| T::open(options)).map_err(|e| connect_error(&format!("{}.initRobot", T::NAME), &e))?;
         *self.running.write().unwrap_or_else(PoisonError::into_inner) = Some(Running { client: Arc::new(client), dog });
         Ok(())
     }
@@ -119,7 +114,7 @@ impl<T: Facade> Session<T> {
         let old = self.running.write().unwrap_or_else(PoisonError::into_inner).take();
         if let Some(Running { client, .. }) = old {
             match Arc::try_unwrap(client) {
-                Ok(client) => runtime::block_on(py, client.close())?,
+                Ok(client) => py.detach(move || Device::close(client)).unwrap_or_else(|never| match never {}),
                 Err(shared) => py.detach(move || drop(shared)),
             }
         }
@@ -147,12 +142,27 @@ impl<T: Facade> Session<T> {
         get(&running.client).ok_or_else(|| no_state(&*running.client, running.dog))
     }
 
-    /// A call's outcome as the vendor's return code; the reason of a refusal is kept for
-    /// `last_error`.
-    pub(crate) fn code(&self, outcome: Result<(), CallError>) -> u32 {
-        let code = outcome.as_ref().map_or_else(|e| e.return_code().raw(), |()| 0);
-        self.remember(outcome.err().map(|e| e.to_string()));
+    /// A call's outcome as the vendor's return code, its reason kept for `last_error` when it
+    /// is not 0: a refusal (nothing sent), or a call sent that the robot has not acknowledged.
+    pub(crate) fn code(&self, outcome: Result<Latched, CallError>) -> u32 {
+        let (code, reason) = match outcome {
+            Ok(latched) if latched.return_code == ReturnCode::Queued => (0, None),
+            Ok(Latched { target, reported, return_code }) => (
+                return_code.raw(),
+                Some(format!(
+                    "the command was sent, but the robot has not acknowledged mode {target:?} (it reports {reported:?})"
+                )),
+            ),
+            Err(e) => (e.return_code().raw(), Some(e.to_string())),
+        };
+        self.remember(reason);
         code
+    }
+
+    /// Whether a call that returns no code went out; the reason kept for `last_error` if not.
+    pub(crate) fn accepted(&self, outcome: Result<(), CallError>) -> Result<(), CallError> {
+        self.remember(outcome.as_ref().err().map(ToString::to_string));
+        outcome
     }
 
     /// Keeps (or clears) the reason of the last refused call.
