@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, anyhow, bail};
+use robowire_dds::netns::userns;
+use robowire_fixtures::interop;
 use robowire_fixtures::peers::{cpython, peers_dir, unitree_python};
-use robowire_fixtures::{interop, userns};
 use serde_json::Value;
 
 use crate::bench::Row;

@@ -3,7 +3,7 @@
 
 mod adapter;
 mod error;
-#[cfg(feature = "test-support")]
+#[cfg(feature = "netns")]
 pub mod netns;
 mod participant;
 pub mod qos;

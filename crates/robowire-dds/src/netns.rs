@@ -1,4 +1,4 @@
-//! A network whose loopback carries multicast, for DDS on one machine (feature `test-support`).
+//! A network whose loopback carries multicast, for DDS on one machine (feature `netns`).
 //!
 //! DDS discovery uses multicast; a loopback interface without it (common on CI machines and
 //! containers) discovers nothing. Where `lo` lacks it, one of two private networks is made, each
@@ -11,15 +11,18 @@
 //!   create on current Linux distributions, owning a new network namespace. [`CHILD_ENV`] marks
 //!   the run inside, which sets `lo` up before anything else.
 //!
-//! [`with_loopback_multicast`] does this for a test; [`for_this_process`] for a whole program
-//! (the CLI's demo, an example, a bench). Where neither is possible a test is skipped with one
-//! line (failed under `ROBOWIRE_INTEROP=1`, see `robowire_fixtures::interop`) and a program gets
-//! [`Loopback::Unavailable`] with the reason.
+//! [`for_this_process`] does this for a whole program (the CLI's demo, an example, a bench) and
+//! gives [`Loopback::Unavailable`] with the reason where neither is possible;
+//! `with_loopback_multicast` (feature `test-support`) does it for a test, which is skipped with
+//! one line where neither is possible (failed under `ROBOWIRE_INTEROP=1`, see
+//! `robowire_fixtures::interop`).
 
-use std::io::Write;
+pub mod userns;
+
 use std::process::{Command, ExitStatus};
 
-use robowire_fixtures::{interop, userns};
+#[cfg(feature = "test-support")]
+use robowire_fixtures::interop;
 
 /// Set in the environment of a run inside its user + network namespace: the test's name, or
 /// [`PROCESS`] for a whole program.
@@ -116,7 +119,7 @@ pub fn is_root() -> bool {
     nix::unistd::geteuid().is_root()
 }
 
-/// Runs a test's `body` where `lo` carries multicast:
+/// Runs a test's `body` where `lo` carries multicast (feature `test-support`):
 ///
 /// 1. here, when it already does;
 /// 2. as root, on a thread in a new network namespace ([`in_loopback_namespace`]);
@@ -129,7 +132,10 @@ pub fn is_root() -> bool {
 ///
 /// Call it from the test's own thread (the harness names it after the test). Everything before
 /// the call runs again in case 3.
+#[cfg(feature = "test-support")]
 pub fn with_loopback_multicast(body: impl FnOnce() + Send) {
+    use std::io::Write;
+
     let test = interop::current_test();
     if std::env::var_os(CHILD_ENV).is_some_and(|v| v == test.as_str()) {
         setup_loopback().unwrap_or_else(|e| panic!("{test}: lo in its user + network namespace: {e}"));

@@ -3,7 +3,6 @@
 
 pub mod interop;
 pub mod peers;
-pub mod userns;
 pub mod zsl1;
 
 use std::path::PathBuf;
