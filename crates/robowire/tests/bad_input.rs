@@ -2,12 +2,11 @@
 //! an unreadable capture, a wrong interface name — exits non-zero with one line that says what
 //! to do, and never panics.
 
-use std::net::UdpSocket;
-use std::process::Command;
+mod support;
 
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use std::net::UdpSocket;
+
+use support::robowire;
 
 /// One case: the arguments, and words the error line must contain (what to do about it).
 struct Case {

@@ -1,12 +1,11 @@
 //! The `robowire` binary as users script it.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Output, Stdio};
+mod support;
+
+use std::process::Output;
 use std::sync::Mutex;
 
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use support::{Running, robowire};
 
 /// `robowire demo …`, one at a time: its scenarios are paced by the wall clock (a phase of
 /// motion lasts so long), and two at once on two cores starve each other's streams.
@@ -90,15 +89,8 @@ fn demo_refuses_a_nonsense_duration() {
 
 #[test]
 fn sim_and_device_commands_as_two_processes() {
-    let mut sim = robowire()
-        .args(["sim", "kmc", "--report-every-s", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut first_line = String::new();
-    BufReader::new(sim.stdout.take().unwrap()).read_line(&mut first_line).unwrap();
-    let port = first_line.trim().to_string();
+    let sim = Running::start(&["sim", "kmc", "--report-every-s", "0"]);
+    let port = sim.first_line.clone();
     assert!(port.starts_with("/dev/pts/"), "{port}");
 
     let speed = robowire().args(["kmc", "--port", &port, "speed"]).output().unwrap();
@@ -120,8 +112,7 @@ fn sim_and_device_commands_as_two_processes() {
         .output()
         .unwrap();
     let refused = robowire().args(["kmc", "--port", &port, "drive", "--velocity", "inf"]).output().unwrap();
-    sim.kill().unwrap();
-    let _ = sim.wait();
+    drop(sim);
 
     assert!(speed.status.success(), "{}", String::from_utf8_lossy(&speed.stderr));
     assert!(String::from_utf8_lossy(&speed.stdout).starts_with("speed"));

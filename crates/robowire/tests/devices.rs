@@ -2,15 +2,13 @@
 //! the simulators: a chassis on a pseudo-terminal, a dog on loopback UDP, and the `sim:`
 //! addresses. (The Go2 on DDS is in `tests/go2.rs`, in a private network.)
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+mod support;
+
+use std::process::Stdio;
 
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use serde_json::Value;
-
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use support::{Running, robowire};
 
 /// `robowire status ARGS --json`: its JSON.
 fn status_json(args: &[&str]) -> Value {
@@ -21,26 +19,20 @@ fn status_json(args: &[&str]) -> Value {
 
 /// `robowire watch ARGS` until it printed `lines` state lines, then Ctrl-C: the lines.
 fn watch(args: &[&str], lines: usize) -> Vec<String> {
-    let mut child = robowire().arg("watch").args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut watch = Running::spawn(robowire().arg("watch").args(args).stderr(Stdio::null()));
+    let mut line = watch.first_line.clone();
     let mut seen = Vec::new();
-    let mut line = String::new();
-    while seen.len() < lines {
-        line.clear();
-        assert!(out.read_line(&mut line).unwrap() > 0, "watch {args:?} ended after {seen:?}");
+    loop {
         if !line.starts_with("connection:") {
-            seen.push(line.trim().to_owned());
+            seen.push(line);
         }
+        if seen.len() == lines {
+            break;
+        }
+        line = watch.next_line().unwrap_or_else(|| panic!("watch {args:?} ended after {seen:?}"));
     }
-    interrupt(child);
+    watch.interrupt();
     seen
-}
-
-/// Ctrl-C, and a clean exit.
-fn interrupt(mut child: Child) {
-    rustix::process::kill_process(rustix::process::Pid::from_child(&child), rustix::process::Signal::INT).unwrap();
-    let status = child.wait().unwrap();
-    assert!(status.success(), "exit after Ctrl-C: {status}");
 }
 
 #[test]
@@ -58,21 +50,12 @@ fn a_chassis_on_a_serial_port() {
 
 #[test]
 fn a_dog_on_loopback_udp() {
-    let mut sim = robowire()
-        .args(["sim", "dog", "--bind", "127.0.0.31", "--report-every-s", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut ready = String::new();
-    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut ready).unwrap();
+    let _sim = Running::start(&["sim", "dog", "--bind", "127.0.0.31", "--report-every-s", "0"]);
     let status = status_json(&["zsl1:127.0.0.31", "--local", "127.0.0.31:0"]);
     assert_eq!(status["datagram"], "high_level_state", "{status}");
     assert!(status["mode"].is_u64() && status["battery_percent"].is_u64(), "{status}");
     let lines = watch(&["zsl1:127.0.0.31", "--local", "127.0.0.31:0"], 3);
     assert!(lines.iter().all(|l| l.starts_with("mode ")), "{lines:?}");
-    let _ = sim.kill();
-    let _ = sim.wait();
 }
 
 #[test]

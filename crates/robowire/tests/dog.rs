@@ -1,36 +1,19 @@
 //! `robowire sim dog` and `robowire dog …` as separate processes on loopback, the way a user
 //! scripts them.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Output, Stdio};
+mod support;
 
-struct Sim(Child);
+use std::process::Output;
 
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use support::{Running, robowire};
 
 /// Starts `robowire sim dog` on free ports; returns it and its HighLevel port.
-fn sim(extra: &[&str]) -> (Sim, String) {
-    let mut child = robowire()
-        .args(["sim", "dog", "--high-level-port", "0", "--low-level-port", "0", "--report-every-s", "0"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-    let high = line.split_whitespace().next().expect("the simulator prints its addresses first");
+fn sim(extra: &[&str]) -> (Running, String) {
+    let args = ["sim", "dog", "--high-level-port", "0", "--low-level-port", "0", "--report-every-s", "0"];
+    let sim = Running::start(&[&args[..], extra].concat());
+    let high = sim.first_line.split_whitespace().next().expect("the simulator prints its addresses first");
     let port = high.rsplit(':').next().unwrap().to_string();
-    (Sim(child), port)
+    (sim, port)
 }
 
 fn dog(port: &str, args: &[&str]) -> Output {

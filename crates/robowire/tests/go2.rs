@@ -3,47 +3,19 @@
 //! `robowire go2 …` against the same simulator. Each where loopback carries multicast
 //! (`robowire_dds::netns`).
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Child, Command, Stdio};
+mod support;
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Command, Stdio};
 
 use robowire_dds::netns::with_loopback_multicast;
-
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use support::{Running, robowire};
 
 /// `robowire sim go2 --interface lo`, started and waited for.
-struct Sim(Child);
-
-impl Sim {
-    fn start() -> Self {
-        let mut child = robowire()
-            .args(["sim", "go2", "--interface", "lo", "--report-every-s", "0"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let mut first = String::new();
-        BufReader::new(child.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
-        assert!(first.starts_with("go2 domain 0 lo"), "{first}");
-        Self(child)
-    }
-
-    /// Ctrl-C, then everything it printed after its first line.
-    fn stop(mut self) -> String {
-        rustix::process::kill_process(rustix::process::Pid::from_child(&self.0), rustix::process::Signal::INT).unwrap();
-        let mut rest = String::new();
-        self.0.stdout.take().unwrap().read_to_string(&mut rest).unwrap();
-        assert!(self.0.wait().unwrap().success());
-        rest
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
+fn start_sim() -> Running {
+    let sim = Running::start(&["sim", "go2", "--interface", "lo", "--report-every-s", "0"]);
+    assert!(sim.first_line.starts_with("go2 domain 0 lo"), "{}", sim.first_line);
+    sim
 }
 
 #[test]
@@ -53,7 +25,7 @@ fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
     };
     let examples = robowire_fixtures::peers::unitree_go2_examples().unwrap();
     with_loopback_multicast(|| {
-        let sim = Sim::start();
+        let sim = start_sim();
         let mut example = Command::new(&python)
             .arg("go2_stand_example.py")
             .arg("lo")
@@ -69,7 +41,7 @@ fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
         let stdout = String::from_utf8_lossy(&out.stdout);
         // The example ends with sys.exit(-1) after printing "Done!".
         assert!(stdout.contains("Done!"), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
-        let log = sim.stop();
+        let log = sim.interrupt().stdout;
         assert!(log.contains("ReleaseMode: sport mode \"normal\" released"), "{log}");
         let last = log.lines().last().unwrap_or_default();
         let accepted: u64 = last.split_whitespace().nth(2).and_then(|n| n.parse().ok()).unwrap_or(0);
@@ -91,7 +63,7 @@ fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
 #[test]
 fn robowire_go2_status_release_stand_and_the_dds_inspector() {
     with_loopback_multicast(|| {
-        let sim = Sim::start();
+        let sim = start_sim();
         let go2 = |args: &[&str]| robowire().args(["go2", "--interface", "lo"]).args(args).output().unwrap();
         let status = go2(&["status", "--json"]);
         assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
@@ -117,7 +89,7 @@ fn robowire_go2_status_release_stand_and_the_dds_inspector() {
         assert_eq!(echo.lines().count(), 2, "{echo}");
         assert!(echo.lines().all(|l| serde_json::from_str::<serde_json::Value>(l).is_ok_and(|v| v["tick"].is_u64())));
 
-        let log = sim.stop();
+        let log = sim.interrupt().stdout;
         assert!(log.contains("sport StandDown") && log.contains("ReleaseMode"), "{log}");
     });
 }
@@ -139,7 +111,7 @@ fn no_robot_on_the_network_is_a_clear_error() {
 #[test]
 fn status_and_watch_of_a_go2_by_address() {
     with_loopback_multicast(|| {
-        let sim = Sim::start();
+        let sim = start_sim();
         let out = robowire().args(["status", "go2:lo", "--json"]).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let state: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

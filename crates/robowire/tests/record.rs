@@ -4,15 +4,13 @@
 //! other and with what the simulator counted. Then `robowire decode --mcap` and `robowire replay`
 //! on the same file; a truncated capture is a clear error, not a panic.
 
-use std::io::{BufRead, BufReader};
+mod support;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 
 use serde_json::Value;
-
-fn robowire() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_robowire"))
-}
+use support::{Running, robowire};
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("robowire-record-{}-{name}", std::process::id()))
@@ -21,15 +19,12 @@ fn temp(name: &str) -> std::path::PathBuf {
 #[test]
 fn a_recorded_dog_session_reads_back_everywhere() {
     let (sim_capture, client_capture) = (temp("sim.mcap"), temp("client.mcap"));
-    let mut sim = robowire()
-        .args(["sim", "dog", "--bind", "127.0.0.23", "--report-every-s", "0", "--record"])
-        .arg(&sim_capture)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
+    let sim = Running::spawn(
+        robowire()
+            .args(["sim", "dog", "--bind", "127.0.0.23", "--report-every-s", "0", "--record"])
+            .arg(&sim_capture)
+            .stderr(Stdio::piped()),
+    );
     let walk = robowire()
         .args(["dog", "--dog-ip", "127.0.0.23", "--local-ip", "127.0.0.23", "--record"])
         .arg(&client_capture)
@@ -54,10 +49,7 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         .output()
         .unwrap();
     assert!(walk.status.success(), "{}", String::from_utf8_lossy(&walk.stderr));
-    rustix::process::kill_process(rustix::process::Pid::from_child(&sim), rustix::process::Signal::INT).unwrap();
-    let out = sim.wait_with_output().unwrap();
-    assert!(out.status.success());
-    let log = String::from_utf8_lossy(&out.stderr);
+    let log = sim.interrupt().stderr;
     assert!(log.contains("record:") && log.contains(" 0 dropped"), "{log}");
 
     // The reader runs where its Python is (skipped with a line otherwise); the rest runs anyway.
@@ -132,14 +124,7 @@ fn modes(states: impl Iterator<Item = zsl_proto::udp::HighLevelState>) -> Vec<u3
 fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     use zsl_proto::udp::{AnyDatagram, HighLevelState};
     let capture = temp("walk.mcap");
-    let mut sim = robowire()
-        .args(["sim", "dog", "--bind", "127.0.0.26", "--report-every-s", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    BufReader::new(sim.stdout.as_mut().unwrap()).read_line(&mut first).unwrap();
+    let sim = Running::start(&["sim", "dog", "--bind", "127.0.0.26", "--report-every-s", "0"]);
     let dog = |args: &[&str], record: bool| {
         let mut command = robowire();
         command.args(["dog", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26"]);
@@ -164,8 +149,7 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
         assert!(began.elapsed().as_secs() < 30, "the simulated dog never stood up");
     }
     dog(&["move", "0.5", "0", "0", "--duration", "0.5"], true);
-    let _ = sim.kill();
-    let _ = sim.wait();
+    drop(sim);
 
     let zsl = zsl_proto::description::DESCRIPTIONS;
     let recorded: Vec<HighLevelState> = robowire_record::read_frames(&std::fs::read(&capture).unwrap(), &zsl)
@@ -179,16 +163,10 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     let recorded_modes = modes(recorded.iter().copied());
     assert!(recorded_modes.contains(&18), "the recorded walk: {recorded_modes:?}");
 
-    let mut replay = robowire()
-        .args(["replay", "--as-device", "--bind", "127.0.0.27"])
-        .arg(&capture)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut addr = String::new();
-    BufReader::new(replay.stdout.as_mut().unwrap()).read_line(&mut addr).unwrap();
-    assert_eq!(addr.trim(), "127.0.0.27:43997");
+    let replay = Running::spawn(
+        robowire().args(["replay", "--as-device", "--bind", "127.0.0.27"]).arg(&capture).stderr(Stdio::piped()),
+    );
+    assert_eq!(replay.first_line, "127.0.0.27:43997");
 
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
     let (seen, states_received) = runtime.block_on(async {
@@ -208,8 +186,8 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
         client.close();
         (seen, states)
     });
-    let out = replay.wait_with_output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = replay.wait();
+    assert!(out.status.success(), "{}", out.stderr);
     assert_eq!(modes(seen.iter().copied()), recorded_modes, "the live client went through the recorded modes");
     assert_eq!(states_received, recorded.len() as u64, "every recorded state arrived");
     assert_eq!(seen.last(), recorded.last(), "ending in the recorded last state, field for field");

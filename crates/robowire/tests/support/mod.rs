@@ -1,0 +1,82 @@
+//! What the CLI's integration tests share: the binary under test, and a `robowire` process (a
+//! simulator, a replay) that ends with its test.
+
+#![allow(dead_code, reason = "each test binary uses part of it")]
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
+
+/// The `robowire` binary under test.
+pub(crate) fn robowire() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_robowire"))
+}
+
+/// A `robowire` process started by a test, killed when dropped.
+pub(crate) struct Running {
+    child: Child,
+    stdout: BufReader<ChildStdout>,
+    /// Its first line on stdout, without the line end: a simulator's ready line (its port or
+    /// addresses).
+    pub(crate) first_line: String,
+}
+
+/// What a [`Running`] process did after its first line.
+pub(crate) struct Ended {
+    pub(crate) status: ExitStatus,
+    /// Its stdout after the first line.
+    pub(crate) stdout: String,
+    /// Its stderr, when it was piped.
+    pub(crate) stderr: String,
+}
+
+impl Running {
+    /// `robowire ARGS`, its stderr discarded, once it printed its first line.
+    pub(crate) fn start(args: &[&str]) -> Self {
+        Self::spawn(robowire().args(args).stderr(Stdio::null()))
+    }
+
+    /// `command` with its stdout piped, once it printed its first line (it must print one).
+    pub(crate) fn spawn(command: &mut Command) -> Self {
+        let mut child = command.stdout(Stdio::piped()).spawn().unwrap();
+        let mut stdout = BufReader::new(child.stdout.take().unwrap());
+        let mut first_line = String::new();
+        stdout.read_line(&mut first_line).unwrap();
+        assert!(!first_line.is_empty(), "{command:?} ended before its first line: {:?}", child.wait());
+        first_line.truncate(first_line.trim_end().len());
+        Self { child, stdout, first_line }
+    }
+
+    /// Its next line on stdout, without the line end; `None` once it closed stdout.
+    pub(crate) fn next_line(&mut self) -> Option<String> {
+        let mut line = String::new();
+        (self.stdout.read_line(&mut line).unwrap() > 0).then(|| line.trim_end().to_owned())
+    }
+
+    /// Ctrl-C; it must exit cleanly.
+    pub(crate) fn interrupt(self) -> Ended {
+        let pid = rustix::process::Pid::from_child(&self.child);
+        rustix::process::kill_process(pid, rustix::process::Signal::INT).unwrap();
+        let ended = self.wait();
+        assert!(ended.status.success(), "exit after Ctrl-C: {}\n{}", ended.status, ended.stderr);
+        ended
+    }
+
+    /// Waits until it ends by itself.
+    pub(crate) fn wait(mut self) -> Ended {
+        let mut stdout = String::new();
+        self.stdout.read_to_string(&mut stdout).unwrap();
+        let mut stderr = String::new();
+        if let Some(mut pipe) = self.child.stderr.take() {
+            pipe.read_to_string(&mut stderr).unwrap();
+        }
+        let status = self.child.wait().unwrap();
+        Ended { status, stdout, stderr }
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
