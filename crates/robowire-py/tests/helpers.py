@@ -3,7 +3,7 @@
 import time
 
 
-def wait_until(predicate, timeout_s: float = 3.0, step_s: float = 0.01):
+def wait_until(predicate, timeout_s: float = 10.0, step_s: float = 0.01):
     """Polls ``predicate`` until it returns something truthy (returned) or ``timeout_s``
     passes (``AssertionError``)."""
     deadline = time.monotonic() + timeout_s

@@ -9,7 +9,8 @@ Scenarios:
 - sense: reads one sample of each of rt/NS/joint_states, rt/NS/imu, rt/NS/battery_state,
   rt/NS/tf, rt/NS/odom, field for field.
 - stand_up: calls the std_srvs/Trigger service NS/stand_up (rq/…Request, rr/…Reply).
-- stand_and_drive: stand_up, then drive (a dog must stand before it walks).
+- stand_and_drive: stand_up, then drive once rt/NS/odom shows the standing height (a dog must
+  stand before it walks).
 - sense_chassis: rt/NS/battery_state and rt/NS/diagnostics of a KMC chassis.
 - sense_go2: rt/NS/joint_states and rt/NS/imu of a Go2, and rt/NS/lowstate with Unitree's class.
 """
@@ -37,12 +38,20 @@ def topic(ns, name):
 
 
 def take_one(reader, timeout_s=10.0):
+    sample = poll_one(reader, timeout_s)
+    if sample is None:
+        raise SystemExit(f"nothing on {reader.topic.name} within {timeout_s} s")
+    return sample
+
+
+def poll_one(reader, timeout_s):
+    """The next sample, or None after timeout_s."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         for sample in reader.take(N=1):
             return sample
         time.sleep(0.005)
-    raise SystemExit(f"nothing on {reader.topic.name} within {timeout_s} s")
+    return None
 
 
 def latest(reader):
@@ -50,9 +59,17 @@ def latest(reader):
     return samples[-1] if samples else None
 
 
+# The simulated dog's body height once it stood up (0.30 m; 0.10 m lying), m.
+STANDING_Z_M = 0.29
+
+
 def stand_and_drive(dp, ns):
     stood = stand_up(dp, ns)
-    time.sleep(2.0)  # standing up takes the dog about 1.2 s
+    odom = DataReader(dp, Topic(dp, topic(ns, "odom"), Odometry), qos=RELIABLE)
+    deadline = time.monotonic() + 10.0
+    while take_one(odom).pose.pose.position.z < STANDING_Z_M:
+        if time.monotonic() > deadline:
+            raise SystemExit("the dog did not stand up within 10 s")
     return {"stand_up": stood, **drive(dp, ns)}
 
 
@@ -133,10 +150,16 @@ def sense_go2(dp, ns):
 def stand_up(dp, ns):
     requests = DataWriter(dp, Topic(dp, f"rq{ns}/stand_upRequest", TriggerRequest), qos=RELIABLE)
     replies = DataReader(dp, Topic(dp, f"rr{ns}/stand_upReply", TriggerResponse), qos=RELIABLE)
-    time.sleep(1.0)  # discovery both ways before the request
+    # A request written before both sides discovered each other is lost (volatile durability):
+    # the same request again until answered, as a client waiting for its service would.
     guid = 0x1234_5678_9ABC_DEF0
-    requests.write(TriggerRequest(guid=guid, seq=1))
-    reply = take_one(replies)
+    deadline = time.monotonic() + 10.0
+    reply = None
+    while reply is None:
+        if time.monotonic() > deadline:
+            raise SystemExit("no reply from stand_up within 10 s")
+        requests.write(TriggerRequest(guid=guid, seq=1))
+        reply = poll_one(replies, timeout_s=0.2)
     return {"guid_matches": reply.guid == guid, "seq": reply.seq, "success": reply.success, "message": reply.message}
 
 
