@@ -1,6 +1,6 @@
 //! An object a Python class owns until `close()`: shared by calls on any thread, dropped once.
 
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{Mutex, MutexGuard};
 
 use pyo3::prelude::*;
 
@@ -19,7 +19,7 @@ impl<T> Owned<T> {
     }
 
     fn lock(&self) -> MutexGuard<'_, Option<T>> {
-        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
+        robowire_rt::lock(&self.inner)
     }
 
     /// Runs `f` on the value, or raises `ClosedError`.

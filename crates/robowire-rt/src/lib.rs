@@ -6,13 +6,14 @@ mod latest;
 mod placement;
 pub mod runner;
 pub mod stats;
+pub mod sync;
 mod thread;
 
-pub use device::lock;
 pub use latest::Latest;
 pub use placement::Placement;
 pub use robowire_core::schedule;
 pub use robowire_core::schedule::Time;
+pub use sync::lock;
 pub use thread::{RtError, lock_memory, pin_current_thread, set_fine_timer_slack, set_realtime_priority};
 
 /// Time on the monotonic clock (`CLOCK_MONOTONIC`), ns: the clock of every robowire deadline

@@ -363,11 +363,8 @@ impl Driver {
     /// The oldest received frame, waiting up to `timeout` for one.
     pub fn wait_pop_message(&self, timeout: Duration) -> Option<ChassisFrame> {
         let queue = self.inbox.queue();
-        let (mut queue, _) = self
-            .inbox
-            .message_ready
-            .wait_timeout_while(queue, timeout, |q| q.is_empty())
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut queue =
+            robowire_rt::sync::wait_timeout_while(&self.inbox.message_ready, queue, timeout, |q| q.is_empty());
         queue.pop_front()
     }
 

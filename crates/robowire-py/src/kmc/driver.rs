@@ -3,13 +3,13 @@
 //! (stop burst); the Python object lives on across runs.
 
 use std::collections::VecDeque;
-use std::sync::{Mutex, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::sync::{Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::{Duration, Instant};
 
 use kmc::{ChassisFrame, ChassisState, Connection, Device, DriverOptions, LinkState, Placement, SerialPortOptions};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use robowire_rt::device::lock;
+use robowire_rt::lock;
 
 use super::{frame_to_py, raise, state_to_py};
 use crate::errors::{Kind, chain, error};
@@ -59,11 +59,11 @@ pub(crate) struct Driver {
 
 impl Driver {
     fn read(&self) -> RwLockReadGuard<'_, Run> {
-        self.run.read().unwrap_or_else(PoisonError::into_inner)
+        robowire_rt::sync::read(&self.run)
     }
 
     fn write(&self) -> RwLockWriteGuard<'_, Run> {
-        self.run.write().unwrap_or_else(PoisonError::into_inner)
+        robowire_rt::sync::write(&self.run)
     }
 
     /// `ClosedError` saying why there is no running driver.

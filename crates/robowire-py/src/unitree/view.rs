@@ -3,7 +3,7 @@
 //! `cmd.motor_cmd[3].q = 0.5` changes `cmd`. Where a field lies, its type and its range come from
 //! `lowcmd_proto::field`; this module turns its places and values into Python objects.
 
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use lowcmd_proto::field::{Element, PlaceKind};
 use lowcmd_proto::layout::{Scalar, StructLayout};
@@ -19,7 +19,7 @@ use crate::errors::{Kind, error};
 pub(crate) type Image = Arc<Mutex<Vec<u8>>>;
 
 pub(crate) fn lock(image: &Image) -> MutexGuard<'_, Vec<u8>> {
-    image.lock().unwrap_or_else(PoisonError::into_inner)
+    robowire_rt::lock(image)
 }
 
 /// A field error as an `ArgumentError` naming the field.

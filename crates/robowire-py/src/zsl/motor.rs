@@ -1,7 +1,7 @@
 //! `MotorCommand` and `MotorState` with the vendor's field names, and `JointArray`: one field's
 //! four legs (FR, FL, RR, RL), a live view that writes through, as the vendor's numpy arrays do.
 
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
@@ -14,7 +14,7 @@ use crate::errors::{Kind, error};
 pub(crate) type Rows = Arc<Mutex<Vec<[f32; 4]>>>;
 
 fn lock(rows: &Rows) -> MutexGuard<'_, Vec<[f32; 4]>> {
-    rows.lock().unwrap_or_else(PoisonError::into_inner)
+    robowire_rt::lock(rows)
 }
 
 /// Four floats from any sequence of four numbers (list, tuple, `JointArray`, numpy array).

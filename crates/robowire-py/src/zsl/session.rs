@@ -3,7 +3,7 @@
 //! reason kept in `last_error`; "no state" as an exception instead of the vendor's zeros.
 
 use std::net::{IpAddr, SocketAddr};
-use std::sync::{Arc, Mutex, PoisonError, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 use std::time::Duration;
 
 use pyo3::prelude::*;
@@ -104,14 +104,14 @@ impl<T: Facade> Session<T> {
         let dog = options.dog;
         let client =
             py.detach(|| T::open(options)).map_err(|e| connect_error(&format!("{}.initRobot", T::NAME), &e))?;
-        *self.running.write().unwrap_or_else(PoisonError::into_inner) = Some(Running { client: Arc::new(client), dog });
+        *robowire_rt::sync::write(&self.running) = Some(Running { client: Arc::new(client), dog });
         Ok(())
     }
 
     /// Stops streaming and frees the port (bound again at once if no other thread is inside a
     /// call on this client). Idempotent.
     pub(crate) fn close(&self, py: Python<'_>) -> PyResult<()> {
-        let old = self.running.write().unwrap_or_else(PoisonError::into_inner).take();
+        let old = robowire_rt::sync::write(&self.running).take();
         if let Some(Running { client, .. }) = old {
             match Arc::try_unwrap(client) {
                 Ok(client) => py.detach(move || Device::close(client)).unwrap_or_else(|never| match never {}),
@@ -123,7 +123,7 @@ impl<T: Facade> Session<T> {
 
     /// The running client, or `ClosedError`.
     pub(crate) fn running(&self) -> PyResult<Running<T>> {
-        self.running.read().unwrap_or_else(PoisonError::into_inner).clone().ok_or_else(|| {
+        robowire_rt::sync::read(&self.running).clone().ok_or_else(|| {
             error(
                 Kind::Closed,
                 format!("this {} is not connected: call initRobot(local_ip, local_port, dog_ip) first", T::NAME),
@@ -133,7 +133,7 @@ impl<T: Facade> Session<T> {
 
     /// The client, if running.
     pub(crate) fn client(&self) -> Option<Arc<T>> {
-        self.running.read().unwrap_or_else(PoisonError::into_inner).as_ref().map(|r| r.client.clone())
+        robowire_rt::sync::read(&self.running).as_ref().map(|r| r.client.clone())
     }
 
     /// A getter: the value, or `NoStateError` saying why there is none.
@@ -167,12 +167,12 @@ impl<T: Facade> Session<T> {
 
     /// Keeps (or clears) the reason of the last refused call.
     pub(crate) fn remember(&self, reason: Option<String>) {
-        *self.last_error.lock().unwrap_or_else(PoisonError::into_inner) = reason;
+        *robowire_rt::lock(&self.last_error) = reason;
     }
 
     /// Why the last call returned a non-zero code, if it did.
     pub(crate) fn last_error(&self) -> Option<String> {
-        self.last_error.lock().unwrap_or_else(PoisonError::into_inner).clone()
+        robowire_rt::lock(&self.last_error).clone()
     }
 
     /// `checkConnect()`: state within the watchdog's 3 s. False before `initRobot`.

@@ -61,10 +61,3 @@ pub trait Device {
         self.receiving().connection_events()
     }
 }
-
-/// Locks `mutex`, going on with the data if a thread panicked while holding it (every mutex in
-/// robowire guards plain data whose invariants hold between statements). Never on a stream
-/// thread.
-pub fn lock<T: ?Sized>(mutex: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
-}
