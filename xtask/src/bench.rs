@@ -431,6 +431,58 @@ fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         target: "–".into(),
         met: None,
     });
+    rows.extend(stalled_reader_rows(&meta["stalled_reader"])?);
+    Ok(rows)
+}
+
+/// A stalled reader may raise the LowCmd stream's p99 lateness to 1.5× the healthy run's, and no
+/// send may be later than 1 ms (issue: a reader that stops reading, reliable QoS).
+const STALLED_P99_RATIO: f64 = 1.5;
+const STALLED_MAX_US: u64 = 1000;
+
+/// Rows of the stalled-reader runs: the Go2 client's LowCmd stream with a healthy RELIABLE
+/// reader, and beside it the same stream while the reader stalls.
+fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let case = |key: &str| -> anyhow::Result<(u64, u64, u64, u64, f64, f64)> {
+        let c = &meta[key];
+        let (p50, p99, max) = percentiles_us(&c["lateness"])?;
+        let dropped = c["dropped"].as_u64().with_context(|| format!("dds meta stalled_reader.{key}.dropped"))?;
+        let run = c["run_s"].as_f64().with_context(|| format!("dds meta stalled_reader.{key}.run_s"))?;
+        let stall = c["stall_s"].as_f64().with_context(|| format!("dds meta stalled_reader.{key}.stall_s"))?;
+        Ok((p50, p99, max, dropped, run, stall))
+    };
+    let window = meta["window_samples"].as_u64().context("dds meta stalled_reader.window_samples")?;
+    let (h50, h99, hmax, hdropped, hrun, _) = case("healthy")?;
+    let figure = |p50: u64, p99: u64, max: u64, dropped: u64| {
+        format!("p50 {p50} µs, p99 {p99} µs, max {max} µs; {dropped} dropped")
+    };
+    let mut rows = vec![Row {
+        path: format!("Go2 LowCmd stream (500 Hz) send lateness, a healthy RELIABLE reader of rt/lowcmd ({hrun:.0} s)"),
+        figure: figure(h50, h99, hmax, hdropped),
+        baseline: "–".into(),
+        ratio: "–".into(),
+        target: format!("max ≤ {} ms", STALLED_MAX_US / 1000),
+        met: Some(hmax <= STALLED_MAX_US),
+    }];
+    for (key, what) in [
+        ("stops_taking", "stops taking samples (its participant still acknowledges)"),
+        ("stopped", "is stopped (SIGSTOP: neither reads nor acknowledges)"),
+        ("window_full", "is stopped until rustdds's send window is full, then 1 s more"),
+    ] {
+        let (p50, p99, max, dropped, run, stall) = case(key)?;
+        let ratio = p99 as f64 / h99.max(1) as f64;
+        let window = if key == "window_full" { format!(" ({window} samples)") } else { String::new() };
+        rows.push(Row {
+            path: format!(
+                "Go2 LowCmd stream (500 Hz) send lateness, the reader {what}{window}: {stall:.1} s of a {run:.1} s run"
+            ),
+            figure: figure(p50, p99, max, dropped),
+            baseline: format!("healthy reader: {}", figure(h50, h99, hmax, hdropped)),
+            ratio: format!("{ratio:.2}× (p99); max {:.2} ms", max as f64 / 1000.0),
+            target: format!("p99 ≤ {STALLED_P99_RATIO}× healthy, max ≤ {} ms", STALLED_MAX_US / 1000),
+            met: Some(ratio <= STALLED_P99_RATIO && max <= STALLED_MAX_US),
+        });
+    }
     Ok(rows)
 }
 
@@ -467,5 +519,32 @@ mod tests {
         let rows = round_trip_rows(&meta, "trip", "raw echo", None).unwrap();
         assert!(rows.iter().all(|r| r.met.is_none()));
         assert!(round_trip_rows(&serde_json::json!({}), "trip", "raw", None).is_err(), "missing keys are errors");
+    }
+
+    #[test]
+    fn stalled_reader_rows_judge_p99_against_the_healthy_run_and_the_max() {
+        let case = |p99: u64, max: u64, dropped: u64| {
+            serde_json::json!({
+                "lateness": {"count": 1500, "p50_us": 0, "p99_us": p99, "max_us": max},
+                "dropped": dropped, "run_s": 3.0, "stall_s": 1.0,
+            })
+        };
+        let meta = serde_json::json!({
+            "window_samples": 8192,
+            "healthy": case(40, 900, 0),
+            "stops_taking": case(60, 1000, 0),
+            "stopped": case(61, 500, 0),
+            "window_full": case(50, 1001, 700),
+        });
+        let rows = stalled_reader_rows(&meta).unwrap();
+        assert_eq!(rows.len(), 4);
+        assert_eq!((rows[0].target.as_str(), rows[0].met), ("max ≤ 1 ms", Some(true)));
+        assert_eq!(rows[1].figure, "p50 0 µs, p99 60 µs, max 1000 µs; 0 dropped");
+        assert_eq!(rows[1].baseline, "healthy reader: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
+        assert_eq!((rows[1].ratio.as_str(), rows[1].met), ("1.50× (p99); max 1.00 ms", Some(true)));
+        assert_eq!(rows[2].met, Some(false), "p99 above 1.5× healthy");
+        assert_eq!(rows[3].met, Some(false), "a send later than 1 ms");
+        assert!(rows[3].path.contains("8192 samples") && rows[3].figure.ends_with("700 dropped"));
+        assert!(stalled_reader_rows(&serde_json::json!({})).is_err(), "missing keys are errors");
     }
 }

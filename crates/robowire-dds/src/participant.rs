@@ -116,7 +116,7 @@ impl Participant {
         Ok(Writer::new(inner, name))
     }
 
-    /// A reader of `T` on topic `name`. It yields samples from a tokio task (any executor).
+    /// A reader of `T` on topic `name` (any executor).
     pub fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
         self.reader_of_type(name, T::TYPE_NAME, qos)
     }
@@ -136,9 +136,9 @@ impl Participant {
         let topic = self.topic(name, type_name, qos, "reader")?;
         let inner = self
             .subscriber
-            .create_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))
+            .create_simple_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))
             .map_err(|source| DdsError::Create { what: "reader", topic: name.into(), source })?;
-        Ok(Reader::new(inner, name))
+        Ok(Reader::new(inner, name, usize::try_from(qos.depth).unwrap_or(1)))
     }
 
     /// Topics seen from other participants' writers and readers, by name.

@@ -1,11 +1,12 @@
 //! Typed writers and readers with their counters.
 
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
+use std::task::{Context, Poll};
 
-use futures::StreamExt;
 use robowire_core::cdr::CdrType;
-use rustdds::no_key::{DataReader, DataReaderStream, DataWriter};
+use rustdds::no_key::{DataWriter, SimpleDataReader};
 use rustdds::{DataWriterStatus, StatusEvented};
 
 use crate::DdsError;
@@ -164,10 +165,24 @@ pub struct Sample<T> {
     pub writer: [u8; 16],
 }
 
+/// Samples a reader takes between two drains of rustdds's notification socketpair.
+const NOTIFICATIONS_DRAINED_EVERY: u32 = 64;
+
 /// Reads `T` from one topic, asynchronously (any executor). Samples whose body does not decode
-/// are counted and skipped.
+/// are counted and skipped. As DDS's keep-last history: of the samples that arrived since the last
+/// `recv`, the newest `depth` (the QoS's) are kept, delivered oldest first; a keep-last-1 reader
+/// gets the newest.
+///
+/// Served by the caller's task: `recv` takes from rustdds's topic cache itself and, when nothing
+/// is there, parks on the waker rustdds's event loop wakes when a sample arrives (no task, no
+/// channel in between).
 pub struct Reader<T: CdrType + 'static> {
-    stream: DataReaderStream<Decoded<T>, CdrAdapter<T>>,
+    inner: SimpleDataReader<Decoded<T>, CdrAdapter<T>>,
+    /// Samples taken and not yet delivered, oldest first; at most `depth`.
+    kept: VecDeque<Sample<T>>,
+    depth: usize,
+    /// Samples taken since rustdds's per-sample notification bytes were last drained.
+    undrained: u32,
     topic: String,
     counters: Arc<Counters>,
     last_error: Option<String>,
@@ -180,20 +195,60 @@ impl<T: CdrType + 'static> std::fmt::Debug for Reader<T> {
 }
 
 impl<T: CdrType + 'static> Reader<T> {
-    pub(crate) fn new(inner: DataReader<Decoded<T>, CdrAdapter<T>>, topic: &str) -> Self {
-        Self { stream: inner.async_sample_stream(), topic: topic.into(), counters: Arc::default(), last_error: None }
+    pub(crate) fn new(inner: SimpleDataReader<Decoded<T>, CdrAdapter<T>>, topic: &str, depth: usize) -> Self {
+        let depth = depth.max(1);
+        Self {
+            inner,
+            kept: VecDeque::with_capacity(depth),
+            depth,
+            undrained: 0,
+            topic: topic.into(),
+            counters: Arc::default(),
+            last_error: None,
+        }
     }
 
     /// The next sample that decodes.
     pub async fn recv(&mut self) -> Result<Sample<T>, DdsError> {
+        let sample = std::future::poll_fn(|cx| self.poll_recv(cx)).await;
+        Counters::bump(&self.counters.samples);
+        Ok(sample)
+    }
+
+    /// The next kept sample; else, `cx`'s waker handed to rustdds (it wakes it once, when a
+    /// sample arrives) and one more look, so that a sample that arrived in between is not missed.
+    fn poll_recv(&mut self, cx: &mut Context<'_>) -> Poll<Sample<T>> {
+        self.take_arrived();
+        if let Some(sample) = self.kept.pop_front() {
+            return Poll::Ready(sample);
+        }
+        self.inner.set_waker(Some(cx.waker().clone()));
+        self.take_arrived();
+        self.kept.pop_front().map_or(Poll::Pending, Poll::Ready)
+    }
+
+    /// Takes every sample that arrived into `kept`, the oldest dropped beyond `depth`; counts the
+    /// ones that do not decode.
+    fn take_arrived(&mut self) {
+        // rustdds also writes a byte to a socketpair (for a mio poll, unused here) per sample:
+        // emptied now and then, so that it does not stay full.
+        if self.undrained >= NOTIFICATIONS_DRAINED_EVERY {
+            self.inner.drain_read_notifications();
+            self.undrained = 0;
+        }
         loop {
-            match self.stream.next().await {
-                Some(Ok(sample)) => match (sample.sample_info().writer_guid().to_bytes(), sample.into_value()) {
-                    (writer, Ok(value)) => {
-                        Counters::bump(&self.counters.samples);
-                        return Ok(Sample { value, writer });
+            let taken = self.inner.try_take_one();
+            self.undrained += u32::from(!matches!(taken, Ok(None)));
+            match taken {
+                Ok(None) => return,
+                Ok(Some(change)) => match change.sample {
+                    Ok(value) => {
+                        if self.kept.len() == self.depth {
+                            self.kept.pop_front();
+                        }
+                        self.kept.push_back(Sample { value, writer: change.writer_guid.to_bytes() });
                     }
-                    (_, Err(failure)) => {
+                    Err(failure) => {
                         let counter = if failure.checksum {
                             &self.counters.checksum_errors
                         } else {
@@ -204,11 +259,10 @@ impl<T: CdrType + 'static> Reader<T> {
                     }
                 },
                 // A read error of the library (a sample it could not take): counted, next.
-                Some(Err(e)) => {
+                Err(e) => {
                     Counters::bump(&self.counters.decode_errors);
                     self.last_error = Some(e.to_string());
                 }
-                None => return Err(DdsError::Closed { topic: self.topic.clone() }),
             }
         }
     }

@@ -8,7 +8,7 @@ use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::rpc::{RpcClient, RpcServer, Service};
-use robowire_dds::{Participant, ParticipantOptions};
+use robowire_dds::{Participant, ParticipantOptions, Reader};
 
 const WAIT: Duration = Duration::from_secs(20);
 
@@ -86,6 +86,70 @@ fn lowcmd_and_lowstate_between_two_participants_and_a_call() {
             serve.abort();
 
             let _ = LowState::default();
+        })
+    });
+}
+
+fn tagged(tag: u32) -> LowCmd {
+    let mut cmd = LowCmd::default();
+    cmd.reserve = tag.into();
+    cmd
+}
+
+/// The tag of the reader's next sample.
+async fn next(reader: &mut Reader<LowCmd>) -> u32 {
+    tokio::time::timeout(WAIT, reader.recv()).await.expect("a sample").unwrap().value.reserve.get()
+}
+
+/// Of the samples that arrived since the last `recv`, a reader keeps the newest `depth` (its QoS's
+/// keep-last history), oldest first: a keep-last-1 reader gets the newest.
+#[test]
+fn a_reader_delivers_the_newest_depth_samples_oldest_first() {
+    with_loopback_multicast(|| {
+        runtime().block_on(async {
+            let options = ParticipantOptions::new(0, Some("lo"));
+            let robot = Participant::new(options.clone()).unwrap();
+            let client = Participant::new(options).unwrap();
+            // Reliable, so that none of the burst is lost; all three in one participant, fed by
+            // its one event loop in arrival order.
+            let reliable = |depth| Qos { reliable: true, depth, ..Qos::READER };
+            let mut every = robot.reader::<LowCmd>(LowCmd::TOPIC, reliable(16)).unwrap();
+            let mut newest = robot.reader::<LowCmd>(LowCmd::TOPIC, reliable(1)).unwrap();
+            let mut four = robot.reader::<LowCmd>(LowCmd::TOPIC, reliable(4)).unwrap();
+            let writer = client.writer::<LowCmd>(LowCmd::TOPIC, Qos::WRITER).unwrap();
+            // Tag 0 until each reader has one (discovery takes a moment).
+            for reader in [&mut every, &mut newest, &mut four] {
+                tokio::time::timeout(WAIT, async {
+                    loop {
+                        writer.write(tagged(0)).unwrap();
+                        if let Ok(Ok(_)) = tokio::time::timeout(Duration::from_millis(50), reader.recv()).await {
+                            break;
+                        }
+                    }
+                })
+                .await
+                .expect("each reader matched");
+            }
+            for tag in 1..=11 {
+                writer.write(tagged(tag)).unwrap();
+            }
+            // Once the depth-16 reader has all eleven, in order, the other two have them too.
+            let mut seen = Vec::new();
+            while seen.last() != Some(&11) {
+                let sample = tokio::time::timeout(WAIT, every.recv()).await.expect("the burst").unwrap();
+                let tag = sample.value.reserve.get();
+                if tag != 0 {
+                    seen.push(tag);
+                }
+            }
+            assert_eq!(seen, (1..=11).collect::<Vec<u32>>());
+            assert_eq!(next(&mut newest).await, 11, "keep last 1: the newest");
+            let mut last_four = Vec::new();
+            for _ in 0..4 {
+                last_four.push(next(&mut four).await);
+            }
+            assert_eq!(last_four, [8, 9, 10, 11], "keep last 4: the newest four, oldest first");
+            assert_eq!(newest.stats().decode_errors + four.stats().checksum_errors, 0);
         })
     });
 }

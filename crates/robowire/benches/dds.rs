@@ -9,19 +9,33 @@
 //! - one way: a LowCmd written (encode, CRC, rustdds) → decoded and verified at a reader in
 //!   another participant, beside `ddsperf`'s half round trip.
 //!
+//! - a stalled reader: the send lateness of a `go2::LowLevel` client's 500 Hz LowCmd stream
+//!   (`set_joints` latched once, nothing else) while a RELIABLE reader of `rt/lowcmd`, a process
+//!   of its own (this program run again), is healthy; stops taking samples for 1 s (rustdds still
+//!   acknowledges what arrives: its acknowledgements come from its event loop, not from takes);
+//!   is stopped (`SIGSTOP`: it neither reads nor acknowledges) for 1 s; is stopped long enough to
+//!   fill rustdds's reliable send window (8192 unacknowledged samples, 16.4 s at 500 Hz) and
+//!   1 s beyond, when the writer drops what it cannot admit. The stream's lateness is its wake-up
+//!   lateness on each tick (a write that waited would make the next ticks late).
+//!
 //! Each side has a CPU of its own (client CPU 0, peer CPU 1), ddsperf's as ours. Figures to
 //! `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Runs where loopback carries multicast
 //! (`robowire_dds::netns`); needs `ddsperf` (Debian's cyclonedds-tools).
 
-use std::process::Command;
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+use go2::{Device, JointCommand, LowLevel, LowLevelOptions};
 use lowcmd_proto::api::motion_switcher;
 use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
-use serde_json::json;
+use serde_json::{Value, json};
 
 /// Both sides get a CPU of their own, ddsperf's and ours alike: the client side on CPU 0, the
 /// peer (pong, the simulator, the second participant) on CPU 1.
@@ -52,7 +66,7 @@ fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
 fn ddsperf(seconds: u32) -> (f64, f64) {
     let mut pong = Command::new("taskset")
         .args(["-c", &PEER_CPU.to_string(), "ddsperf", "-D", &(seconds + 3).to_string(), "pong"])
-        .stdout(std::process::Stdio::null())
+        .stdout(Stdio::null())
         .spawn()
         .expect("ddsperf (apt install cyclonedds-tools)");
     std::thread::sleep(Duration::from_millis(300));
@@ -152,8 +166,202 @@ async fn one_way(seconds: u32) -> Vec<f64> {
     samples
 }
 
+/// Set in the environment of this program run again as the reliable LowCmd reader.
+const READER_ENV: &str = "ROBOWIRE_BENCH_DDS_RELIABLE_READER";
+/// The reader's QoS: reliable (it acknowledges, so the writer keeps what it has not), keep last 1.
+const RELIABLE_READER: Qos = Qos { reliable: true, ..Qos::READER };
+/// rustdds 0.15.1's reliable send window without ResourceLimits (`DEFAULT_WRITER_MAX_SAMPLES`):
+/// unacknowledged samples a reliable writer holds before it admits no more.
+const RUSTDDS_WINDOW_SAMPLES: u32 = 8192;
+/// The Go2's LowCmd period.
+const LOWCMD_PERIOD: Duration = Duration::from_millis(2);
+
+/// This program as the reader: a RELIABLE reader of `rt/lowcmd` on the peer's CPU taking every
+/// sample. It prints `receiving` at its first sample; on stdin, `stop` stops taking (its
+/// participant still receives and acknowledges), `go` takes again; at the end of stdin it prints
+/// `taken N` and returns.
+fn reliable_reader() {
+    robowire_rt::pin_current_thread(PEER_CPU).expect("pinning (needs 2 CPUs)");
+    let taking = Arc::new(AtomicBool::new(true));
+    let done = Arc::new(AtomicBool::new(false));
+    std::thread::spawn({
+        let (taking, done) = (taking.clone(), done.clone());
+        move || {
+            for line in std::io::stdin().lock().lines().map_while(Result::ok) {
+                taking.store(line.trim() != "stop", Ordering::Relaxed);
+            }
+            done.store(true, Ordering::Relaxed);
+        }
+    });
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+    let taken = runtime.block_on(async {
+        let participant = Participant::new(ParticipantOptions::new(0, Some("lo"))).expect("participant");
+        let mut reader = participant.reader::<LowCmd>(LowCmd::TOPIC, RELIABLE_READER).expect("reader");
+        let mut taken = 0u64;
+        while !done.load(Ordering::Relaxed) {
+            if !taking.load(Ordering::Relaxed) {
+                tokio::time::sleep(Duration::from_millis(1)).await;
+                continue;
+            }
+            // Bounded, so that `stop` and the end are seen while nothing arrives.
+            if let Ok(sample) = tokio::time::timeout(Duration::from_millis(10), reader.recv()).await {
+                sample.expect("the reader");
+                taken += 1;
+                if taken == 1 {
+                    println!("receiving");
+                }
+            }
+        }
+        taken
+    });
+    println!("taken {taken}");
+}
+
+/// What the reader does in the middle of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stall {
+    /// Nothing: it takes every sample.
+    None,
+    /// It stops taking samples (its participant still acknowledges them).
+    StopTaking,
+    /// Its process is stopped: it neither reads nor acknowledges.
+    StopProcess,
+}
+
+/// The reader process, started.
+struct ReaderProcess {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    lines: mpsc::Receiver<String>,
+}
+
+impl ReaderProcess {
+    fn spawn() -> Self {
+        let mut child = Command::new(std::env::current_exe().expect("this program"))
+            .env(READER_ENV, "1")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("the reader process");
+        let stdout = child.stdout.take().expect("its stdout");
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+        Self { stdin: child.stdin.take(), child, lines }
+    }
+
+    /// The first line of the reader that starts with `prefix`; panics after `timeout`.
+    fn line(&self, prefix: &str, timeout: Duration) -> String {
+        let end = Instant::now() + timeout;
+        loop {
+            let left = end.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if line.starts_with(prefix) => return line,
+                Ok(_) => {}
+                Err(e) => panic!("the reader said no `{prefix}` within {timeout:?}: {e}"),
+            }
+        }
+    }
+
+    fn say(&mut self, word: &str) {
+        writeln!(self.stdin.as_mut().expect("the reader's stdin"), "{word}").expect("telling the reader");
+    }
+
+    fn signal(&self, signal: rustix::process::Signal) {
+        let pid = rustix::process::Pid::from_raw(self.child.id() as i32).expect("a pid");
+        rustix::process::kill_process(pid, signal).expect("signalling the reader");
+    }
+
+    fn stall(&mut self, stall: Stall) {
+        match stall {
+            Stall::None => {}
+            Stall::StopTaking => self.say("stop"),
+            Stall::StopProcess => self.signal(rustix::process::Signal::STOP),
+        }
+    }
+
+    fn resume(&mut self, stall: Stall) {
+        match stall {
+            Stall::None => {}
+            Stall::StopTaking => self.say("go"),
+            Stall::StopProcess => self.signal(rustix::process::Signal::CONT),
+        }
+    }
+
+    /// Ends the reader: the samples it took.
+    fn finish(mut self) -> u64 {
+        drop(self.stdin.take());
+        let line = self.line("taken ", Duration::from_secs(10));
+        let _ = self.child.wait();
+        line["taken ".len()..].parse().expect("a count")
+    }
+}
+
+fn summary(s: &robowire_core::timing::LatenessSummary) -> Value {
+    json!({"count": s.count, "p50_us": s.p50_us, "p99_us": s.p99_us, "max_us": s.max_us})
+}
+
+/// A Go2 client's LowCmd stream against the reader process: `before`, then the reader's `stall`
+/// for `stall_for`, then `after`. The client's send lateness (over its ring: the last 4096
+/// ticks, 8.2 s; max since the start), its counters, and the samples the reader took.
+fn lowcmd_stream(stall: Stall, before: Duration, stall_for: Duration, after: Duration) -> Value {
+    let mut reader = ReaderProcess::spawn();
+    let client = LowLevel::<go2::Go2>::open(LowLevelOptions::on(Some("lo"), 0)).expect("Go2 client");
+    client.set_joints(&[JointCommand::hold(0.0, 0.0, 1.0); 12]).expect("a command");
+    reader.line("receiving", Duration::from_secs(30));
+    std::thread::sleep(before);
+    reader.stall(stall);
+    std::thread::sleep(stall_for);
+    reader.resume(stall);
+    std::thread::sleep(after);
+    let stats = client.stats();
+    drop(client);
+    let taken = reader.finish();
+    let lateness = stats.send_lateness;
+    println!(
+        "LowCmd stream, reader {stall:?} for {stall_for:?}: lateness p50 {} p99 {} max {} µs; sent {}, dropped {}, write drops {}; reader took {taken}",
+        lateness.p50_us, lateness.p99_us, lateness.max_us, stats.commands_sent, stats.lowcmd.dropped, stats.write_drops
+    );
+    json!({
+        "stall": format!("{stall:?}"),
+        "stall_s": stall_for.as_secs_f64(),
+        "run_s": (before + stall_for + after).as_secs_f64(),
+        "lateness": summary(&lateness),
+        "sent": stats.commands_sent,
+        "written": stats.lowcmd.samples,
+        "dropped": stats.lowcmd.dropped,
+        "write_errors": stats.lowcmd.write_errors,
+        "reader_took": taken,
+    })
+}
+
+/// The stalled-reader cases, each against a fresh client and reader: healthy, stops taking 1 s,
+/// stopped 1 s (each over `seconds`), stopped until the send window is full and 1 s beyond.
+fn stalled_reader(seconds: u32) -> Value {
+    let stall = Duration::from_secs(1);
+    let side = (Duration::from_secs(u64::from(seconds)).saturating_sub(stall) / 2).max(Duration::from_secs(1));
+    let healthy = lowcmd_stream(Stall::None, side, stall, side);
+    let stop_taking = lowcmd_stream(Stall::StopTaking, side, stall, side);
+    let stopped = lowcmd_stream(Stall::StopProcess, side, stall, side);
+    let to_fill = LOWCMD_PERIOD * RUSTDDS_WINDOW_SAMPLES + Duration::from_secs(1);
+    let window_full = lowcmd_stream(Stall::StopProcess, Duration::from_secs(1), to_fill, Duration::from_secs(2));
+    json!({
+        "window_samples": RUSTDDS_WINDOW_SAMPLES,
+        "healthy": healthy,
+        "stops_taking": stop_taking,
+        "stopped": stopped,
+        "window_full": window_full,
+    })
+}
+
 fn main() {
     // `cargo bench` passes harness arguments: not ours.
+    if std::env::var_os(READER_ENV).is_some() {
+        return reliable_reader();
+    }
     let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
     let meta = robowire_dds::netns::for_this_process().run(|| {
         let (half50, half99) = ddsperf(seconds);
@@ -161,6 +369,7 @@ fn main() {
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         let trips = runtime.block_on(round_trips(seconds));
         let ways = runtime.block_on(one_way(seconds));
+        let stalled = stalled_reader(seconds);
         let ((r50, r99), (w50, w99)) = (percentiles(trips.clone()), percentiles(ways.clone()));
         println!(
             "round trip p50 {r50:.1} p99 {r99:.1} µs ({} samples); one way p50 {w50:.1} p99 {w99:.1} µs; ddsperf half round trip p50 {half50:.1} p99 {half99:.1} µs",
@@ -171,6 +380,7 @@ fn main() {
             "round_trip_us": {"p50": r50, "p99": r99, "count": trips.len()},
             "one_way_us": {"p50": w50, "p99": w99, "count": ways.len()},
             "ddsperf_half_round_trip_us": {"p50": half50, "p99": half99},
+            "stalled_reader": stalled,
         })
     })
     .unwrap_or_else(|e| panic!("DDS on one machine needs multicast on lo: {e}"));
