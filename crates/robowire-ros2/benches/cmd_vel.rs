@@ -37,10 +37,16 @@ impl Dog {
         Self { socket, walking: walking.encode().to_vec() }
     }
 
-    /// Waits for the client's first datagram, then tells it the dog walks.
-    fn greet(&self) -> SocketAddr {
+    /// Waits for the first datagram of a client other than `before` (whose last datagrams may
+    /// still be queued), then tells it the dog walks.
+    fn greet(&self, before: Option<SocketAddr>) -> SocketAddr {
         let mut buf = [0u8; 64];
-        let (_, client) = self.socket.recv_from(&mut buf).expect("the client streams");
+        let client = loop {
+            let (_, client) = self.socket.recv_from(&mut buf).expect("the client streams");
+            if Some(client) != before {
+                break client;
+            }
+        };
         for _ in 0..5 {
             self.socket.send_to(&self.walking, client).unwrap();
             std::thread::sleep(Duration::from_millis(20));
@@ -88,7 +94,7 @@ fn main() {
             ..BridgeOptions::new(vec!["zsl1:127.0.0.1".parse::<DeviceAddress>().unwrap()])
         };
         let bridge = runtime.spawn(robowire_ros2::run(options, stop, |_| {}));
-        let client = dog.greet();
+        let bridge_client = dog.greet(None);
         let publisher = Participant::new(lo.clone()).unwrap();
         let writer = publisher.writer::<Twist>("rt/cmd_vel", Qos::ROS_DEFAULT).unwrap();
         let deadline = Instant::now() + Duration::from_secs(10);
@@ -106,7 +112,7 @@ fn main() {
                 bridged.push(start.elapsed().as_secs_f64() * 1e6);
             }
             if i % 100 == 0 {
-                dog.keep_alive(client);
+                dog.keep_alive(bridge_client);
             }
         }
         stop_tx.send(true).unwrap();
@@ -136,7 +142,7 @@ fn main() {
         runtime.block_on(async {
             let options = ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
             let robot = HighLevel::open(options).unwrap();
-            let client = dog.greet();
+            let client = dog.greet(Some(bridge_client));
             assert!(robot.wait_connected(Duration::from_secs(2)).await);
             for i in 0..n + 50 {
                 let vx = speeds[i % 2];

@@ -162,8 +162,8 @@ fn round_trips(runtime: &tokio::runtime::Runtime, raw: &mut Vec<u64>, trip: &mut
                 let raw_ns = start.elapsed().as_nanos() as u64;
                 let target = if i % 2 == 0 { ControlMode::Passive } else { ControlMode::LieDown };
                 let start = Instant::now();
-                // The 11th call in a row made while the robot still reports the other mode is
-                // `NotAcknowledged` (it was sent all the same): the result does not matter here.
+                // The 11th call in a row made while the robot still reports the other mode carries
+                // the vendor's 0x3007 (it was sent all the same): the result does not matter here.
                 let _ = if i % 2 == 0 { dog.passive() } else { dog.lie_down() };
                 assert!(dog.wait_for_mode(target, Duration::from_secs(1)).await.is_some());
                 if i >= 200 {
