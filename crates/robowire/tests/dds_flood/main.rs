@@ -7,10 +7,10 @@
 //! nothing of a panic.
 //!
 //! rustdds 0.15.1 trusts six fields of what any host on the network sends (see
-//! [`rustdds_0_15_1_trusts`]): one datagram makes it allocate gigabytes, loop for minutes or panic
-//! on its event-loop thread, and the participant goes silent. The default flood redraws the
-//! datagrams that would; the ignored test sends them. The flooded programs run under an
-//! address-space limit ([`MEMORY_LIMIT_KB`]), so that such a bug fails the test instead of
+//! `datagrams::rustdds_0_15_1_trusts`): one datagram makes it allocate gigabytes, loop for
+//! minutes or panic on its event-loop thread, and the participant goes silent. The default flood
+//! redraws the datagrams that would; two ignored tests send them. The flooded programs run under
+//! an address-space limit ([`MEMORY_LIMIT_KB`]), so that such a bug fails the test instead of
 //! exhausting the machine's memory.
 //!
 //! Forged discovery packets name random locators, which the participants then send to: each test
