@@ -1,6 +1,7 @@
 //! robowire for Python: the `robowire._native` extension behind the `robowire` package
 //! (`python/robowire`). Importing it starts no thread and opens nothing: each client and
 //! simulator starts its own threads when it is opened, and stops them when it is closed.
+#![forbid(unsafe_code)]
 
 mod device;
 mod errors;
