@@ -38,6 +38,10 @@ pub struct OpenOptions {
     pub zsl_local: SocketAddr,
     /// `kmc:` polls the battery (1 Hz) and the motors' all-state (10 Hz).
     pub kmc_polls: bool,
+    /// A device silent this long is `Disconnected` (`kmc:`, `zsl1:`, `zsl1w:`, `go2:`, `hg:` and
+    /// their simulators); `None`: each device's default (KMC 500 ms, ZSL-1 the vendor's 3 s
+    /// watchdog, Go2/HG 100 ms).
+    pub state_timeout: Option<Duration>,
 }
 
 impl Default for OpenOptions {
@@ -47,6 +51,7 @@ impl Default for OpenOptions {
             sim_interface: None,
             zsl_local: SocketAddr::new(IpAddr::V4(Ipv4Addr::UNSPECIFIED), zsl_proto::udp::DEFAULT_LOCAL_PORT),
             kmc_polls: true,
+            state_timeout: None,
         }
     }
 }
@@ -156,15 +161,14 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
             } else {
                 ::zsl::udp::Model::Zsl1
             };
-            let client = ::zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), *ip)
-                .with_model(model);
-            Box::new(::zsl::udp::HighLevel::open(client)?)
+            let client = ::zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), *ip);
+            Box::new(::zsl::udp::HighLevel::open(zsl_options(client, model, options))?)
         }
         DeviceAddress::Go2(interface) => {
-            Box::new(go2::LowLevel::<go2::Go2>::open(go2::LowLevelOptions::on(Some(interface), options.domain))?)
+            Box::new(go2::LowLevel::<go2::Go2>::open(go2_options(Some(interface), options))?)
         }
         DeviceAddress::Hg(interface) => {
-            Box::new(go2::LowLevel::<go2::Hg>::open(go2::LowLevelOptions::on(Some(interface), options.domain))?)
+            Box::new(go2::LowLevel::<go2::Hg>::open(go2_options(Some(interface), options))?)
         }
         DeviceAddress::Spline(name) => {
             Box::new(::zsl::spline::SplineMonitor::open(::zsl::spline::SplineMonitorOptions::new(name))?)
@@ -180,7 +184,27 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
 }
 
 fn kmc_options(options: &OpenOptions) -> ::kmc::DriverOptions {
-    ::kmc::DriverOptions { poll_battery: options.kmc_polls, poll_allstate: options.kmc_polls, ..Default::default() }
+    let defaults = ::kmc::DriverOptions::default();
+    ::kmc::DriverOptions {
+        poll_battery: options.kmc_polls,
+        poll_allstate: options.kmc_polls,
+        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
+        ..defaults
+    }
+}
+
+fn zsl_options(
+    client: ::zsl::udp::ClientOptions,
+    model: ::zsl::udp::Model,
+    options: &OpenOptions,
+) -> ::zsl::udp::ClientOptions {
+    let watchdog = options.state_timeout.unwrap_or(client.watchdog);
+    client.with_model(model).with_watchdog(watchdog)
+}
+
+fn go2_options(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
+    let defaults = go2::LowLevelOptions::on(interface, options.domain);
+    go2::LowLevelOptions { state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout), ..defaults }
 }
 
 #[cfg(feature = "sim")]
@@ -340,6 +364,13 @@ impl AnyDevice {
     #[cfg(feature = "sim")]
     pub fn simulator(&self) -> Option<&Simulator> {
         self.simulator.as_ref()
+    }
+
+    /// As [`close`](Self::close), but hands the simulator back still running, for a look at what
+    /// the device sent last (a stop burst, a damping command).
+    #[cfg(feature = "sim")]
+    pub fn close_keeping_simulator(self) -> (Result<(), DeviceError>, Option<Simulator>) {
+        (self.link.close(), self.simulator)
     }
 
     /// Does the device's safe thing (stop burst, stop, damping) and closes it; then stops its

@@ -43,9 +43,8 @@ pub(crate) fn open(
             let client = zsl::udp::ClientOptions {
                 dog,
                 ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip())
-            }
-            .with_model(model);
-            let link = zsl::udp::HighLevel::open(client)?;
+            };
+            let link = zsl::udp::HighLevel::open(crate::zsl_options(client, model, options))?;
             (Simulator::Dog(sim), Box::new(link))
         }
         SimKind::Spline => {
@@ -59,10 +58,11 @@ pub(crate) fn open(
         }
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
-            let participant = go2::ParticipantOptions::new(options.domain, Some(interface));
-            let sim = Go2Sim::spawn(Go2SimConfig { participant: participant.clone(), ..Go2SimConfig::default() })
-                .map_err(|e| failed(e.into()))?;
-            let client = go2::LowLevel::<go2::Go2>::open(go2::LowLevelOptions { participant, ..Default::default() })?;
+            let client = crate::go2_options(Some(interface), options);
+            let sim =
+                Go2Sim::spawn(Go2SimConfig { participant: client.participant.clone(), ..Go2SimConfig::default() })
+                    .map_err(|e| failed(e.into()))?;
+            let client = go2::LowLevel::<go2::Go2>::open(client)?;
             (Simulator::Go2(sim), Box::new(client))
         }
     })

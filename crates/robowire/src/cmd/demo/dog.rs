@@ -2,12 +2,12 @@
 //! user's program would: stand, walk a square (closed loop on the reported position and
 //! heading), attitude, a trick, faults (error word, silence), lie down.
 
-use std::net::Ipv4Addr;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use robowire_sim::dog::{DogFault, DogSim, DogSimConfig, STANDING_HEIGHT_M};
-use zsl::udp::{Action, CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, ReturnCode};
+use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_sim::dog::{DogFault, DogSim, STANDING_HEIGHT_M};
+use zsl::udp::{Action, CallError, Connection, ControlMode, Device, HighLevel, Latched, ReturnCode};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
@@ -121,19 +121,17 @@ async fn show_progress(dog: &HighLevel, out: &Output) -> std::convert::Infallibl
 
 async fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) =="));
-    let sim = DogSim::spawn(DogSimConfig::loopback()).context("starting the dog simulator")?;
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
     let watchdog = Duration::from_millis(500);
-    let options = ClientOptions {
-        dog: sim.high_level_addr(),
-        ..ClientOptions::high_level(Ipv4Addr::LOCALHOST.into(), 0, Ipv4Addr::LOCALHOST.into())
-    }
-    .with_watchdog(watchdog);
-    let dog = HighLevel::open(options)?;
+    let device =
+        super::open_simulated(SimKind::Zsl1, &OpenOptions { state_timeout: Some(watchdog), ..Default::default() })?;
+    let (Some(Simulator::Dog(sim)), Some(dog)) = (device.simulator(), device.zsl()) else {
+        anyhow::bail!("sim:zsl1 opened something other than a simulated ZSL-1");
+    };
     out.line(format_args!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr()));
     tokio::select! {
-        report = steps(&sim, &dog, watchdog, duration_s, out) => report,
-        never = show_progress(&dog, out) => match never {},
+        report = steps(sim, dog, watchdog, duration_s, out) => report,
+        never = show_progress(dog, out) => match never {},
     }
 }
 

@@ -4,10 +4,11 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use kmc::{ChassisFrame, Device, Driver, DriverOptions};
+use kmc::{ChassisFrame, Device, DriverOptions};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_core::timing::LatenessRing;
-use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
+use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_sim::kmc::Fault;
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
@@ -33,8 +34,12 @@ const PHASES: [Phase; 3] = [
 
 pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
     out.line("== KMC chassis (UART on a pseudo-terminal) ==");
-    let sim = ChassisSim::spawn(ChassisSimConfig::default()).context("starting the chassis simulator")?;
-    let options = DriverOptions { poll_battery: true, poll_allstate: true, ..Default::default() };
+    // sim:kmc's driver: the defaults, with the battery and all-state polls.
+    let device = super::open_simulated(SimKind::Kmc, &OpenOptions { kmc_polls: true, ..OpenOptions::default() })?;
+    let (Some(Simulator::Kmc(sim)), Some(driver)) = (device.simulator(), device.kmc()) else {
+        anyhow::bail!("sim:kmc opened something other than a simulated KMC chassis");
+    };
+    let options = DriverOptions::default();
     out.line(format_args!(
         "simulator on {}; Driver at {} Hz control, {} Hz speed, battery and all-state polls",
         sim.path().display(),
@@ -42,7 +47,6 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
         options.vehicle_speed_rate_hz
     ));
     let control_rate_hz = options.control_rate_hz;
-    let driver = Driver::open(sim.path(), options)?;
     let started = Instant::now();
     let phase_time = Duration::from_secs_f64(duration_s / PHASES.len() as f64).max(MIN_PHASE);
     let mut report = DeviceReport::new("kmc");
@@ -150,7 +154,9 @@ pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport>
     std::thread::sleep(Duration::from_millis(50));
     let before_stop = sim.received().len();
     let stats = driver.stats();
-    driver.close().context("closing the driver")?;
+    let (closed, simulator) = device.close_keeping_simulator();
+    closed.context("closing the driver")?;
+    let Some(Simulator::Kmc(sim)) = simulator else { anyhow::bail!("sim:kmc's simulator is gone") };
     let elapsed = started.elapsed();
     // The burst is the sentinel: once three (0, 0) end the line after the command, everything
     // the driver wrote has arrived (or 2 s pass).

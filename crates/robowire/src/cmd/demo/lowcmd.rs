@@ -9,10 +9,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use go2::trajectory::{JointTrajectory, STAND_KD, STAND_KP};
-use go2::{Device, Go2, LowCmd, LowLevel, LowLevelOptions, MotorCmd};
+use go2::{Device, LowCmd, MotorCmd};
 use robowire_core::timing::LatenessRing;
-use robowire_dds::ParticipantOptions;
-use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
+use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_sim::go2::Go2Fault;
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;
@@ -43,11 +43,11 @@ fn command(pose: &[f32; 12], tag: u32) -> LowCmd {
 fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
-        let lo = ParticipantOptions::new(0, Some("lo"));
-        let sim = Go2Sim::spawn(Go2SimConfig { participant: lo.clone(), ..Go2SimConfig::default() })
-            .context("starting the Go2 simulator")?;
-        let robot = LowLevel::<Go2>::open(LowLevelOptions { participant: lo, ..LowLevelOptions::default() })
-            .context("the Go2 client")?;
+        // sim:go2: the simulator and the client on DDS domain 0, interface lo.
+        let device = super::open_simulated(SimKind::Go2, &OpenOptions::default())?;
+        let (Some(Simulator::Go2(sim)), Some(robot)) = (device.simulator(), device.go2()) else {
+            anyhow::bail!("sim:go2 opened something other than a simulated Go2");
+        };
         let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
         out.line(format_args!("simulator and client on DDS domain 0, interface lo; LowState tick {}", first.tick.get()));
 

@@ -19,6 +19,16 @@ use robowire_dds::netns::Loopback;
 
 use crate::output::Output;
 
+/// The simulated device at `sim:KIND`, opened by address as any app opens a device: its client
+/// and, still reachable for faults and snapshots, its simulator.
+fn open_simulated(
+    kind: robowire_devices::SimKind,
+    options: &robowire_devices::OpenOptions,
+) -> anyhow::Result<robowire_devices::AnyDevice> {
+    let address = robowire_devices::DeviceAddress::Sim(kind);
+    robowire_devices::open(&address, options).map_err(|e| anyhow::anyhow!("opening {address}: {e:#}"))
+}
+
 #[derive(Debug, Args)]
 pub(crate) struct DemoArgs {
     /// Seconds of motion per device scenario, split over its phases (at least 0.8 s each, so
