@@ -383,3 +383,24 @@ impl AnyDevice {
         closed
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_state_timeout_reaches_every_facade_and_none_keeps_their_defaults() {
+        let quick = OpenOptions { state_timeout: Some(Duration::from_millis(250)), ..OpenOptions::default() };
+        let zsl_client = || ::zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
+
+        assert_eq!(kmc_options(&quick).state_timeout, Duration::from_millis(250));
+        assert_eq!(zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &quick).watchdog, Duration::from_millis(250));
+        assert_eq!(go2_options(Some("lo"), &quick).state_timeout, Duration::from_millis(250));
+
+        let default = OpenOptions::default();
+        assert_eq!(kmc_options(&default).state_timeout, ::kmc::DriverOptions::default().state_timeout);
+        let zsl = zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &default);
+        assert_eq!((zsl.watchdog, zsl.model), (zsl_client().watchdog, ::zsl::udp::Model::Zsl1W));
+        assert_eq!(go2_options(None, &default).state_timeout, go2::STATE_TIMEOUT);
+    }
+}
