@@ -2,7 +2,7 @@
 //! standard messages (`odom` + `tf`, `imu`, `joint_states`, `battery_state`, `diagnostics`,
 //! and the vendor's own state message passed through); `cmd_vel` drives a device that is driven
 //! by a velocity, through the guard; the device's named services are `std_srvs/Trigger`
-//! services. Nothing here knows which device it is.
+//! services, each request acted on once. Nothing here knows which device it is.
 
 use std::time::Instant;
 
@@ -128,7 +128,11 @@ pub(crate) async fn run(
             }
             (i, request) = next_request(&mut services), if !services.is_empty() => {
                 let request = request?.value;
-                let service = &services[i];
+                let service = &mut services[i];
+                if let Some(sent) = service.answer_again(&request) {
+                    sent?;
+                    continue;
+                }
                 let (success, message) = match device.call(service.name) {
                     Ok(said) => (true, said),
                     Err(e) => (false, robowire_devices::error_chain(&e)),

@@ -151,7 +151,8 @@ def stand_up(dp, ns):
     requests = DataWriter(dp, Topic(dp, f"rq{ns}/stand_upRequest", TriggerRequest), qos=RELIABLE)
     replies = DataReader(dp, Topic(dp, f"rr{ns}/stand_upReply", TriggerResponse), qos=RELIABLE)
     # A request written before both sides discovered each other is lost (volatile durability):
-    # the same request again until answered, as a client waiting for its service would.
+    # the same request (same id) again until answered, as a client waiting for its service would.
+    # The bridge acts on an id once: however many were sent, the dog stands up once.
     guid = 0x1234_5678_9ABC_DEF0
     deadline = time.monotonic() + 10.0
     reply = None
