@@ -259,6 +259,25 @@ impl Robowire {
         }
     }
 
+    /// CPU time each of its threads used so far, busiest first: a thread that spins after the
+    /// flood shows here.
+    fn cpu_by_thread(&self) -> String {
+        let ticks_per_s = rustix::param::clock_ticks_per_second() as f64;
+        let tasks = std::fs::read_dir(format!("/proc/{}/task", self.child.id())).into_iter().flatten().flatten();
+        let mut threads: Vec<(f64, String)> = tasks
+            .filter_map(|task| {
+                let stat = std::fs::read_to_string(task.path().join("stat")).ok()?;
+                let (name, rest) = stat.split_once(" (")?.1.rsplit_once(") ")?;
+                let fields: Vec<&str> = rest.split_whitespace().collect();
+                // utime and stime: fields 14 and 15 of the line, 12 and 13 after the name.
+                let ticks: u64 = fields.get(11)?.parse::<u64>().ok()? + fields.get(12)?.parse::<u64>().ok()?;
+                Some((ticks as f64 / ticks_per_s, name.to_owned()))
+            })
+            .collect();
+        threads.sort_by(|a, b| b.0.total_cmp(&a.0));
+        threads.iter().take(6).map(|(s, name)| format!("{name} {s:.2} s")).collect::<Vec<_>>().join(", ")
+    }
+
     /// Ctrl-C: it must close both pipes within [`WAIT`] and end successfully, having said nothing
     /// of a panic. What it printed.
     fn stop(mut self) -> String {
@@ -347,7 +366,8 @@ fn flood_a_go2(trusted_fields: bool) {
 
     runtime().block_on(async {
         if let Err(stopped) = lowstate_goes_on(&participant()).await {
-            panic!("after the flood, {stopped}; the simulator said {}", sim.output());
+            let cpu = sim.cpu_by_thread();
+            panic!("after the flood, {stopped}; the simulator's CPU by thread: {cpu}; it said {}", sim.output());
         }
 
         let robot = LowLevel::<Go2>::open(LowLevelOptions::on(Some("lo"), 0)).unwrap();
@@ -461,7 +481,8 @@ fn a_flooded_ros2_bridge_still_publishes_odom_and_obeys_cmd_vel() {
             }
         });
         if let Err(failed) = driven {
-            panic!("{failed}; the bridge said {}", bridge.output());
+            let cpu = bridge.cpu_by_thread();
+            panic!("{failed}; the bridge's CPU by thread: {cpu}; it said {}", bridge.output());
         }
 
         let out = bridge.stop();
