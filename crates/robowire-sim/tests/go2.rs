@@ -37,7 +37,7 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
             sim.inject(Go2Fault::MotorFault { motor: 11 });
             sim.clear_faults();
         };
-        let ((ran_after, last), calls) = hammer::while_hammering(api, || {
+        let (ran_after, last) = hammer::while_hammering(api, || {
             let start = Instant::now();
             loop {
                 let ran = sim.snapshot().state_lateness.count;
@@ -48,7 +48,6 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
                 assert!(start.elapsed() < WAIT, "the stream stalled after {} ticks", ran - ran_before);
             }
         });
-        assert!(calls > 0, "the API ran meanwhile");
         // The two ends are read a state apart at most: a small error, well inside the bound.
         let (ran, slots) = (ran_after - ran_before, (last - first) / 2);
         let skipped = slots.saturating_sub(ran);
