@@ -131,14 +131,14 @@ pub(crate) async fn run(
                 let service = &mut services[i];
                 if let Some(sent) = service.answer_again(&request) {
                     sent?;
-                    continue;
+                } else {
+                    let (success, message) = match device.call(service.name) {
+                        Ok(said) => (true, said),
+                        Err(e) => (false, robowire_devices::error_chain(&e)),
+                    };
+                    service.reply(&request, success, message)?;
+                    report.service_call();
                 }
-                let (success, message) = match device.call(service.name) {
-                    Ok(said) => (true, said),
-                    Err(e) => (false, robowire_devices::error_chain(&e)),
-                };
-                service.reply(&request, success, message)?;
-                report.service_call();
             }
         }
     }
