@@ -14,6 +14,7 @@ mod error;
 pub mod field;
 pub mod go2;
 pub mod hg;
+pub mod idl;
 pub mod layout;
 mod message;
 pub mod plan;
