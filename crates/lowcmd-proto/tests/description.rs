@@ -2,6 +2,8 @@
 //! serializer) decode to their DDS type and the vendor's fields; HG messages and the services'
 //! requests and answers by what they are; any bytes give JSON or a typed error.
 
+mod golden;
+
 use lowcmd_proto::api::{self, Request, RequestHeader, Response};
 use lowcmd_proto::description::{API_CLIENT, API_SERVER, DESCRIPTIONS, GO2_LOW_LEVEL, HG_LOW_LEVEL};
 use lowcmd_proto::{CdrEncoding, HgLowCmd, HgLowState, LowCmd, LowState, Message};
@@ -21,15 +23,8 @@ fn fields_as_json<M: Message + serde::Serialize + serde::de::DeserializeOwned>(f
 
 #[test]
 fn golden_payloads_decode_to_their_type_and_the_vendors_fields() {
-    let vectors: Value = serde_json::from_str(include_str!("../../../fixtures/unitree/vectors.json")).unwrap();
-    let source = |name: &str| {
-        ["lowcmd", "lowstate"]
-            .iter()
-            .flat_map(|k| vectors[k].as_array().unwrap())
-            .find(|v| v["name"] == name)
-            .unwrap_or_else(|| panic!("no vector {name}"))["fields"]
-            .clone()
-    };
+    let vectors = golden::vectors();
+    let source = |name: &str| golden::source_fields(&vectors, name);
     let payloads = vectors["cdr"].as_array().unwrap();
     assert!(payloads.len() >= 8);
     for payload in payloads {

@@ -7,6 +7,8 @@
 //! Gated like every interop test: without node, npm or the npm registry the tests skip with a
 //! line; `ROBOWIRE_INTEROP=1` makes that a failure.
 
+mod golden;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -311,15 +313,8 @@ fn service_messages_in_both_encodings() {
 #[test]
 fn golden_payloads_decode_to_the_vendors_fields() {
     let Some(node_modules) = node_modules() else { return };
-    let vectors: Value = serde_json::from_str(include_str!("../../../fixtures/unitree/vectors.json")).unwrap();
-    let fields = |name: &str| {
-        ["lowcmd", "lowstate"]
-            .iter()
-            .flat_map(|k| vectors[k].as_array().unwrap())
-            .find(|v| v["name"] == name)
-            .unwrap_or_else(|| panic!("no vector {name}"))["fields"]
-            .clone()
-    };
+    let vectors = golden::vectors();
+    let fields = |name: &str| golden::source_fields(&vectors, name);
     let payloads = vectors["cdr"].as_array().unwrap();
     let cases: Vec<_> = payloads
         .iter()
@@ -351,4 +346,64 @@ fn golden_payloads_decode_to_the_vendors_fields() {
         }
     }
     assert!(xcdr1 >= 6, "{xcdr1} XCDR1 golden payloads");
+}
+
+/// Unitree's SDK serializes a `SportModeState_` (no codec of this crate has it) with a distinct
+/// value in every field; its fields, and its XCDR1 and XCDR2 payloads (cyclonedds), as JSON.
+const SPORT_MODE_STATE_PY: &str = r#"
+import dataclasses, json
+import numpy as np
+from unitree_sdk2py.idl.unitree_go.msg.dds_ import IMUState_, PathPoint_, SportModeState_, TimeSpec_
+
+n = 0
+def f32s(count):
+    global n
+    values = [float(np.float32((n + i + 1) * 0.731 - 97.25)) for i in range(count)]
+    n += count
+    return values
+
+m = SportModeState_(
+    stamp=TimeSpec_(sec=-123456, nanosec=987654321),
+    error_code=0xDEADBEEF,
+    imu_state=IMUState_(quaternion=f32s(4), gyroscope=f32s(3), accelerometer=f32s(3), rpy=f32s(3), temperature=201),
+    mode=7,
+    progress=f32s(1)[0],
+    gait_type=3,
+    foot_raise_height=f32s(1)[0],
+    position=f32s(3),
+    body_height=f32s(1)[0],
+    velocity=f32s(3),
+    yaw_speed=f32s(1)[0],
+    range_obstacle=f32s(4),
+    foot_force=[-1, 300, -32768, 32767],
+    foot_position_body=f32s(12),
+    foot_speed_body=f32s(12),
+    path_point=[PathPoint_(*f32s(7)) for _ in range(10)],
+)
+print(json.dumps({
+    "fields": dataclasses.asdict(m),
+    "xcdr1": m.serialize().hex(),
+    "xcdr2": m.serialize(use_version_2=True).hex(),
+}))
+"#;
+
+/// `SportModeState_` as Unitree's SDK serializes it, decoded by Foxglove with
+/// [`idl::GO2_SPORT_MODE_STATE`]: XCDR1 exactly; XCDR2 with the array-of-structs gap
+/// (`path_point`).
+#[test]
+fn sport_mode_state_from_the_vendors_serializer() {
+    let Some(node_modules) = node_modules() else { return };
+    let Some(python) = interop::require_part("Unitree's Python SDK", robowire_fixtures::peers::unitree_python()) else {
+        return;
+    };
+    let out = run("Unitree's SDK serializing SportModeState_", Command::new(python).args(["-c", SPORT_MODE_STATE_PY]))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let vendor: Value = serde_json::from_str(&out).unwrap();
+    let payload = |k: &str| robowire_fixtures::hex_bytes(vendor[k].as_str().unwrap()).unwrap();
+    let (xcdr1, xcdr2) = (payload("xcdr1"), payload("xcdr2"));
+    assert_eq!((&xcdr1[..2], &xcdr2[..2]), (&[0, 1][..], &[0, 7][..]), "encapsulation headers");
+    let schema = &idl::GO2_SPORT_MODE_STATE;
+    let results = decode(&node_modules, &[(schema, xcdr1.clone()), (schema, xcdr2)]);
+    assert_decoded(&results[0], &vendor["fields"], "SportModeState_ XCDR1");
+    xcdr2_struct_array_gap(&results[1], &vendor["fields"], xcdr1.len(), "SportModeState_ XCDR2");
 }
