@@ -181,14 +181,17 @@ where
         let (receiving, opened) = Receiving::spawn(&format!("{name}-receive"), watchdog, {
             let (participant_options, service_timeout, ticks) =
                 (options.participant.clone(), options.service_timeout, ticks.clone());
+            let (low_level_tap, services_tap) = (options.low_level_tap.clone(), options.services_tap.clone());
             move || async move {
                 let participant = Arc::new(Participant::new(participant_options)?);
                 // Reliable like Unitree's, but the stream thread's writes never wait.
-                let writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::STREAM_WRITER)?;
-                let reader = participant.reader::<R::State>(R::State::TOPIC, Qos::READER)?;
+                let mut writer = participant.writer::<R::Cmd>(R::Cmd::TOPIC, Qos::STREAM_WRITER)?;
+                let mut reader = participant.reader::<R::State>(R::State::TOPIC, Qos::READER)?;
+                writer.set_tap(low_level_tap.clone());
+                reader.set_tap(low_level_tap);
                 let lowstate = reader.stats_handle();
                 // Their answers are read by tasks of this thread's runtime.
-                let services = Arc::new(Services::new(&participant, service_timeout)?);
+                let services = Arc::new(Services::new(&participant, service_timeout, services_tap.as_ref())?);
                 let link = StateLink::<R> { reader, ticks: Ticks::default(), counters: ticks };
                 Ok::<_, Go2Error>((link, Opened::<R> { participant, writer, lowstate, services }))
             }

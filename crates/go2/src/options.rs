@@ -5,6 +5,7 @@ use std::time::Duration;
 use lowcmd_proto::stream::StreamConfig;
 use robowire_dds::ParticipantOptions;
 use robowire_rt::Placement;
+use robowire_tap::Tap;
 
 use crate::Go2Error;
 
@@ -30,6 +31,11 @@ pub struct LowLevelOptions {
     pub service_timeout: Duration,
     /// Where the LowCmd stream thread runs (priority, CPU, memory lock).
     pub placement: Placement,
+    /// Where each `rt/lowcmd` written and `rt/lowstate` taken goes, as its payload (a link
+    /// described by `lowcmd_proto::description::GO2_LOW_LEVEL` or `HG_LOW_LEVEL`).
+    pub low_level_tap: Option<Tap>,
+    /// Where each service request and answer goes (`lowcmd_proto::description::API_CLIENT`).
+    pub services_tap: Option<Tap>,
 }
 
 impl Default for LowLevelOptions {
@@ -41,6 +47,8 @@ impl Default for LowLevelOptions {
             state_timeout: STATE_TIMEOUT,
             service_timeout: Duration::from_secs(5),
             placement: Placement::default(),
+            low_level_tap: None,
+            services_tap: None,
         }
     }
 }

@@ -9,6 +9,7 @@ use std::time::Duration;
 use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, status};
 use robowire_dds::rpc::{RpcClient, Service};
 use robowire_dds::{DdsError, Participant};
+use robowire_tap::Tap;
 
 use crate::Go2Error;
 
@@ -43,10 +44,17 @@ pub struct ServiceClient {
 impl ServiceClient {
     /// A client of `service` (`motion_switcher`, `sport`, …).
     pub fn new(participant: &Participant, service: &'static str) -> Result<Self, DdsError> {
-        let rpc = RpcClient::new(
+        Self::tapped(participant, service, None)
+    }
+
+    /// As [`new`](Self::new), its requests and answers handed to `tap` (a link described by
+    /// `lowcmd_proto::description::API_CLIENT`).
+    pub fn tapped(participant: &Participant, service: &'static str, tap: Option<Tap>) -> Result<Self, DdsError> {
+        let rpc = RpcClient::tapped(
             participant,
             &api::request_topic(service).to_string(),
             &api::response_topic(service).to_string(),
+            tap,
         )?;
         // Request ids as Unitree's SDKs make them: the clock in ns, unique per call.
         let first_id = std::time::SystemTime::now()
@@ -86,10 +94,10 @@ pub(crate) struct Services {
 }
 
 impl Services {
-    pub(crate) fn new(participant: &Participant, timeout: Duration) -> Result<Self, DdsError> {
+    pub(crate) fn new(participant: &Participant, timeout: Duration, tap: Option<&Tap>) -> Result<Self, DdsError> {
         Ok(Self {
-            switcher: ServiceClient::new(participant, api::motion_switcher::SERVICE)?,
-            sport: ServiceClient::new(participant, api::sport::SERVICE)?,
+            switcher: ServiceClient::tapped(participant, api::motion_switcher::SERVICE, tap.cloned())?,
+            sport: ServiceClient::tapped(participant, api::sport::SERVICE, tap.cloned())?,
             timeout,
         })
     }

@@ -31,6 +31,7 @@ pub static HOST: LinkProtocol = LinkProtocol {
     name: "kmc.host",
     layout: LAYOUT,
     decode: |p, direction, f| frame(p, direction == Direction::Sent, f),
+    wire_schema: None,
 };
 
 /// A chassis link recorded at the chassis (`kmc.chassis`, a simulator): it sends chassis frames
@@ -39,6 +40,7 @@ pub static CHASSIS: LinkProtocol = LinkProtocol {
     name: "kmc.chassis",
     layout: LAYOUT,
     decode: |p, direction, f| frame(p, direction == Direction::Received, f),
+    wire_schema: None,
 };
 
 /// Both ends of a KMC link.

@@ -26,9 +26,10 @@
 use robowire_core::Direction;
 use robowire_core::cdr::CdrEncoding;
 use robowire_core::json::serde_json::json;
-use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
+use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol, WireSchema};
 
 use crate::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
+use crate::idl::{self, IdlSchema};
 use crate::{DecodeError, HgLowCmd, HgLowState, LowCmd, LowState, Message};
 
 /// The layout of the low-level links.
@@ -37,13 +38,21 @@ const LOW_LEVEL_LAYOUT: &str = "unitree-lowlevel over unitree-dds, CDR payload w
 const API_LAYOUT: &str = "unitree-dds services, CDR payload with its encapsulation header";
 
 /// A Go2's low-level link (`unitree_go.low_level`): `unitree_go` `LowCmd_` and `LowState_`.
-pub static GO2_LOW_LEVEL: LinkProtocol =
-    LinkProtocol { name: "unitree_go.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<LowCmd, LowState> };
+pub static GO2_LOW_LEVEL: LinkProtocol = LinkProtocol {
+    name: "unitree_go.low_level",
+    layout: LOW_LEVEL_LAYOUT,
+    decode: low_level::<LowCmd, LowState>,
+    wire_schema: Some(|_, frame| low_level_wire::<LowCmd, LowState>(frame, &idl::GO2_LOW_CMD, &idl::GO2_LOW_STATE)),
+};
 
 /// An HG robot's (G1's) low-level link (`unitree_hg.low_level`): `unitree_hg` `LowCmd_` and
 /// `LowState_`.
-pub static HG_LOW_LEVEL: LinkProtocol =
-    LinkProtocol { name: "unitree_hg.low_level", layout: LOW_LEVEL_LAYOUT, decode: low_level::<HgLowCmd, HgLowState> };
+pub static HG_LOW_LEVEL: LinkProtocol = LinkProtocol {
+    name: "unitree_hg.low_level",
+    layout: LOW_LEVEL_LAYOUT,
+    decode: low_level::<HgLowCmd, HgLowState>,
+    wire_schema: Some(|_, frame| low_level_wire::<HgLowCmd, HgLowState>(frame, &idl::HG_LOW_CMD, &idl::HG_LOW_STATE)),
+};
 
 /// A service link recorded at the caller (`unitree_api.client`): it sends `Request_` and
 /// receives `Response_`.
@@ -51,6 +60,7 @@ pub static API_CLIENT: LinkProtocol = LinkProtocol {
     name: "unitree_api.client",
     layout: API_LAYOUT,
     decode: |p, direction, f| call(p, direction == Direction::Sent, f),
+    wire_schema: Some(|direction, f| call_wire(direction == Direction::Sent, f)),
 };
 
 /// A service link recorded at the service (`unitree_api.server`): it receives `Request_` and
@@ -59,6 +69,7 @@ pub static API_SERVER: LinkProtocol = LinkProtocol {
     name: "unitree_api.server",
     layout: API_LAYOUT,
     decode: |p, direction, f| call(p, direction == Direction::Received, f),
+    wire_schema: Some(|direction, f| call_wire(direction == Direction::Received, f)),
 };
 
 /// Every Unitree DDS link.
@@ -98,6 +109,36 @@ where
         }
         // The command's length, or no encapsulation header: the command's decoder says which.
         _ => message::<C>(protocol, frame),
+    }
+}
+
+/// `schema` as the wire schema of a `cdr` channel.
+fn cdr(schema: &IdlSchema) -> WireSchema {
+    WireSchema { encoding: "cdr", name: schema.name, schema_encoding: "omgidl", text: schema.text }
+}
+
+/// A low-level frame's wire schema: an XCDR1 payload of the command's or the state's exact
+/// length. Not an XCDR2 one: Foxglove's CDR reader (`@foxglove/cdr` 3.5) reads no DHEADER in
+/// PLAIN_CDR2, which CycloneDDS and these codecs put before an array of structs (the motors), so
+/// it would show wrong values; nor a frame of another length, which no CDR reader can read. Those
+/// are recorded raw, beside their JSON.
+fn low_level_wire<C: Message, S: Message>(frame: &[u8], command: &IdlSchema, state: &IdlSchema) -> Option<WireSchema> {
+    let xcdr1 = CdrEncoding::Xcdr1;
+    match encoding(frame)? {
+        CdrEncoding::Xcdr1 if frame.len() == C::cdr_len(xcdr1) => Some(cdr(command)),
+        CdrEncoding::Xcdr1 if frame.len() == S::cdr_len(xcdr1) => Some(cdr(state)),
+        _ => None,
+    }
+}
+
+/// A service frame's wire schema: a `Request_` or `Response_` payload that decodes (either
+/// encoding: their structs hold no array of structs), so that a CDR reader can read it whole.
+fn call_wire(is_request: bool, frame: &[u8]) -> Option<WireSchema> {
+    let body = frame.get(4..).filter(|_| encoding(frame).is_some())?;
+    if is_request {
+        Request::decode_body(body).ok().map(|_| cdr(&idl::API_REQUEST))
+    } else {
+        Response::decode_body(body).ok().map(|_| cdr(&idl::API_RESPONSE))
     }
 }
 

@@ -69,7 +69,33 @@ pub trait LinkDescription: core::fmt::Debug + Send + Sync {
     fn schema(&self, frame: &JsonFrame) -> Value {
         schema_of(frame.schema, &frame.value)
     }
+
+    /// The standard encoding `frame` already is as it travels (a DDS payload is `cdr`), with its
+    /// schema, for frames that MCAP readers decode as they are; a recorder then writes them once,
+    /// under that encoding, instead of raw bytes beside JSON. `None` (the default): the frames are
+    /// the protocol's own bytes.
+    fn wire_schema(&self, direction: Direction, frame: &[u8]) -> Option<WireSchema> {
+        let _ = (direction, frame);
+        None
+    }
 }
+
+/// A message encoding that MCAP readers (Foxglove, `ros2 bag`) decode without a plugin, and its
+/// schema, by the names of MCAP's registry of well-known encodings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WireSchema {
+    /// The message encoding (`cdr`).
+    pub encoding: &'static str,
+    /// The schema's name: the fully qualified type (`unitree_go::msg::dds_::LowState_`).
+    pub name: &'static str,
+    /// The schema's encoding (`omgidl`, `ros2msg`).
+    pub schema_encoding: &'static str,
+    /// The schema itself, self-contained.
+    pub text: &'static str,
+}
+
+/// [`LinkDescription::wire_schema`] as a function.
+pub type WireSchemaOf = fn(direction: Direction, frame: &[u8]) -> Option<WireSchema>;
 
 /// A [`LinkDescription`] from its parts: what each codec declares its links with.
 #[derive(Debug, Clone, Copy)]
@@ -80,6 +106,8 @@ pub struct LinkProtocol {
     pub layout: &'static str,
     /// [`LinkDescription::decode`], given the protocol's name for its errors.
     pub decode: fn(name: &'static str, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError>,
+    /// [`LinkDescription::wire_schema`]; `None` for a protocol of its own bytes.
+    pub wire_schema: Option<WireSchemaOf>,
 }
 
 impl LinkDescription for LinkProtocol {
@@ -94,7 +122,23 @@ impl LinkDescription for LinkProtocol {
     fn decode(&self, direction: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
         (self.decode)(self.name, direction, frame)
     }
+
+    fn wire_schema(&self, direction: Direction, frame: &[u8]) -> Option<WireSchema> {
+        self.wire_schema.and_then(|wire| wire(direction, frame))
+    }
 }
+
+/// The bytes a stream decoder skipped while looking for frames (line noise, broken or rejected
+/// frames), recorded beside a serial link's frames: as JSON, their count and hex.
+pub static SKIPPED_BYTES: LinkProtocol = LinkProtocol {
+    name: "stream.skipped",
+    layout: "bytes a stream decoder skipped between frames, as they were on the line",
+    decode: |_, _, bytes| {
+        let hex: alloc::string::String = bytes.iter().map(|b| alloc::format!("{b:02x}")).collect();
+        Ok(JsonFrame { schema: "robowire.SkippedBytes", value: json!({ "len": bytes.len(), "hex": hex }) })
+    },
+    wire_schema: None,
+};
 
 /// A frame as JSON.
 #[derive(Debug, Clone, PartialEq)]

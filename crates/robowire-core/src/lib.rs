@@ -15,7 +15,7 @@ mod stream;
 pub mod timing;
 
 pub use datagram::DatagramCodec;
-pub use stream::{DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};
+pub use stream::{Consumed, DecodeStep, DecoderCounters, FrameBuffer, StreamDecoder};
 
 /// Which way a frame went, seen from the end of the link that owns it (the one recording it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -63,6 +63,15 @@ pub trait StreamDecoder {
     fn counters(&self) -> DecoderCounters;
 }
 
+/// The bytes one decoding step consumed ([`FrameBuffer::next_frame_seen`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Consumed<'a> {
+    /// Bytes skipped while searching (noise, rejected candidates' first bytes).
+    pub skipped: &'a [u8],
+    /// The frame's bytes; empty when the step found none.
+    pub frame: &'a [u8],
+}
+
 /// A fixed-capacity byte buffer in front of a [`StreamDecoder`]: push bytes, pop frames.
 ///
 /// Transports read straight into [`spare_mut`](Self::spare_mut) and [`commit`](Self::commit)
@@ -119,6 +128,31 @@ impl<D: StreamDecoder, const N: usize> FrameBuffer<D, N> {
         }
         let step = self.decoder.decode(&self.buf[self.start..self.end]);
         self.start = (self.start + step.consumed).min(self.end);
+        if self.start == self.end {
+            self.start = 0;
+            self.end = 0;
+        }
+        step.frame
+    }
+
+    /// As [`next_frame`](Self::next_frame), showing `seen` the bytes the step consumed: the ones
+    /// skipped before a frame (or without one), then the frame's own, either possibly empty. For a
+    /// tap that records the frames as they were on the line and the noise between them.
+    pub fn next_frame_seen(&mut self, seen: impl FnOnce(Consumed<'_>)) -> Option<D::Frame> {
+        if self.start == self.end {
+            return None;
+        }
+        let skipped_before = self.decoder.counters().skipped_bytes;
+        let step = self.decoder.decode(&self.buf[self.start..self.end]);
+        let consumed = step.consumed.min(self.end - self.start);
+        let skipped = usize::try_from(self.decoder.counters().skipped_bytes.saturating_sub(skipped_before))
+            .map_or(consumed, |n| n.min(consumed));
+        let bytes = &self.buf[self.start..self.start + consumed];
+        let frame_len = if step.frame.is_some() { consumed - skipped } else { 0 };
+        if consumed > 0 {
+            seen(Consumed { skipped: &bytes[..consumed - frame_len], frame: &bytes[consumed - frame_len..] });
+        }
+        self.start += consumed;
         if self.start == self.end {
             self.start = 0;
             self.end = 0;

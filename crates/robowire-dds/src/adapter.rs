@@ -91,6 +91,52 @@ impl<'de, T: CdrType> Decode<'de, Decoded<T>> for Decoder<T> {
     }
 }
 
+/// A payload as a tapped reader took it, for its tap: the encapsulation header rebuilt from the
+/// representation rustdds reports (its 2 option bytes, which rustdds does not hand over, as
+/// zero) and the body, copied into room allocated once.
+#[derive(Debug)]
+pub(crate) struct TakenPayload {
+    pub(crate) header: [u8; 4],
+    pub(crate) body: Vec<u8>,
+    /// Longer than a tap's slot: not copied.
+    pub(crate) oversize: bool,
+}
+
+impl TakenPayload {
+    pub(crate) fn new() -> Self {
+        Self { header: [0; 4], body: Vec::with_capacity(robowire_tap::SLOT_BYTES), oversize: false }
+    }
+}
+
+/// The reader's decoder when a tap listens: keeps a copy of each payload it decodes.
+pub(crate) struct TapDecoder<'a, T> {
+    pub(crate) taken: &'a std::cell::RefCell<TakenPayload>,
+    pub(crate) decoder: PhantomData<fn(T) -> T>,
+}
+
+impl<T> Clone for TapDecoder<'_, T> {
+    fn clone(&self) -> Self {
+        Self { taken: self.taken, decoder: PhantomData }
+    }
+}
+
+impl<'de, T: CdrType> Decode<'de, Decoded<T>> for TapDecoder<'_, T> {
+    type Error = Never;
+
+    fn decode_bytes(self, body: &'de [u8], id: RepresentationIdentifier) -> Result<Decoded<T>, Never> {
+        if let Ok(mut taken) = self.taken.try_borrow_mut() {
+            let [a, b] = id.to_bytes();
+            taken.header = [a, b, 0, 0];
+            taken.body.clear();
+            taken.oversize = body.len() + 4 > robowire_tap::SLOT_BYTES;
+            if !taken.oversize {
+                taken.body.extend_from_slice(body);
+            }
+        }
+        Decoder::<T>(PhantomData).decode_bytes(body, id)
+    }
+}
+
 impl<T: CdrType> DefaultDecoder<Decoded<T>> for CdrAdapter<T> {
     type Decoder = Decoder<T>;
     const DECODER: Decoder<T> = Decoder(PhantomData);

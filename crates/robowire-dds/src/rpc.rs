@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use robowire_core::cdr::CdrType;
 use robowire_rt::lock;
+use robowire_tap::Tap;
 use tokio::sync::oneshot;
 use tokio::task::JoinHandle;
 
@@ -64,8 +65,20 @@ impl<S: Service> Drop for RpcClient<S> {
 impl<S: Service> RpcClient<S> {
     /// A client writing requests to `request_topic` and reading answers from `answer_topic`.
     pub fn new(participant: &Participant, request_topic: &str, answer_topic: &str) -> Result<Self, DdsError> {
-        let requests = participant.writer::<S::Request>(request_topic, Qos::WRITER)?;
+        Self::tapped(participant, request_topic, answer_topic, None)
+    }
+
+    /// As [`new`](Self::new), the requests and answers handed to `tap` (sent and received).
+    pub fn tapped(
+        participant: &Participant,
+        request_topic: &str,
+        answer_topic: &str,
+        tap: Option<Tap>,
+    ) -> Result<Self, DdsError> {
+        let mut requests = participant.writer::<S::Request>(request_topic, Qos::WRITER)?;
         let mut answers = participant.reader::<S::Answer>(answer_topic, Qos::RPC_READER)?;
+        requests.set_tap(tap.clone());
+        answers.set_tap(tap);
         let pending: Pending<S::Answer> = Arc::default();
         let task = tokio::spawn({
             let pending = pending.clone();
@@ -131,10 +144,21 @@ impl<Q: CdrType + 'static, A: CdrType + 'static> std::fmt::Debug for RpcServer<Q
 impl<Q: CdrType + 'static, A: CdrType + 'static> RpcServer<Q, A> {
     /// A server reading requests from `request_topic` and answering on `answer_topic`.
     pub fn new(participant: &Participant, request_topic: &str, answer_topic: &str) -> Result<Self, DdsError> {
-        Ok(Self {
-            requests: participant.reader(request_topic, Qos::RPC_READER)?,
-            answers: participant.writer(answer_topic, Qos::WRITER)?,
-        })
+        Self::tapped(participant, request_topic, answer_topic, None)
+    }
+
+    /// As [`new`](Self::new), the requests and answers handed to `tap` (received and sent).
+    pub fn tapped(
+        participant: &Participant,
+        request_topic: &str,
+        answer_topic: &str,
+        tap: Option<Tap>,
+    ) -> Result<Self, DdsError> {
+        let mut requests = participant.reader(request_topic, Qos::RPC_READER)?;
+        let mut answers = participant.writer(answer_topic, Qos::WRITER)?;
+        requests.set_tap(tap.clone());
+        answers.set_tap(tap);
+        Ok(Self { requests, answers })
     }
 
     /// The next request.

@@ -5,12 +5,22 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 use std::task::{Context, Poll};
 
+use std::cell::RefCell;
+use std::marker::PhantomData;
+
 use robowire_core::cdr::CdrType;
+use robowire_tap::{Direction, SLOT_BYTES, SampleOrigin, Tap};
 use rustdds::no_key::{DataWriter, SimpleDataReader};
-use rustdds::{DataWriterStatus, StatusEvented};
+use rustdds::{DataWriterStatus, RTPSEntity, StatusEvented, Timestamp};
 
 use crate::DdsError;
-use crate::adapter::{CdrAdapter, Decoded};
+use crate::adapter::{CdrAdapter, Decoded, TakenPayload, TapDecoder};
+
+/// An RTPS timestamp (seconds and 2^-32 fractions since the Unix epoch) as Unix ns.
+fn unix_ns(timestamp: Timestamp) -> u64 {
+    let ticks = timestamp.to_ticks();
+    (ticks >> 32) * 1_000_000_000 + (((ticks & 0xffff_ffff) * 1_000_000_000) >> 32)
+}
 
 /// What a writer or reader has done.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -84,6 +94,8 @@ pub struct Writer<T: CdrType + 'static> {
     counters: Arc<Counters>,
     /// Matched readers, from the last publication-matched status seen.
     matched: AtomicI64,
+    /// Where each sample written goes as its payload, with this writer's GUID.
+    tap: Option<(Tap, [u8; 16])>,
 }
 
 impl<T: CdrType + 'static> std::fmt::Debug for Writer<T> {
@@ -94,12 +106,38 @@ impl<T: CdrType + 'static> std::fmt::Debug for Writer<T> {
 
 impl<T: CdrType + 'static> Writer<T> {
     pub(crate) fn new(inner: DataWriter<T, CdrAdapter<T>>, topic: &str) -> Self {
-        Self { inner, topic: topic.into(), counters: Arc::default(), matched: AtomicI64::new(0) }
+        Self { inner, topic: topic.into(), counters: Arc::default(), matched: AtomicI64::new(0), tap: None }
+    }
+
+    /// Hands every sample this writer publishes to `tap` as its payload (encapsulation header,
+    /// body), with the writer's GUID and the source timestamp it is published with.
+    pub fn set_tap(&mut self, tap: Option<Tap>) {
+        let guid = self.inner.guid().to_bytes();
+        self.tap = tap.map(|tap| (tap, guid));
+    }
+
+    /// Publishes `sample`, its payload first handed to the tap if there is one: the payload as
+    /// rustdds will send it, encoded on the stack (no allocation), and the source timestamp
+    /// given to rustdds so that the tap's and the wire's agree.
+    fn publish(&self, sample: T) -> Result<(), rustdds::dds::WriteError<T>> {
+        let Some((tap, guid)) = &self.tap else { return self.inner.write(sample, None) };
+        let source = Timestamp::now();
+        let mut payload = [0u8; SLOT_BYTES];
+        let [a, b] = <CdrAdapter<T> as rustdds::no_key::SerializerAdapter<T>>::output_encoding().to_bytes();
+        payload[..4].copy_from_slice(&[a, b, 0, 0]);
+        let body = sample.encode_body(&mut payload[4..]).ok();
+        self.inner.write(sample, Some(source))?;
+        let origin = SampleOrigin { writer: Some(*guid), source_unix_ns: Some(unix_ns(source)) };
+        match body {
+            Some(n) => tap.record_parts(Direction::Sent, &[&payload[..4 + n]], origin),
+            None => tap.count_oversize(),
+        }
+        Ok(())
     }
 
     /// Encodes `sample` with its codec and publishes it.
     pub fn write(&self, sample: T) -> Result<(), DdsError> {
-        match self.inner.write(sample, None) {
+        match self.publish(sample) {
             Ok(()) => {
                 Counters::bump(&self.counters.samples);
                 Ok(())
@@ -114,7 +152,7 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Publishes `sample` without ever waiting (with [`Qos::STREAM_WRITER`](crate::qos::Qos::STREAM_WRITER)):
     /// a full send window drops it. No allocation on a refusal. For stream threads.
     pub fn try_write(&self, sample: T) -> Result<(), WriteRefused> {
-        match self.inner.write(sample, None) {
+        match self.publish(sample) {
             Ok(()) => {
                 Counters::bump(&self.counters.samples);
                 Ok(())
@@ -186,6 +224,8 @@ pub struct Reader<T: CdrType + 'static> {
     topic: String,
     counters: Arc<Counters>,
     last_error: Option<String>,
+    /// Where each sample taken goes as its payload, and the room it is copied into meanwhile.
+    tap: Option<(Tap, RefCell<TakenPayload>)>,
 }
 
 impl<T: CdrType + 'static> std::fmt::Debug for Reader<T> {
@@ -205,7 +245,15 @@ impl<T: CdrType + 'static> Reader<T> {
             topic: topic.into(),
             counters: Arc::default(),
             last_error: None,
+            tap: None,
         }
+    }
+
+    /// Hands every sample this reader takes to `tap` as its payload (encapsulation header, body:
+    /// decodable or not), with its writer's GUID and source timestamp. The header's two option
+    /// bytes are recorded as zero (rustdds does not hand them over).
+    pub fn set_tap(&mut self, tap: Option<Tap>) {
+        self.tap = tap.map(|tap| (tap, RefCell::new(TakenPayload::new())));
     }
 
     /// The next sample that decodes.
@@ -237,7 +285,25 @@ impl<T: CdrType + 'static> Reader<T> {
             self.undrained = 0;
         }
         loop {
-            let taken = self.inner.try_take_one();
+            let taken = match &self.tap {
+                None => self.inner.try_take_one(),
+                Some((tap, payload)) => {
+                    let taken = self.inner.try_take_one_with(TapDecoder::<T> { taken: payload, decoder: PhantomData });
+                    if let Ok(Some(change)) = &taken {
+                        let origin = SampleOrigin {
+                            writer: Some(change.writer_guid.to_bytes()),
+                            source_unix_ns: change.write_options.source_timestamp().map(unix_ns),
+                        };
+                        let payload = payload.borrow();
+                        if payload.oversize {
+                            tap.count_oversize();
+                        } else {
+                            tap.record_parts(Direction::Received, &[&payload.header, &payload.body], origin);
+                        }
+                    }
+                    taken
+                }
+            };
             self.undrained += u32::from(!matches!(taken, Ok(None)));
             match taken {
                 Ok(None) => return,

@@ -23,6 +23,7 @@ pub use sim::Simulator;
 pub use zsl::state_line as zsl_state_line;
 
 use link::Link;
+use robowire_record::RecordLinks;
 use serde_json::Value;
 use tokio::sync::watch;
 
@@ -42,6 +43,10 @@ pub struct OpenOptions {
     /// their simulators); `None`: each device's default (KMC 500 ms, ZSL-1 the vendor's 3 s
     /// watchdog, Go2/HG 100 ms).
     pub state_timeout: Option<Duration>,
+    /// Record the device's links with this recorder (`None`: not recorded), named after the
+    /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `dog/high_level`,
+    /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `spline/…`.
+    pub record: Option<RecordLinks>,
 }
 
 impl Default for OpenOptions {
@@ -52,6 +57,7 @@ impl Default for OpenOptions {
             zsl_local: SocketAddr::new(IpAddr::V4(Ipv4Addr::UNSPECIFIED), zsl_proto::udp::DEFAULT_LOCAL_PORT),
             kmc_polls: true,
             state_timeout: None,
+            record: None,
         }
     }
 }
@@ -165,10 +171,10 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
             Box::new(::zsl::udp::HighLevel::open(zsl_options(client, model, options))?)
         }
         DeviceAddress::Go2(interface) => {
-            Box::new(go2::LowLevel::<go2::Go2>::open(go2_options(Some(interface), options))?)
+            Box::new(go2::LowLevel::<go2::Go2>::open(go2_options::<go2::Go2>(Some(interface), options))?)
         }
         DeviceAddress::Hg(interface) => {
-            Box::new(go2::LowLevel::<go2::Hg>::open(go2_options(Some(interface), options))?)
+            Box::new(go2::LowLevel::<go2::Hg>::open(go2_options::<go2::Hg>(Some(interface), options))?)
         }
         DeviceAddress::Spline(name) => {
             Box::new(::zsl::spline::SplineMonitor::open(::zsl::spline::SplineMonitorOptions::new(name))?)
@@ -185,10 +191,15 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
 
 fn kmc_options(options: &OpenOptions) -> ::kmc::DriverOptions {
     let defaults = ::kmc::DriverOptions::default();
+    let record = options.record.as_ref();
     ::kmc::DriverOptions {
         poll_battery: options.kmc_polls,
         poll_allstate: options.kmc_polls,
         state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
+        taps: robowire_serial::SerialTaps {
+            frames: record.map(|r| r.link("kmc/serial", &kmc_proto::description::HOST)),
+            skipped: record.map(|r| r.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES)),
+        },
         ..defaults
     }
 }
@@ -199,12 +210,23 @@ fn zsl_options(
     options: &OpenOptions,
 ) -> ::zsl::udp::ClientOptions {
     let watchdog = options.state_timeout.unwrap_or(client.watchdog);
-    client.with_model(model).with_watchdog(watchdog)
+    let client = client.with_model(model).with_watchdog(watchdog);
+    match &options.record {
+        Some(record) => client.with_tap(record.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
+        None => client,
+    }
 }
 
-fn go2_options(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
+fn go2_options<R: unitree::Family>(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
     let defaults = go2::LowLevelOptions::on(interface, options.domain);
-    go2::LowLevelOptions { state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout), ..defaults }
+    let record = options.record.as_ref();
+    go2::LowLevelOptions {
+        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
+        low_level_tap: record.map(|r| r.link(&format!("{}/low_level", R::RECORDED_AS), R::LOW_LEVEL)),
+        services_tap: record
+            .map(|r| r.link(&format!("{}/api", R::RECORDED_AS), &lowcmd_proto::description::API_CLIENT)),
+        ..defaults
+    }
 }
 
 #[cfg(feature = "sim")]
@@ -395,12 +417,12 @@ mod tests {
 
         assert_eq!(kmc_options(&quick).state_timeout, Duration::from_millis(250));
         assert_eq!(zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &quick).watchdog, Duration::from_millis(250));
-        assert_eq!(go2_options(Some("lo"), &quick).state_timeout, Duration::from_millis(250));
+        assert_eq!(go2_options::<go2::Go2>(Some("lo"), &quick).state_timeout, Duration::from_millis(250));
 
         let default = OpenOptions::default();
         assert_eq!(kmc_options(&default).state_timeout, ::kmc::DriverOptions::default().state_timeout);
         let zsl = zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &default);
         assert_eq!((zsl.watchdog, zsl.model), (zsl_client().watchdog, ::zsl::udp::Model::Zsl1W));
-        assert_eq!(go2_options(None, &default).state_timeout, go2::STATE_TIMEOUT);
+        assert_eq!(go2_options::<go2::Go2>(None, &default).state_timeout, go2::STATE_TIMEOUT);
     }
 }

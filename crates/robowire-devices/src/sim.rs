@@ -58,7 +58,7 @@ pub(crate) fn open(
         }
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
-            let client = crate::go2_options(Some(interface), options);
+            let client = crate::go2_options::<go2::Go2>(Some(interface), options);
             let sim =
                 Go2Sim::spawn(Go2SimConfig { participant: client.participant.clone(), ..Go2SimConfig::default() })
                     .map_err(|e| failed(e.into()))?;

@@ -13,6 +13,10 @@ use crate::{DeviceError, Observation};
 
 /// What differs between the Unitree families for a device view.
 pub(crate) trait Family: Robot<State: serde::Serialize> {
+    /// The name its links are recorded under (`go2/low_level`).
+    const RECORDED_AS: &'static str;
+    /// Its low-level link's description.
+    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription;
     /// The state as a few lines.
     fn text(state: &Self::State) -> String;
     /// The state as one line.
@@ -34,6 +38,9 @@ fn imu(quaternion: [F32; 4], gyroscope: [F32; 3], accelerometer: [F32; 3]) -> Im
 }
 
 impl Family for Go2 {
+    const RECORDED_AS: &'static str = "go2";
+    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &lowcmd_proto::description::GO2_LOW_LEVEL;
+
     fn text(state: &LowState) -> String {
         let mut lines = vec![Self::line(state)];
         for (i, name) in go2::GO2_JOINT_NAMES.iter().enumerate() {
@@ -89,6 +96,9 @@ impl Family for Go2 {
 }
 
 impl Family for Hg {
+    const RECORDED_AS: &'static str = "hg";
+    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &lowcmd_proto::description::HG_LOW_LEVEL;
+
     fn text(state: &HgLowState) -> String {
         let q: Vec<f32> = state.motor_state.iter().map(|m| m.q.get()).collect();
         format!("{}\n  q rad (35 slots): {}", Self::line(state), floats(&q))

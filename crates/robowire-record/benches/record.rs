@@ -68,26 +68,49 @@ fn main() {
 
     let state =
         HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() }.encode();
-    let path = temp("throughput");
-    let recorder = Recorder::create(&path, "bench").unwrap();
-    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
-    let start = Instant::now();
-    for _ in 0..frames {
-        tap.record(Direction::Received, &state);
-    }
-    let summary = recorder.finish().unwrap();
-    let elapsed = start.elapsed().as_secs_f64();
-    let _ = std::fs::remove_file(&path);
+    let unpaced_raw = throughput(&state, frames, 1, None, false);
+    let unpaced_json = throughput(&state, frames, 1, None, true);
+    let million = throughput(&state, frames.max(1_000_000) * 2, 1, Some(1e6), false);
+    let hundred_links = throughput(&state, if quick { 100_000 } else { 1_000_000 }, 100, Some(100e3), true);
     let meta = json!({
         "lateness_plain_p50_us": median(&mut plain, |r| r.0), "lateness_plain_p99_us": median(&mut plain, |r| r.1),
         "lateness_recorded_p50_us": median(&mut recorded, |r| r.0), "lateness_recorded_p99_us": median(&mut recorded, |r| r.1),
         "stream_frames_dropped": dropped,
-        "throughput_frames_per_s": summary.frames as f64 / elapsed,
-        "throughput_mb_per_s": summary.frames as f64 * state.len() as f64 / elapsed / 1e6,
-        "throughput_offered": frames, "throughput_written": summary.frames, "throughput_dropped": summary.dropped,
+        "frame_bytes": state.len(),
+        "unpaced_raw": unpaced_raw, "unpaced_json": unpaced_json, "paced_1m_raw": million, "links_100_at_1khz": hundred_links,
     });
     println!("record: {meta}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_RECORD") {
         std::fs::write(path, meta.to_string()).unwrap();
     }
+}
+
+/// `frames` copies of `frame` tapped by one thread over `links` links in turn, as fast as it can
+/// or at `rate` frames/s (a busy wait to each frame's due time), into a recorder with its JSON
+/// thread or without: what was written per second of the run, and what was dropped or skipped.
+fn throughput(frame: &[u8], frames: u64, links: u16, rate: Option<f64>, json: bool) -> serde_json::Value {
+    let path = temp("throughput");
+    let options = robowire_record::RecorderOptions { json, ..Default::default() };
+    let recorder = Recorder::create_with(&path, "bench", options).unwrap();
+    let taps: Vec<_> = (0..links).map(|n| recorder.link(&format!("dog{n}/high_level"), &HIGH_LEVEL)).collect();
+    let start = Instant::now();
+    for n in 0..frames {
+        if let Some(rate) = rate {
+            let due = Duration::from_secs_f64(n as f64 / rate);
+            while start.elapsed() < due {
+                std::hint::spin_loop();
+            }
+        }
+        taps[(n % u64::from(links)) as usize].record(Direction::Received, frame);
+    }
+    let tapped_s = start.elapsed().as_secs_f64();
+    let summary = recorder.finish().unwrap();
+    let elapsed = start.elapsed().as_secs_f64();
+    let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+    let _ = std::fs::remove_file(&path);
+    json!({
+        "offered": frames, "offered_per_s": frames as f64 / tapped_s, "written": summary.frames,
+        "written_per_s": summary.frames as f64 / elapsed, "mb_per_s": bytes as f64 / elapsed / 1e6,
+        "dropped": summary.dropped, "json_skipped": summary.json_skipped, "links": links, "json": json,
+    })
 }

@@ -2,13 +2,14 @@
 #![forbid(unsafe_code)]
 
 mod framing;
+mod json_thread;
 mod read;
 mod write;
 
 pub use read::{CaptureSummary, ChannelSummary, ReadError, RecordedFrame, read_frames, summarize};
-pub use robowire_core::json::{FrameError, JsonFrame, LinkDescription};
-pub use robowire_tap::{Direction, Tap};
-pub use write::{RecordError, Recorder, RecordingSummary};
+pub use robowire_core::json::{FrameError, JsonFrame, LinkDescription, WireSchema};
+pub use robowire_tap::{Direction, SampleOrigin, Tap};
+pub use write::{RecordError, RecordLinks, Recorder, RecorderOptions, RecordingSummary};
 
 /// The message encoding of the raw channels: the frame's bytes, as on the wire.
 pub const RAW_ENCODING: &str = "robowire.raw";
@@ -20,7 +21,7 @@ pub fn fuzz_read(bytes: &[u8], known: &[&'static dyn LinkDescription]) {
     let frames = read_frames(bytes, known);
     let summary = summarize(bytes, known);
     if let (Ok(frames), Ok(summary)) = (frames, summary) {
-        let raw: u64 = summary.channels.iter().filter(|c| c.encoding == RAW_ENCODING).map(|c| c.count).sum();
-        assert_eq!(raw, frames.len() as u64, "the summary counts every raw frame read");
+        let raw: u64 = summary.channels.iter().filter(|c| c.frames).map(|c| c.count).sum();
+        assert_eq!(raw, frames.len() as u64, "the summary counts every frame read");
     }
 }

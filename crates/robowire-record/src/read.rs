@@ -5,8 +5,6 @@ use std::collections::BTreeMap;
 use robowire_core::json::{FrameError, JsonFrame, LinkDescription};
 use robowire_tap::Direction;
 
-use crate::RAW_ENCODING;
-
 /// Why a capture could not be read.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -106,6 +104,13 @@ fn raw_channel(
     Ok((field("link")?.clone(), direction, description))
 }
 
+/// Whether `channel` holds a link's frames as they were on the wire: raw
+/// ([`RAW_ENCODING`](crate::RAW_ENCODING)) or in their wire encoding (a DDS payload as `cdr`).
+/// Such a channel names its protocol in its metadata; a JSON channel does not.
+fn carries_frames(channel: &mcap::Channel<'_>) -> bool {
+    channel.metadata.contains_key("protocol")
+}
+
 fn mcap_error(len: usize) -> impl Fn(mcap::McapError) -> ReadError {
     move |source| ReadError::Mcap { len, source }
 }
@@ -122,7 +127,7 @@ pub fn read_frames(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Re
     let mut frames = Vec::new();
     for message in mcap::MessageStream::new(capture).map_err(mcap_error(capture.len()))? {
         let message = message.map_err(mcap_error(capture.len()))?;
-        if message.channel.message_encoding != RAW_ENCODING {
+        if !carries_frames(&message.channel) {
             continue;
         }
         let (link, direction, protocol) = raw_channel(&message.channel, known)?;
@@ -142,8 +147,10 @@ pub fn read_frames(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Re
 pub struct ChannelSummary {
     /// The topic.
     pub topic: String,
-    /// Its message encoding (`robowire.raw`, `json`).
+    /// Its message encoding (`robowire.raw`, `cdr`, `json`).
     pub encoding: String,
+    /// Whether it holds a link's frames as they were on the wire (raw or `cdr`), not JSON.
+    pub frames: bool,
     /// Messages.
     pub count: u64,
     /// First and last log time, ns since the epoch.
@@ -181,7 +188,7 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
         let decoder = match decoders.get(&channel.id) {
             Some(decoder) => *decoder,
             None => {
-                let decoder = if channel.message_encoding == RAW_ENCODING {
+                let decoder = if carries_frames(channel) {
                     let (_, direction, description) = raw_channel(channel, known)?;
                     Some((direction, description))
                 } else {
@@ -195,6 +202,7 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
         let summary = channels.entry(key).or_insert_with(|| ChannelSummary {
             topic: channel.topic.clone(),
             encoding: channel.message_encoding.clone(),
+            frames: decoder.is_some(),
             count: 0,
             span_ns: (message.log_time, message.log_time),
             rate_hz: 0.0,

@@ -10,16 +10,33 @@ use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use mcap::records::{MessageHeader, Metadata};
-use robowire_core::json::{JsonFrame, LinkDescription};
+use robowire_core::json::{LinkDescription, WireSchema};
 use robowire_tap::{Direction, Tap, TapRing, TappedFrame};
 
 use crate::RAW_ENCODING;
+use crate::json_thread::{JsonMessage, JsonThread};
 
-/// Slots of the taps' ring (each [`robowire_tap::SLOT_BYTES`], about 4.8 MB in all): 2 s of a
-/// 500 Hz link both ways, for the writer to fall behind by before frames are dropped.
-const RING_SLOTS: usize = 2048;
-/// How long the writer sleeps when the ring is empty.
-const POLL: Duration = Duration::from_millis(5);
+/// How long the writer sleeps when the ring is empty: at 1 M frames/s, 1 000 frames arrive
+/// meanwhile (a quarter of the default ring).
+const POLL: Duration = Duration::from_millis(1);
+
+/// How a recorder is set up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RecorderOptions {
+    /// Slots of the taps' ring, each [`robowire_tap::SLOT_BYTES`] (the default 4096: about 9.6 MB,
+    /// 4 ms of 1 M frames/s, or 4 s of a 500 Hz link both ways, for the writer to fall behind by
+    /// before frames are dropped).
+    pub ring_slots: usize,
+    /// Writes each frame's JSON message beside its raw bytes (default on); off, a capture has the
+    /// raw channels only, and `robowire decode --mcap` reads them.
+    pub json: bool,
+}
+
+impl Default for RecorderOptions {
+    fn default() -> Self {
+        Self { ring_slots: 4096, json: true }
+    }
+}
 
 /// Why a capture could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -49,7 +66,7 @@ pub enum RecordError {
 /// What a finished capture holds.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct RecordingSummary {
-    /// Frames written, raw channels.
+    /// Frames written, raw (or in their wire encoding).
     pub frames: u64,
     /// Frames the taps dropped because the ring was full (the writer fell behind).
     pub dropped: u64,
@@ -57,6 +74,9 @@ pub struct RecordingSummary {
     pub oversize: u64,
     /// Frames whose decoding for the JSON channel failed (their raw frame is still written).
     pub decode_errors: u64,
+    /// Frames whose JSON message was skipped because the JSON thread fell behind (their raw frame
+    /// is written; `robowire decode --mcap` decodes it).
+    pub json_skipped: u64,
 }
 
 /// Every link's name and description, by link number.
@@ -66,7 +86,9 @@ type Links = Arc<Mutex<Vec<(String, &'static dyn LinkDescription)>>>;
 ///
 /// The taps stamp frames with the monotonic clock; the writer logs them at Unix time, through
 /// the offset between the two clocks taken once when the recorder is created (a step of the wall
-/// clock while recording does not move the frames' times).
+/// clock while recording does not move the frames' times). The writer thread writes each frame
+/// as it was on the wire; a second thread decodes the frames into JSON, so that decoding never
+/// holds the raw frames back.
 #[derive(Debug)]
 pub struct Recorder {
     ring: TapRing,
@@ -76,27 +98,33 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Creates `path` and starts the writer thread. `command` is what is recording (for the
-    /// metadata: `robowire dog … --record`).
+    /// Creates `path` and starts the writer thread, with the default options. `command` is what
+    /// is recording (for the metadata: `robowire dog … --record`).
     pub fn create(path: impl AsRef<Path>, command: &str) -> Result<Self, RecordError> {
+        Self::create_with(path, command, RecorderOptions::default())
+    }
+
+    /// As [`create`](Self::create), with `options`.
+    pub fn create_with(path: impl AsRef<Path>, command: &str, options: RecorderOptions) -> Result<Self, RecordError> {
         let path = path.as_ref().to_path_buf();
         let file = File::create(&path).map_err(|source| RecordError::Create { path: path.clone(), source })?;
-        let write_error = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| RecordError::Write { path, source }
-        };
         let writer = mcap::WriteOptions::new()
             .compression(None)
             .profile("")
             .library(concat!("robowire ", env!("CARGO_PKG_VERSION")))
-            .create(BufWriter::new(file))
-            .map_err(write_error(&path))?;
-        let ring = TapRing::with_slots(RING_SLOTS);
+            .create(BufWriter::with_capacity(1 << 20, file))
+            .map_err(|source| RecordError::Write { path: path.clone(), source })?;
+        let ring = TapRing::with_slots(options.ring_slots);
+        let json = options
+            .json
+            .then(|| JsonThread::spawn(ring.slots() / 2))
+            .transpose()
+            .map_err(|source| RecordError::Create { path: path.clone(), source })?;
         let links = Links::default();
         let stop = Arc::new(AtomicBool::new(false));
         let mut state = WriterState {
             writer,
-            path,
+            path: path.clone(),
             command: command.into(),
             links: links.clone(),
             unix_offset_ns: unix_minus_monotonic_ns(),
@@ -109,21 +137,25 @@ impl Recorder {
             .spawn({
                 let (ring, stop) = (ring.clone(), stop.clone());
                 move || {
-                    let result = state.run(&ring, &stop);
+                    let result = state.run(&ring, &stop, json);
                     ring.close();
                     result
                 }
             })
-            .map_err(|source| RecordError::Create { path: PathBuf::new(), source })?;
+            .map_err(|source| RecordError::Create { path, source })?;
         Ok(Self { ring, links, stop, thread: Some(thread) })
     }
 
     /// A tap for the link `name` (`dog/high_level`), whose frames `description` describes: the
     /// capture names its protocol, and its frames are decoded by it for the JSON channels.
     pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
-        let mut links = robowire_rt::lock(&self.links);
-        links.push((name.trim_matches('/').into(), description));
-        self.ring.tap(u16::try_from(links.len() - 1).unwrap_or(u16::MAX))
+        self.links().link(name, description)
+    }
+
+    /// A handle that registers links with this recorder, for code that opens devices on its
+    /// behalf (`robowire_devices::OpenOptions::record`).
+    pub fn links(&self) -> RecordLinks {
+        RecordLinks { ring: self.ring.clone(), links: self.links.clone() }
     }
 
     /// Frames dropped so far because the ring was full.
@@ -163,6 +195,32 @@ impl Drop for Recorder {
     }
 }
 
+/// Registers links with a [`Recorder`] ([`Recorder::links`]); clones register with the same
+/// one. Taps handed out after the recorder finished drop their frames and count them.
+#[derive(Debug, Clone)]
+pub struct RecordLinks {
+    ring: TapRing,
+    links: Links,
+}
+
+impl RecordLinks {
+    /// As [`Recorder::link`].
+    pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
+        let mut links = robowire_rt::lock(&self.links);
+        links.push((name.trim_matches('/').into(), description));
+        self.ring.tap(u16::try_from(links.len() - 1).unwrap_or(u16::MAX))
+    }
+}
+
+/// Two handles are equal when they register with the same recorder.
+impl PartialEq for RecordLinks {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.links, &other.links)
+    }
+}
+
+impl Eq for RecordLinks {}
+
 /// Unix time minus monotonic time, ns: what turns a tap's stamp into a log time.
 fn unix_minus_monotonic_ns() -> i64 {
     let unix_ns = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_nanos());
@@ -170,12 +228,19 @@ fn unix_minus_monotonic_ns() -> i64 {
     i64::try_from(offset).unwrap_or(0)
 }
 
-/// The channels of one link and direction: raw, and one JSON channel per schema.
+/// Which channels a frame goes to: its link, direction and writer.
+type ChannelKey = (u16, Direction, Option<[u8; 16]>);
+
+/// The channels of one link, direction and writer: the frames' own (raw, or per wire schema),
+/// and one JSON channel per schema.
 struct LinkChannels {
     name: String,
     description: &'static dyn LinkDescription,
-    raw: u16,
+    raw: Option<u16>,
+    wire: HashMap<&'static str, u16>,
     json: HashMap<&'static str, u16>,
+    /// Messages written per channel id, for their sequence numbers.
+    sequence: HashMap<u16, u32>,
 }
 
 /// The writer thread's state.
@@ -186,23 +251,48 @@ struct WriterState {
     links: Links,
     /// Added to a tap's monotonic stamp: Unix time, ns.
     unix_offset_ns: i64,
-    /// (link, direction) → its channels.
-    channels: HashMap<(u16, Direction), LinkChannels>,
-    schemas: HashMap<&'static str, u16>,
+    channels: HashMap<ChannelKey, LinkChannels>,
+    /// Schema ids by (encoding, name).
+    schemas: HashMap<(&'static str, &'static str), u16>,
     summary: RecordingSummary,
 }
 
 impl WriterState {
-    fn run(&mut self, ring: &TapRing, stop: &AtomicBool) -> Result<RecordingSummary, RecordError> {
+    fn run(
+        &mut self,
+        ring: &TapRing,
+        stop: &AtomicBool,
+        json: Option<JsonThread>,
+    ) -> Result<RecordingSummary, RecordError> {
         loop {
             let stopping = stop.load(Ordering::Acquire);
             if stopping {
                 ring.close();
             }
-            while let Some(written) = ring.pop(|frame| self.write(frame)) {
-                written?;
+            let mut queued = false;
+            while let Some(frame) = ring.take() {
+                let Some(description) = self.write_frame(&frame)? else { continue };
+                let Some(json) = &json else { continue };
+                if stopping {
+                    json.push_waiting((frame, description), |m| self.write_json(&m))?;
+                } else if json.offer(frame, description) {
+                    queued = true;
+                } else {
+                    self.summary.json_skipped += 1;
+                }
+            }
+            if let Some(json) = &json {
+                if queued {
+                    json.wake();
+                }
+                for message in json.ready() {
+                    self.write_json(&message)?;
+                }
             }
             if stopping {
+                if let Some(json) = json {
+                    json.finish(|m| self.write_json(&m))?;
+                }
                 return self.close();
             }
             std::thread::park_timeout(POLL);
@@ -213,67 +303,137 @@ impl WriterState {
         |source| RecordError::Write { path: self.path.clone(), source }
     }
 
-    /// The raw channel and description of `frame`'s link and direction, the channel made on
-    /// its first frame. `None` for a link number no one registered (taps are only handed out
-    /// for registered links).
-    fn raw_channel(&mut self, frame: &TappedFrame) -> Result<Option<(u16, &'static dyn LinkDescription)>, RecordError> {
-        let key = (frame.link, frame.direction);
-        if let Some(c) = self.channels.get(&key) {
-            return Ok(Some((c.raw, c.description)));
+    /// The channels of `key`, made on its link's first frame; `None` for a link number no one
+    /// registered (taps are only handed out for registered links).
+    fn link_channels(&mut self, key: ChannelKey) -> Option<&mut LinkChannels> {
+        if !self.channels.contains_key(&key) {
+            let (name, description) = robowire_rt::lock(&self.links).get(usize::from(key.0)).cloned()?;
+            let channels = LinkChannels {
+                name,
+                description,
+                raw: None,
+                wire: HashMap::new(),
+                json: HashMap::new(),
+                sequence: HashMap::new(),
+            };
+            self.channels.insert(key, channels);
         }
-        let link = robowire_rt::lock(&self.links).get(usize::from(frame.link)).cloned();
-        let Some((name, description)) = link else { return Ok(None) };
-        let metadata = BTreeMap::from([
-            ("link".to_string(), name.clone()),
-            ("direction".to_string(), frame.direction.name().to_string()),
-            ("protocol".to_string(), description.protocol().to_string()),
-        ]);
-        let topic = format!("/{name}/{}/raw", frame.direction.name());
-        let raw = self.writer.add_channel(0, &topic, RAW_ENCODING, &metadata).map_err(self.error())?;
-        self.channels.insert(key, LinkChannels { name, description, raw, json: HashMap::new() });
-        Ok(Some((raw, description)))
+        self.channels.get_mut(&key)
     }
 
-    /// The JSON channel of `decoded`'s schema on the link and direction `key`, made with its
-    /// schema on its first message; `None` if `key` has no raw channel yet.
-    fn json_channel(&mut self, key: (u16, Direction), decoded: &JsonFrame) -> Result<Option<u16>, RecordError> {
-        let Some(c) = self.channels.get(&key) else { return Ok(None) };
-        if let Some(&id) = c.json.get(decoded.schema) {
-            return Ok(Some(id));
+    fn schema_id(&mut self, encoding: &'static str, name: &'static str, text: &[u8]) -> Result<u16, RecordError> {
+        if let Some(&id) = self.schemas.get(&(encoding, name)) {
+            return Ok(id);
         }
-        let (name, description) = (c.name.clone(), c.description);
-        let schema = match self.schemas.get(decoded.schema) {
+        let id = self.writer.add_schema(name, encoding, text).map_err(self.error())?;
+        self.schemas.insert((encoding, name), id);
+        Ok(id)
+    }
+
+    /// The metadata of a channel of `key`'s link.
+    fn metadata(key: ChannelKey, name: &str, description: &dyn LinkDescription) -> BTreeMap<String, String> {
+        let mut metadata = BTreeMap::from([
+            ("link".to_string(), name.to_string()),
+            ("direction".to_string(), key.1.name().to_string()),
+            ("protocol".to_string(), description.protocol().to_string()),
+        ]);
+        if let Some(writer) = key.2 {
+            metadata.insert("writer_guid".into(), writer.iter().map(|b| format!("{b:02x}")).collect());
+        }
+        metadata
+    }
+
+    /// Writes `frame` on the channel of its own bytes: its wire encoding's, if its description
+    /// names one, else the raw channel. The description to decode it to JSON with if it went
+    /// raw (a wire encoding readers decode themselves).
+    fn write_frame(&mut self, frame: &TappedFrame) -> Result<Option<&'static dyn LinkDescription>, RecordError> {
+        let key = (frame.link, frame.direction, frame.origin.writer);
+        let Some(channels) = self.link_channels(key) else {
+            self.summary.decode_errors += 1;
+            return Ok(None);
+        };
+        let description = channels.description;
+        let (channel, json) = match description.wire_schema(frame.direction, frame.bytes()) {
+            Some(wire) => (self.wire_channel(key, &wire)?, None),
+            None => (self.raw_channel(key)?, Some(description)),
+        };
+        let unix_ns = frame.monotonic_ns.saturating_add_signed(self.unix_offset_ns);
+        let publish_ns = frame.origin.source_unix_ns.unwrap_or(unix_ns);
+        let sequence = self.next_sequence(key, channel);
+        let header = MessageHeader { channel_id: channel, sequence, log_time: unix_ns, publish_time: publish_ns };
+        self.writer.write_to_known_channel(&header, frame.bytes()).map_err(self.error())?;
+        self.summary.frames += 1;
+        Ok(json)
+    }
+
+    fn next_sequence(&mut self, key: ChannelKey, channel: u16) -> u32 {
+        let Some(channels) = self.channels.get_mut(&key) else { return 0 };
+        let sequence = channels.sequence.entry(channel).or_default();
+        *sequence = sequence.wrapping_add(1);
+        *sequence
+    }
+
+    fn raw_channel(&mut self, key: ChannelKey) -> Result<u16, RecordError> {
+        let Some(channels) = self.channels.get(&key) else { return Err(RecordError::Thread) };
+        if let Some(id) = channels.raw {
+            return Ok(id);
+        }
+        let (name, description) = (channels.name.clone(), channels.description);
+        let topic = format!("/{name}/{}/raw", key.1.name());
+        let metadata = Self::metadata(key, &name, description);
+        let id = self.writer.add_channel(0, &topic, RAW_ENCODING, &metadata).map_err(self.error())?;
+        if let Some(c) = self.channels.get_mut(&key) {
+            c.raw = Some(id);
+        }
+        Ok(id)
+    }
+
+    fn wire_channel(&mut self, key: ChannelKey, wire: &WireSchema) -> Result<u16, RecordError> {
+        let Some(channels) = self.channels.get(&key) else { return Err(RecordError::Thread) };
+        if let Some(&id) = channels.wire.get(wire.name) {
+            return Ok(id);
+        }
+        let (name, description) = (channels.name.clone(), channels.description);
+        let schema = self.schema_id(wire.schema_encoding, wire.name, wire.text.as_bytes())?;
+        let topic = format!("/{name}/{}", key.1.name());
+        let metadata = Self::metadata(key, &name, description);
+        let id = self.writer.add_channel(schema, &topic, wire.encoding, &metadata).map_err(self.error())?;
+        self.channels.get_mut(&key).map(|c| c.wire.insert(wire.name, id));
+        Ok(id)
+    }
+
+    /// Writes a frame's JSON message (made by the JSON thread) on its schema's channel.
+    fn write_json(&mut self, message: &JsonMessage) -> Result<(), RecordError> {
+        let Some(json) = &message.json else {
+            self.summary.decode_errors += 1;
+            return Ok(());
+        };
+        let key = (message.link, message.direction, message.origin.writer);
+        let Some(channels) = self.channels.get(&key) else { return Ok(()) };
+        let channel = match channels.json.get(message.schema) {
             Some(&id) => id,
             None => {
-                let text = serde_json::to_vec(&description.schema(decoded)).unwrap_or_default();
-                let id = self.writer.add_schema(decoded.schema, "jsonschema", &text).map_err(self.error())?;
-                self.schemas.insert(decoded.schema, id);
+                let name = channels.name.clone();
+                let text = message.schema_text.as_ref().map(serde_json::to_vec).transpose().ok().flatten();
+                let schema = match text {
+                    Some(text) => self.schema_id("jsonschema", message.schema, &text)?,
+                    None => self.schemas.get(&("jsonschema", message.schema)).copied().unwrap_or(0),
+                };
+                let mut metadata = BTreeMap::from([("link".to_string(), name.clone())]);
+                if let Some(writer) = key.2 {
+                    metadata.insert("writer_guid".into(), writer.iter().map(|b| format!("{b:02x}")).collect());
+                }
+                let topic = format!("/{name}/{}/{}", key.1.name(), message.schema);
+                let id = self.writer.add_channel(schema, &topic, "json", &metadata).map_err(self.error())?;
+                self.channels.get_mut(&key).map(|c| c.json.insert(message.schema, id));
                 id
             }
         };
-        let metadata = BTreeMap::from([("link".to_string(), name.clone())]);
-        let topic = format!("/{name}/{}", key.1.name());
-        let id = self.writer.add_channel(schema, &topic, "json", &metadata).map_err(self.error())?;
-        self.channels.get_mut(&key).map(|c| c.json.insert(decoded.schema, id));
-        Ok(Some(id))
-    }
-
-    fn write(&mut self, frame: &TappedFrame) -> Result<(), RecordError> {
-        let unix_ns = frame.monotonic_ns.saturating_add_signed(self.unix_offset_ns);
-        let header = |channel_id| MessageHeader { channel_id, sequence: 0, log_time: unix_ns, publish_time: unix_ns };
-        let Some((raw, description)) = self.raw_channel(frame)? else {
-            self.summary.decode_errors += 1;
-            return Ok(());
-        };
-        self.writer.write_to_known_channel(&header(raw), frame.bytes()).map_err(self.error())?;
-        self.summary.frames += 1;
-        let Ok(decoded) = description.decode(frame.direction, frame.bytes()) else {
-            self.summary.decode_errors += 1;
-            return Ok(());
-        };
-        let Some(json_channel) = self.json_channel((frame.link, frame.direction), &decoded)? else { return Ok(()) };
-        let json = serde_json::to_vec(&decoded.value).unwrap_or_default();
-        self.writer.write_to_known_channel(&header(json_channel), &json).map_err(self.error())?;
+        let unix_ns = message.monotonic_ns.saturating_add_signed(self.unix_offset_ns);
+        let publish_ns = message.origin.source_unix_ns.unwrap_or(unix_ns);
+        let sequence = self.next_sequence(key, channel);
+        let header = MessageHeader { channel_id: channel, sequence, log_time: unix_ns, publish_time: publish_ns };
+        self.writer.write_to_known_channel(&header, json).map_err(self.error())?;
         Ok(())
     }
 

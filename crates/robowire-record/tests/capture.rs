@@ -118,7 +118,7 @@ fn the_summary_counts_channels_and_decode_errors() {
     assert_eq!(topic("/dog/high_level/sent/raw").count, 2);
     assert_eq!(topic("/dog/high_level/received/raw").count, 2);
     assert_eq!(topic("/dog/high_level/received/raw").decode_errors, 1, "the 3-byte junk");
-    assert_eq!(topic("/dog/high_level/received").count, 1, "only the state decoded");
+    assert_eq!(topic("/dog/high_level/received/zsl1.HighLevelState").count, 1, "only the state decoded");
     assert_eq!(summary.metadata["command"], "test");
     assert_eq!(summary.metadata["link:dog/high_level"], "zsl1.high_level (zsl1-udp, vendor SDK v0.2.7)");
 }

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use robowire_core::{DecoderCounters, FrameBuffer, StreamDecoder};
+use robowire_tap::{Direction, Tap};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio_serial::{DataBits, FlowControl, Parity, SerialPort, SerialStream, StopBits};
 
@@ -102,6 +103,17 @@ pub struct LinkCounters {
     pub reopens: u64,
 }
 
+/// Where a link's traffic goes for a recorder: each frame written and read as it was on the
+/// line, and the bytes the decoder skipped between frames (line noise, broken frames) as records
+/// of their own.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SerialTaps {
+    /// Frames written (sent) and decoded (received).
+    pub frames: Option<Tap>,
+    /// Bytes skipped by the decoder (received), one record per decoding step that skipped any.
+    pub skipped: Option<Tap>,
+}
+
 /// Receive buffer size: at least one frame of any robowire stream codec, plus room to read
 /// ahead.
 pub const RX_BUFFER_LEN: usize = 1024;
@@ -118,6 +130,7 @@ pub struct SerialLink<D: StreamDecoder> {
     rx: FrameBuffer<D, RX_BUFFER_LEN>,
     counters: LinkCounters,
     rts_asserted: bool,
+    taps: SerialTaps,
 }
 
 impl<D: StreamDecoder> std::fmt::Debug for SerialLink<D> {
@@ -144,7 +157,13 @@ impl<D: StreamDecoder> SerialLink<D> {
             rx: FrameBuffer::new(decoder),
             counters: LinkCounters::default(),
             rts_asserted,
+            taps: SerialTaps::default(),
         })
+    }
+
+    /// Hands the link's traffic to `taps` from now on (its [`SyncWriter`]s made after this too).
+    pub fn set_taps(&mut self, taps: SerialTaps) {
+        self.taps = taps;
     }
 
     /// The device path.
@@ -181,7 +200,13 @@ impl<D: StreamDecoder> SerialLink<D> {
             self.native.as_ref().ok_or_else(|| SerialError::Disconnected { path: self.path.clone(), source: None })?;
         let mut port = native.try_clone().map_err(|source| SerialError::Open { path: self.path.clone(), source })?;
         port.set_timeout(SYNC_WRITE_TIMEOUT).map_err(|source| SerialError::Open { path: self.path.clone(), source })?;
-        Ok(SyncWriter { port, path: self.path.clone(), bytes_written: 0, frames_written: 0 })
+        Ok(SyncWriter {
+            port,
+            path: self.path.clone(),
+            bytes_written: 0,
+            frames_written: 0,
+            tap: self.taps.frames.clone(),
+        })
     }
 
     fn disconnected(&mut self, source: Option<io::Error>) -> SerialError {
@@ -196,7 +221,20 @@ impl<D: StreamDecoder> SerialLink<D> {
     /// (end-of-file and read errors both mean that on a serial port), never a busy loop.
     pub async fn recv(&mut self) -> Result<D::Frame, SerialError> {
         loop {
-            if let Some(frame) = self.rx.next_frame() {
+            let taps = &self.taps;
+            let frame = if taps.frames.is_none() && taps.skipped.is_none() {
+                self.rx.next_frame()
+            } else {
+                self.rx.next_frame_seen(|consumed| {
+                    if let (Some(tap), false) = (&taps.skipped, consumed.skipped.is_empty()) {
+                        tap.record(Direction::Received, consumed.skipped);
+                    }
+                    if let (Some(tap), false) = (&taps.frames, consumed.frame.is_empty()) {
+                        tap.record(Direction::Received, consumed.frame);
+                    }
+                })
+            };
+            if let Some(frame) = frame {
                 return Ok(frame);
             }
             let Some(port) = self.port.as_mut() else { return Err(self.disconnected(None)) };
@@ -225,6 +263,9 @@ impl<D: StreamDecoder> SerialLink<D> {
             Ok(()) => {
                 self.counters.bytes_written += frame.len() as u64;
                 self.counters.frames_written += 1;
+                if let Some(tap) = &self.taps.frames {
+                    tap.record(Direction::Sent, frame);
+                }
                 Ok(())
             }
             Err(e) => Err(self.disconnected(Some(e))),
@@ -273,6 +314,7 @@ pub struct SyncWriter {
     path: PathBuf,
     bytes_written: u64,
     frames_written: u64,
+    tap: Option<Tap>,
 }
 
 impl std::fmt::Debug for SyncWriter {
@@ -290,6 +332,9 @@ impl SyncWriter {
             Ok(()) => {
                 self.bytes_written += frame.len() as u64;
                 self.frames_written += 1;
+                if let Some(tap) = &self.tap {
+                    tap.record(Direction::Sent, frame);
+                }
                 Ok(())
             }
             Err(e) => Err(SerialError::Disconnected { path: self.path.clone(), source: Some(e) }),

@@ -16,6 +16,21 @@ pub const SLOT_BYTES: usize = 2304;
 /// A slot's bytes.
 type Slot = Box<[u8; SLOT_BYTES]>;
 
+/// What a middleware says of a sample besides its bytes (DDS: the writer's GUID, the source
+/// timestamp); nothing for links that say nothing (serial, UDP, shared memory).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SampleOrigin {
+    /// The GUID of the writer that published it (RTPS: 12-byte prefix, 4-byte entity id).
+    pub writer: Option<[u8; 16]>,
+    /// When its writer published it by the writer's clock (DDS source timestamp): Unix time, ns.
+    pub source_unix_ns: Option<u64>,
+}
+
+impl SampleOrigin {
+    /// Nothing known besides the bytes.
+    pub const NONE: Self = Self { writer: None, source_unix_ns: None };
+}
+
 /// One frame as it was on the wire, in its slot.
 pub struct TappedFrame {
     /// The link, as the recorder numbered it.
@@ -24,6 +39,8 @@ pub struct TappedFrame {
     pub direction: Direction,
     /// When the tap took it: `CLOCK_MONOTONIC`, ns ([`robowire_rt::monotonic_ns`]).
     pub monotonic_ns: u64,
+    /// What the middleware said of it.
+    pub origin: SampleOrigin,
     len: u16,
     slot: Slot,
 }
@@ -41,6 +58,7 @@ impl std::fmt::Debug for TappedFrame {
             .field("link", &self.link)
             .field("direction", &self.direction)
             .field("monotonic_ns", &self.monotonic_ns)
+            .field("origin", &self.origin)
             .field("len", &self.len)
             .finish_non_exhaustive()
     }
@@ -118,6 +136,19 @@ impl TapRing {
         Some(result)
     }
 
+    /// The oldest frame in the ring, to keep as long as needed (another thread may decode it):
+    /// its slot goes back to the ring when the [`HeldFrame`] is dropped. `None` if the ring is
+    /// empty.
+    pub fn take(&self) -> Option<HeldFrame> {
+        let frame = self.ring.filled.pop()?;
+        Some(HeldFrame { frame: Some(frame), ring: self.ring.clone() })
+    }
+
+    /// Frames in the ring now, waiting for the recorder.
+    pub fn waiting(&self) -> usize {
+        self.ring.filled.len()
+    }
+
     /// Refuses frames from now on (each tap drops and counts them); those in the ring stay.
     pub fn close(&self) {
         self.ring.closed.store(true, Ordering::Release);
@@ -131,6 +162,36 @@ impl TapRing {
     /// How many frames the ring holds at most.
     pub fn slots(&self) -> usize {
         self.ring.filled.capacity()
+    }
+}
+
+/// A frame taken out of its ring ([`TapRing::take`]); its slot returns to the ring on drop.
+pub struct HeldFrame {
+    /// Always `Some` until dropped.
+    frame: Option<TappedFrame>,
+    ring: Arc<Ring>,
+}
+
+impl std::ops::Deref for HeldFrame {
+    type Target = TappedFrame;
+    fn deref(&self) -> &TappedFrame {
+        // Only `drop` takes it out.
+        self.frame.as_ref().unwrap_or_else(|| unreachable!("a held frame is taken only on drop"))
+    }
+}
+
+impl std::fmt::Debug for HeldFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.frame.fmt(f)
+    }
+}
+
+impl Drop for HeldFrame {
+    fn drop(&mut self) {
+        if let Some(frame) = self.frame.take() {
+            // Never full: there are as many places as slots.
+            let _ = self.ring.free.push(frame.slot);
+        }
     }
 }
 
@@ -166,8 +227,21 @@ impl Tap {
     /// longer than [`SLOT_BYTES`] is counted as oversize; one that finds the ring full or closed
     /// is counted as dropped.
     pub fn record(&self, direction: Direction, bytes: &[u8]) {
+        self.record_parts(direction, &[bytes], SampleOrigin::NONE);
+    }
+
+    /// Counts a frame that was too long to record ([`TapCounters::oversize`]), for a caller that
+    /// found so before copying it.
+    pub fn count_oversize(&self) {
+        self.ring.counters.oversize.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// As [`record`](Self::record), for a frame in `parts` (a DDS payload's encapsulation header
+    /// and body, say) that the middleware says `origin` of.
+    pub fn record_parts(&self, direction: Direction, parts: &[&[u8]], origin: SampleOrigin) {
         let counters = &self.ring.counters;
-        let Some(len) = u16::try_from(bytes.len()).ok().filter(|_| bytes.len() <= SLOT_BYTES) else {
+        let total = parts.iter().map(|p| p.len()).fold(0usize, usize::saturating_add);
+        let Some(len) = u16::try_from(total).ok().filter(|_| total <= SLOT_BYTES) else {
             counters.oversize.fetch_add(1, Ordering::Relaxed);
             return;
         };
@@ -180,8 +254,12 @@ impl Tap {
             counters.dropped.fetch_add(1, Ordering::Relaxed);
             return;
         };
-        slot[..bytes.len()].copy_from_slice(bytes);
-        let frame = TappedFrame { link: self.link, direction, monotonic_ns, len, slot };
+        let mut at = 0;
+        for part in parts {
+            slot[at..at + part.len()].copy_from_slice(part);
+            at += part.len();
+        }
+        let frame = TappedFrame { link: self.link, direction, monotonic_ns, origin, len, slot };
         match self.ring.filled.push(frame) {
             Ok(()) => counters.recorded.fetch_add(1, Ordering::Relaxed),
             // Never full: a filled frame holds one of the slots. Should it be, the slot goes back.

@@ -63,7 +63,9 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         let channels = seen["channels"].as_object().unwrap();
         for direction in ["sent", "received"] {
             let raw = &channels[&format!("/dog/high_level/{direction}/raw")];
-            let json = &channels[&format!("/dog/high_level/{direction}")];
+            // One JSON channel per message type: commands one way, states the other.
+            let prefix = format!("/dog/high_level/{direction}/zsl1.");
+            let json = channels.iter().find(|(t, _)| t.starts_with(&prefix)).map(|(_, c)| c).unwrap();
             assert_eq!(raw["encoding"], "robowire.raw");
             assert_eq!(raw["metadata"]["protocol"], "zsl1.high_level");
             assert_eq!(json["schema_encoding"], "jsonschema", "{json}");

@@ -24,10 +24,12 @@ use crate::udp::AnyDatagram;
 const LAYOUT: &str = "zsl1-udp, vendor SDK v0.2.7";
 
 /// A HighLevel link (`zsl1.high_level`): 40-byte commands, 560-byte states.
-pub static HIGH_LEVEL: LinkProtocol = LinkProtocol { name: "zsl1.high_level", layout: LAYOUT, decode: datagram };
+pub static HIGH_LEVEL: LinkProtocol =
+    LinkProtocol { name: "zsl1.high_level", layout: LAYOUT, decode: datagram, wire_schema: None };
 
 /// A LowLevel link (`zsl1.low_level`): 248-byte commands, 272-byte states.
-pub static LOW_LEVEL: LinkProtocol = LinkProtocol { name: "zsl1.low_level", layout: LAYOUT, decode: datagram };
+pub static LOW_LEVEL: LinkProtocol =
+    LinkProtocol { name: "zsl1.low_level", layout: LAYOUT, decode: datagram, wire_schema: None };
 
 /// Every ZSL-1 link.
 pub static DESCRIPTIONS: [&dyn LinkDescription; 2] = [&HIGH_LEVEL, &LOW_LEVEL];

@@ -24,7 +24,7 @@ use robowire_core::timing::LatenessSummary;
 use robowire_rt::Placement;
 use robowire_rt::device::{Device, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions};
-use robowire_serial::{Backoff, LinkCounters, SerialLink, SerialPortOptions};
+use robowire_serial::{Backoff, LinkCounters, SerialLink, SerialPortOptions, SerialTaps};
 
 pub use self::receive::ChassisState;
 use self::receive::{ChassisLink, Inbox};
@@ -71,6 +71,9 @@ pub struct DriverOptions {
     pub reopen: Option<Backoff>,
     /// Host-side decoder bound for `0xB3` speeds, m/s. Default 20.
     pub max_speed_mps: f32,
+    /// Where the link's frames (a link described by `kmc_proto::description::HOST`) and the
+    /// bytes skipped between them go for a recorder. Default: nowhere.
+    pub taps: SerialTaps,
 }
 
 impl Default for DriverOptions {
@@ -88,6 +91,7 @@ impl Default for DriverOptions {
             max_queue: 1024,
             reopen: Some(Backoff::default()),
             max_speed_mps: kmc_proto::DEFAULT_MAX_SPEED_MPS,
+            taps: SerialTaps::default(),
         }
     }
 }
@@ -258,7 +262,8 @@ impl Driver {
                 let decoder = ChassisFrameDecoder::new()
                     .with_max_speed_mps(options.max_speed_mps)
                     .map_err(|e| KmcError::Option { name: "max_speed_mps", reason: e.to_string() })?;
-                let link = SerialLink::open(&port, &options.serial, decoder)?;
+                let mut link = SerialLink::open(&port, &options.serial, decoder)?;
+                link.set_taps(options.taps);
                 *robowire_rt::lock(&stream.writer) = Some(link.sync_writer()?);
                 inbox.set_link_state(LinkState::Connected);
                 let state = ChassisState::default();

@@ -30,6 +30,7 @@ use robowire_dds::{DdsError, Participant, ParticipantOptions, Reader, StatsHandl
 use robowire_rt::runner::{Job, Runner, RunnerOptions, Waker};
 use robowire_rt::stats::{Counter, SharedLateness};
 use robowire_rt::{Latest, lock};
+use robowire_tap::Tap;
 use tokio::sync::watch;
 
 pub use model::{COMMAND_HOLD_S, Go2Body, JOINTS, LYING_POSE_RAD, STAND_POSE_RAD};
@@ -51,6 +52,12 @@ pub struct Go2SimConfig {
     /// Answer every accepted LowCmd with a LowState at once, besides the 500 Hz stream (for
     /// round-trip measurements; a real Go2 only streams).
     pub answer_lowcmd: bool,
+    /// Where each `rt/lowstate` written (the corrupted ones of a fault too) and `rt/lowcmd`
+    /// taken goes, as its payload: a link described by `lowcmd_proto::description::GO2_LOW_LEVEL`.
+    pub low_level_tap: Option<Tap>,
+    /// Where each service request taken and answer written goes
+    /// (`lowcmd_proto::description::API_SERVER`).
+    pub services_tap: Option<Tap>,
 }
 
 impl Default for Go2SimConfig {
@@ -60,6 +67,8 @@ impl Default for Go2SimConfig {
             state_period: Duration::from_millis(2),
             cpu: None,
             answer_lowcmd: false,
+            low_level_tap: None,
+            services_tap: None,
         }
     }
 }
@@ -220,15 +229,26 @@ impl Go2Sim {
             log: vec![format!("booted lying down; sport mode \"{BOOT_SPORT_MODE}\" owns the motors")],
         }));
         // The stream's writers never wait: a full send window is a dropped sample, counted.
-        let writer = participant.writer::<LowState>(LowState::TOPIC, Qos::STREAM_WRITER)?;
-        let corrupt = participant.writer::<BitFlipped>(LowState::TOPIC, Qos::STREAM_WRITER)?;
+        let tap = &config.low_level_tap;
+        let mut writer = participant.writer::<LowState>(LowState::TOPIC, Qos::STREAM_WRITER)?;
+        let mut corrupt = participant.writer::<BitFlipped>(LowState::TOPIC, Qos::STREAM_WRITER)?;
+        let mut reader = participant.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER)?;
+        writer.set_tap(tap.clone());
+        corrupt.set_tap(tap.clone());
+        reader.set_tap(tap.clone());
         let lowstate = writer.stats_handle();
-        let reader = participant.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER)?;
         let lowcmd = reader.stats_handle();
-        let answers =
-            config.answer_lowcmd.then(|| participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)).transpose()?;
-        let switcher = services::service_server(&participant, motion_switcher::SERVICE)?;
-        let sport = services::service_server(&participant, sport::SERVICE)?;
+        let answers = config
+            .answer_lowcmd
+            .then(|| {
+                let mut answers = participant.writer::<LowState>(LowState::TOPIC, Qos::WRITER)?;
+                answers.set_tap(tap.clone());
+                Ok::<_, DdsError>(answers)
+            })
+            .transpose()?;
+        let services_tap = config.services_tap.clone();
+        let switcher = services::service_server(&participant, motion_switcher::SERVICE, services_tap.clone())?;
+        let sport = services::service_server(&participant, sport::SERVICE, services_tap)?;
         let job = StateStream {
             body,
             wire: WireFaults::default(),

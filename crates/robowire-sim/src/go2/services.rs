@@ -34,8 +34,10 @@ pub(super) type ServiceServer = RpcServer<ApiRequest, ApiResponse>;
 pub(super) fn service_server(
     participant: &robowire_dds::Participant,
     service: &str,
+    tap: Option<robowire_tap::Tap>,
 ) -> Result<ServiceServer, robowire_dds::DdsError> {
-    RpcServer::new(participant, &api::request_topic(service).to_string(), &api::response_topic(service).to_string())
+    let (requests, answers) = (api::request_topic(service).to_string(), api::response_topic(service).to_string());
+    RpcServer::tapped(participant, &requests, &answers, tap)
 }
 
 /// What the services thread keeps: who owns the motors, and the LowCmds' arrivals.

@@ -33,6 +33,8 @@ pub(crate) struct Go2Args {
     /// Seconds to wait for the robot's first LowState.
     #[arg(long, default_value_t = 5.0)]
     connect_timeout_s: f64,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
     #[command(subcommand)]
     command: Go2Command,
 }
@@ -71,8 +73,16 @@ use crate::cmd::seconds;
 pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
     let connect = seconds("--connect-timeout-s", args.connect_timeout_s)?;
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
-    runtime.block_on(async {
-        let options = LowLevelOptions { participant: args.dds.participant(), ..LowLevelOptions::default() };
+    let recorder = args.record.start("robowire go2")?;
+    let code = runtime.block_on(async {
+        let options = LowLevelOptions {
+            participant: args.dds.participant(),
+            low_level_tap: recorder
+                .as_ref()
+                .map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
+            services_tap: recorder.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_CLIENT)),
+            ..LowLevelOptions::default()
+        };
         let robot = LowLevel::<Go2>::open(options).context("joining DDS")?;
         let state = robot.wait_state(connect, |_| true).await.with_context(|| {
             format!(
@@ -119,8 +129,10 @@ pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
         };
         eprintln!("{}", robot.stats_line());
         robot.close();
-        Ok(code)
-    })
+        anyhow::Ok(code)
+    })?;
+    crate::cmd::record::finish(recorder)?;
+    Ok(code)
 }
 
 async fn release(robot: &LowLevel<Go2>) -> anyhow::Result<()> {

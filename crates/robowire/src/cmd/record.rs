@@ -19,6 +19,22 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
     .concat()
 }
 
+/// `--record FILE.mcap`, for the commands that record.
+#[derive(Debug, Clone, Args)]
+pub(crate) struct RecordArgs {
+    /// Record every frame of the device's links, both ways, to this MCAP file (Foxglove opens
+    /// it; `robowire replay`, `decode --mcap` and `plot` read it).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub(crate) record: Option<PathBuf>,
+}
+
+impl RecordArgs {
+    /// The recorder, if asked for; `command` names what records in the capture's metadata.
+    pub(crate) fn start(&self, command: &str) -> anyhow::Result<Option<Recorder>> {
+        start(self.record.as_deref(), command)
+    }
+}
+
 /// A recorder on `path`, if given.
 pub(crate) fn start(path: Option<&Path>, command: &str) -> anyhow::Result<Option<Recorder>> {
     path.map(|p| Recorder::create(p, command).with_context(|| format!("recording to {}", p.display()))).transpose()
@@ -29,8 +45,9 @@ pub(crate) fn finish(recorder: Option<Recorder>) -> anyhow::Result<()> {
     if let Some(recorder) = recorder {
         let summary = recorder.finish().context("closing the capture")?;
         eprintln!(
-            "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable",
-            summary.frames, summary.dropped, summary.oversize, summary.decode_errors
+            "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable, \
+             {} without JSON (the decoder fell behind)",
+            summary.frames, summary.dropped, summary.oversize, summary.decode_errors, summary.json_skipped
         );
     }
     Ok(())

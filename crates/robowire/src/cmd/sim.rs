@@ -28,6 +28,8 @@ pub(crate) struct Go2SimArgs {
     /// Print the simulator's state every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Debug, Args)]
@@ -234,7 +236,13 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
 
 fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::go2::{Go2Sim, Go2SimConfig};
-    let config = Go2SimConfig { participant: args.dds.participant(), ..Go2SimConfig::default() };
+    let recorder = args.record.start("robowire sim go2")?;
+    let config = Go2SimConfig {
+        participant: args.dds.participant(),
+        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
+        services_tap: recorder.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
+        ..Go2SimConfig::default()
+    };
     let sim = Go2Sim::spawn(config).context("starting the Go2 simulator")?;
     let interface = args.dds.interface.as_deref().unwrap_or("the default interface");
     // The first line, alone, for scripts.
@@ -277,5 +285,7 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
         "lowcmd accepted {} ignored {} bad CRC {} bad head {}; final q {:?}",
         s.lowcmd.accepted, s.lowcmd.ignored_sport_mode, s.lowcmd.bad_crc, s.lowcmd.bad_head, s.joints_rad
     );
+    drop(sim);
+    crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)
 }

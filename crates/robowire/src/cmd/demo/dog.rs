@@ -2,6 +2,7 @@
 //! user's program would: stand, walk a square (closed loop on the reported position and
 //! heading), attitude, a trick, faults (error word, silence), lie down.
 
+use robowire_record::RecordLinks;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -96,9 +97,9 @@ async fn stand(dog: &HighLevel, calls: &mut Calls, name: &str) -> anyhow::Result
     Ok(dog.wait_for_state(WAIT, up).await.is_some())
 }
 
-pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
-    runtime.block_on(scenario(duration_s, out))
+    runtime.block_on(scenario(duration_s, out, record))
 }
 
 /// The live line, until the scenario ends.
@@ -119,12 +120,14 @@ async fn show_progress(dog: &HighLevel, out: &Output) -> std::convert::Infallibl
     }
 }
 
-async fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+async fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) =="));
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
     let watchdog = Duration::from_millis(500);
-    let device =
-        super::open_simulated(SimKind::Zsl1, &OpenOptions { state_timeout: Some(watchdog), ..Default::default() })?;
+    let device = super::open_simulated(
+        SimKind::Zsl1,
+        &OpenOptions { state_timeout: Some(watchdog), record: record.cloned(), ..Default::default() },
+    )?;
     let (Some(Simulator::Dog(sim)), Some(dog)) = (device.simulator(), device.zsl()) else {
         anyhow::bail!("sim:zsl1 opened something other than a simulated ZSL-1");
     };

@@ -1,6 +1,7 @@
 //! The chassis scenario: straight, turn, reverse, command timeout, stop, with a burst of line
 //! noise and a dropped response on the way.
 
+use robowire_record::RecordLinks;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -32,10 +33,13 @@ const PHASES: [Phase; 3] = [
     Phase { name: "reverse", velocity_mps: -0.3, yaw_rate_radps: 0.0 },
 ];
 
-pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line("== KMC chassis (UART on a pseudo-terminal) ==");
     // sim:kmc's driver: the defaults, with the battery and all-state polls.
-    let device = super::open_simulated(SimKind::Kmc, &OpenOptions { kmc_polls: true, ..OpenOptions::default() })?;
+    let device = super::open_simulated(
+        SimKind::Kmc,
+        &OpenOptions { kmc_polls: true, record: record.cloned(), ..OpenOptions::default() },
+    )?;
     let (Some(Simulator::Kmc(sim)), Some(driver)) = (device.simulator(), device.kmc()) else {
         anyhow::bail!("sim:kmc opened something other than a simulated KMC chassis");
     };

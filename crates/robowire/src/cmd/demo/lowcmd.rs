@@ -4,6 +4,7 @@
 //! `robowire_dds::netns`): release the sport mode, stand up from lying, hold, with bit flips
 //! injected on `rt/lowstate` and caught by the CRC.
 
+use robowire_record::RecordLinks;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
@@ -20,13 +21,13 @@ use crate::output::Output;
 /// Every this many LowStates one goes out with a flipped bit, during the fault phase.
 const FLIP_EVERY: u32 = 25;
 
-pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== Unitree Go2 over DDS (rt/lowcmd, rt/lowstate, motion_switcher; simulated Go2) =="));
     if robowire_dds::netns::loopback_has_multicast() {
-        return scenario(duration_s, out);
+        return scenario(duration_s, out, record);
     }
     out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace (root)");
-    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out))
+    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out, record))
         .context("DDS on one machine needs multicast on lo")?
 }
 
@@ -40,11 +41,11 @@ fn command(pose: &[f32; 12], tag: u32) -> LowCmd {
     cmd
 }
 
-fn scenario(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
         // sim:go2: the simulator and the client on DDS domain 0, interface lo.
-        let device = super::open_simulated(SimKind::Go2, &OpenOptions::default())?;
+        let device = super::open_simulated(SimKind::Go2, &OpenOptions { record: record.cloned(), ..OpenOptions::default() })?;
         let (Some(Simulator::Go2(sim)), Some(robot)) = (device.simulator(), device.go2()) else {
             anyhow::bail!("sim:go2 opened something other than a simulated Go2");
         };

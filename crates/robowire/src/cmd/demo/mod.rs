@@ -16,6 +16,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use robowire_dds::netns::Loopback;
+use robowire_record::RecordLinks;
 
 use crate::output::Output;
 
@@ -42,6 +43,9 @@ pub(crate) struct DemoArgs {
     /// stderr).
     #[arg(long)]
     json: bool,
+    /// Record every device's links, both ways, into this one MCAP file.
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -64,8 +68,9 @@ impl DemoArgs {
     }
 }
 
-/// A device's scenario: runs for about the given seconds of motion, reports what it saw.
-type Scenario = fn(f64, &Output) -> anyhow::Result<DeviceReport>;
+/// A device's scenario: runs for about the given seconds of motion, reports what it saw; its
+/// device's links recorded with the recorder, if any.
+type Scenario = fn(f64, &Output, Option<&RecordLinks>) -> anyhow::Result<DeviceReport>;
 
 /// Runs the demo; `loopback`: where the Go2 scenario's DDS runs (`None`: it is not run).
 pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result<ExitCode> {
@@ -94,6 +99,8 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         (Device::Spline, spline::run),
         (Device::Lowcmd, lowcmd::run),
     ];
+    let recorder = args.record.start("robowire demo")?;
+    let record = recorder.as_ref().map(robowire_record::Recorder::links);
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
         if args.only.is_none_or(|d| d == device) && (go2 || device != Device::Lowcmd) {
@@ -101,11 +108,12 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
                 out.line("");
             }
             let started = Instant::now();
-            let mut report = scenario(args.duration, &out)?;
+            let mut report = scenario(args.duration, &out, record.as_ref())?;
             report.elapsed = started.elapsed();
             reports.push(report);
         }
     }
+    crate::cmd::record::finish(recorder)?;
     out.line("");
     out.line("checks");
     for check in reports.iter().flat_map(|r| &r.checks).filter(|c| !c.timing) {

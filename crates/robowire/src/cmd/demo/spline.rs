@@ -1,6 +1,7 @@
 //! The low-level scenario: a 1 kHz PD loop through shared memory that moves all legs from the
 //! lying pose to a stand pose and holds it, with a hung daemon injected and detected on the way.
 
+use robowire_record::RecordLinks;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -32,7 +33,7 @@ fn command(pose: [f32; 3]) -> SplineCommandBlock {
     cmd
 }
 
-pub(super) fn run(duration_s: f64, out: &Output) -> anyhow::Result<DeviceReport> {
+pub(super) fn run(duration_s: f64, out: &Output, _record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== ZSL-1 low level (spline daemon on shared memory, 1 kHz) =="));
     let sim = SplineSim::spawn(SplineSimConfig::private("demo")).context("starting the spline daemon simulator")?;
     let names = sim.config().clone();
