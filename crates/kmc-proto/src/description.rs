@@ -18,7 +18,9 @@
 //! ```
 
 use robowire_core::Direction;
-use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
+use robowire_core::json::{
+    ANY_VALUE, FrameError, JsonFrame, LinkDescription, LinkPlots, LinkProtocol, PanelSpec, SeriesSpec,
+};
 
 use crate::{ChassisFrame, HostFrame};
 
@@ -42,6 +44,42 @@ pub static CHASSIS: LinkProtocol = LinkProtocol {
     decode: |p, direction, f| frame(p, direction == Direction::Received, f),
     wire_schema: None,
 };
+
+/// What `robowire plot` draws of a chassis link recorded at the host: commanded against observed
+/// velocity, the commanded curvature, the battery.
+pub static PLOTS: [LinkPlots; 1] = [LinkPlots {
+    protocol: "kmc.host",
+    panels: &[
+        PanelSpec {
+            title: "velocity: commanded (0xA5) and reported (0xB3)",
+            y_label: "velocity (m/s)",
+            series: &[
+                sent("commanded", "kmc.PcControl", "/velocity_mps", true),
+                received("reported", "kmc.VehicleSpeed", "/speed_mps"),
+            ],
+        },
+        PanelSpec {
+            title: "curvature: commanded (0xA5)",
+            y_label: "curvature (1/m)",
+            series: &[sent("commanded", "kmc.PcControl", "/curvature_per_m", true)],
+        },
+        PanelSpec {
+            title: "battery (AF 0x07)",
+            y_label: "voltage (V)",
+            series: &[received("battery", "kmc.BatteryVoltage", "/volts")],
+        },
+    ],
+}];
+
+/// A series of frames the host sent.
+const fn sent(name: &'static str, schema: &'static str, pointer: &'static str, held: bool) -> SeriesSpec {
+    SeriesSpec { name, direction: Direction::Sent, schema, pointer, held, range: ANY_VALUE }
+}
+
+/// A series of frames the host received.
+const fn received(name: &'static str, schema: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec { name, direction: Direction::Received, schema, pointer, held: false, range: ANY_VALUE }
+}
 
 /// Both ends of a KMC link.
 pub static DESCRIPTIONS: [&dyn LinkDescription; 2] = [&HOST, &CHASSIS];

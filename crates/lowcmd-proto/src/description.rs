@@ -26,7 +26,9 @@
 use robowire_core::Direction;
 use robowire_core::cdr::CdrEncoding;
 use robowire_core::json::serde_json::json;
-use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol, WireSchema};
+use robowire_core::json::{
+    ANY_VALUE, FrameError, JsonFrame, LinkDescription, LinkPlots, LinkProtocol, PanelSpec, SeriesSpec, WireSchema,
+};
 
 use crate::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
 use crate::idl::{self, IdlSchema};
@@ -71,6 +73,96 @@ pub static API_SERVER: LinkProtocol = LinkProtocol {
     decode: |p, direction, f| call(p, direction == Direction::Received, f),
     wire_schema: Some(|direction, f| call_wire(direction == Direction::Received, f)),
 };
+
+/// What `robowire plot` draws of a Go2's low-level link recorded at the client: each leg's joint
+/// angles against the commanded targets (a target outside ±20 rad, Unitree's "no position"
+/// marker, is not drawn), the body's attitude.
+pub static PLOTS: [LinkPlots; 1] = [LinkPlots {
+    protocol: "unitree_go.low_level",
+    panels: &[
+        PanelSpec {
+            title: "front right leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                target("hip target", "/motor_cmd/0/q"),
+                joint("hip", "/motor_state/0/q"),
+                target("thigh target", "/motor_cmd/1/q"),
+                joint("thigh", "/motor_state/1/q"),
+                target("calf target", "/motor_cmd/2/q"),
+                joint("calf", "/motor_state/2/q"),
+            ],
+        },
+        PanelSpec {
+            title: "front left leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                target("hip target", "/motor_cmd/3/q"),
+                joint("hip", "/motor_state/3/q"),
+                target("thigh target", "/motor_cmd/4/q"),
+                joint("thigh", "/motor_state/4/q"),
+                target("calf target", "/motor_cmd/5/q"),
+                joint("calf", "/motor_state/5/q"),
+            ],
+        },
+        PanelSpec {
+            title: "rear right leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                target("hip target", "/motor_cmd/6/q"),
+                joint("hip", "/motor_state/6/q"),
+                target("thigh target", "/motor_cmd/7/q"),
+                joint("thigh", "/motor_state/7/q"),
+                target("calf target", "/motor_cmd/8/q"),
+                joint("calf", "/motor_state/8/q"),
+            ],
+        },
+        PanelSpec {
+            title: "rear left leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                target("hip target", "/motor_cmd/9/q"),
+                joint("hip", "/motor_state/9/q"),
+                target("thigh target", "/motor_cmd/10/q"),
+                joint("thigh", "/motor_state/10/q"),
+                target("calf target", "/motor_cmd/11/q"),
+                joint("calf", "/motor_state/11/q"),
+            ],
+        },
+        PanelSpec {
+            title: "body attitude (IMU)",
+            y_label: "angle (rad)",
+            series: &[
+                joint("roll", "/imu_state/rpy/0"),
+                joint("pitch", "/imu_state/rpy/1"),
+                joint("yaw", "/imu_state/rpy/2"),
+            ],
+        },
+    ],
+}];
+
+/// A commanded joint target (`LowCmd_`, sent): held until the next command.
+const fn target(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec {
+        name,
+        direction: Direction::Sent,
+        schema: LowCmd::DDS_TYPE_NAME,
+        pointer,
+        held: true,
+        range: (-20.0, 20.0),
+    }
+}
+
+/// A reported value (`LowState_`, received).
+const fn joint(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec {
+        name,
+        direction: Direction::Received,
+        schema: LowState::DDS_TYPE_NAME,
+        pointer,
+        held: false,
+        range: ANY_VALUE,
+    }
+}
 
 /// Every Unitree DDS link.
 pub static DESCRIPTIONS: [&dyn LinkDescription; 4] = [&GO2_LOW_LEVEL, &HG_LOW_LEVEL, &API_CLIENT, &API_SERVER];

@@ -140,6 +140,59 @@ pub static SKIPPED_BYTES: LinkProtocol = LinkProtocol {
     wire_schema: None,
 };
 
+/// What to plot of one protocol's frames (`robowire plot`), as its codec describes it: panels of
+/// series, each a number read from the frames' JSON.
+#[derive(Debug, Clone, Copy)]
+pub struct LinkPlots {
+    /// The protocol ([`LinkDescription::protocol`]).
+    pub protocol: &'static str,
+    /// Its panels, top to bottom.
+    pub panels: &'static [PanelSpec],
+}
+
+/// One panel: the series drawn against one y axis.
+#[derive(Debug, Clone, Copy)]
+pub struct PanelSpec {
+    /// What it shows (`forward velocity`).
+    pub title: &'static str,
+    /// The y axis, with its unit (`velocity (m/s)`).
+    pub y_label: &'static str,
+    /// Its series.
+    pub series: &'static [SeriesSpec],
+}
+
+/// One series: a number in each frame of one message type, one way.
+#[derive(Debug, Clone, Copy)]
+pub struct SeriesSpec {
+    /// Its legend (`commanded`, `observed`).
+    pub name: &'static str,
+    /// The frames' direction, from the recording end.
+    pub direction: Direction,
+    /// The frames' JSON schema name ([`JsonFrame::schema`]).
+    pub schema: &'static str,
+    /// Where the number is in the frame's JSON: a JSON pointer (RFC 6901, `/motor_cmd/0/q`).
+    pub pointer: &'static str,
+    /// A command held until the next (drawn as steps), not a sample.
+    pub held: bool,
+    /// Values outside this range are not drawn (a protocol's "no target" marker, such as
+    /// Unitree's 2.146e9).
+    pub range: (f64, f64),
+}
+
+/// [`SeriesSpec::range`] for a series whose every finite value is drawn.
+pub const ANY_VALUE: (f64, f64) = (-1e300, 1e300);
+
+impl SeriesSpec {
+    /// The series' value in `frame` (a message of its schema), if it is a number in range.
+    pub fn value(&self, frame: &JsonFrame) -> Option<f64> {
+        if frame.schema != self.schema {
+            return None;
+        }
+        let value = frame.value.pointer(self.pointer)?.as_f64()?;
+        (self.range.0..=self.range.1).contains(&value).then_some(value)
+    }
+}
+
 /// A frame as JSON.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JsonFrame {

@@ -14,6 +14,10 @@ pub use write::{RecordError, RecordLinks, Recorder, RecorderOptions, RecordingSu
 /// The message encoding of the raw channels: the frame's bytes, as on the wire.
 pub const RAW_ENCODING: &str = "robowire.raw";
 
+/// The schema encoding of the raw channels' schemas: named by the protocol, the text is the
+/// layout its frames follow (`zsl1-udp, vendor SDK v0.2.7`), for people, not for a decoder.
+pub const LAYOUT_SCHEMA_ENCODING: &str = "robowire.layout";
+
 /// The replay reader's check for the fuzz target: any bytes read as a capture, with the
 /// descriptions `known`, give frames or a typed error, never a panic; what reads as frames also
 /// summarizes.

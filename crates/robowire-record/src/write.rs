@@ -13,8 +13,8 @@ use mcap::records::{MessageHeader, Metadata};
 use robowire_core::json::{LinkDescription, WireSchema};
 use robowire_tap::{Direction, Tap, TapRing, TappedFrame};
 
-use crate::RAW_ENCODING;
 use crate::json_thread::{JsonMessage, JsonThread};
+use crate::{LAYOUT_SCHEMA_ENCODING, RAW_ENCODING};
 
 /// How long the writer sleeps when the ring is empty: at 1 M frames/s, 1 000 frames arrive
 /// meanwhile (a quarter of the default ring).
@@ -381,7 +381,10 @@ impl WriterState {
         let (name, description) = (channels.name.clone(), channels.description);
         let topic = format!("/{name}/{}/raw", key.1.name());
         let metadata = Self::metadata(key, &name, description);
-        let id = self.writer.add_channel(0, &topic, RAW_ENCODING, &metadata).map_err(self.error())?;
+        // The bytes' own layout, named: not a schema a reader decodes with, but every channel
+        // says what its messages are.
+        let schema = self.schema_id(LAYOUT_SCHEMA_ENCODING, description.protocol(), description.layout().as_bytes())?;
+        let id = self.writer.add_channel(schema, &topic, RAW_ENCODING, &metadata).map_err(self.error())?;
         if let Some(c) = self.channels.get_mut(&key) {
             c.raw = Some(id);
         }

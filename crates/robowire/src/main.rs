@@ -45,6 +45,8 @@ enum Command {
     Decode(cmd::decode::DecodeArgs),
     /// Replay an MCAP capture into the decoders, at the recorded pace.
     Replay(cmd::record::ReplayArgs),
+    /// Draw a capture: one page per device, commanded against observed, faults and silences marked.
+    Plot(cmd::plot::PlotArgs),
     /// Encode a message from JSON and print its bytes in hex.
     #[command(subcommand)]
     Encode(cmd::encode::EncodeCommand),
@@ -77,6 +79,7 @@ fn main() -> ExitCode {
         Command::Shm(command) => cmd::shm::run(&command),
         Command::Decode(args) => cmd::decode::run(&args),
         Command::Replay(args) => cmd::record::replay(&args),
+        Command::Plot(args) => cmd::plot::run(&args),
         Command::Encode(command) => cmd::encode::run(&command),
     };
     match result {

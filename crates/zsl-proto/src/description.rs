@@ -16,7 +16,9 @@
 //! ```
 
 use robowire_core::Direction;
-use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
+use robowire_core::json::{
+    ANY_VALUE, FrameError, JsonFrame, LinkDescription, LinkPlots, LinkProtocol, PanelSpec, SeriesSpec,
+};
 
 use crate::udp::AnyDatagram;
 
@@ -30,6 +32,54 @@ pub static HIGH_LEVEL: LinkProtocol =
 /// A LowLevel link (`zsl1.low_level`): 248-byte commands, 272-byte states.
 pub static LOW_LEVEL: LinkProtocol =
     LinkProtocol { name: "zsl1.low_level", layout: LAYOUT, decode: datagram, wire_schema: None };
+
+/// What `robowire plot` draws of a HighLevel link recorded at the client: commanded against
+/// observed motion, the mode, the body's height.
+pub static PLOTS: [LinkPlots; 1] = [LinkPlots {
+    protocol: "zsl1.high_level",
+    panels: &[
+        PanelSpec {
+            title: "forward velocity: commanded and observed (body frame)",
+            y_label: "velocity (m/s)",
+            series: &[command("commanded vx", "/vx_mps"), state("observed vx", "/body_velocity_mps/0")],
+        },
+        PanelSpec {
+            title: "yaw rate: commanded and observed (gyro z)",
+            y_label: "yaw rate (rad/s)",
+            series: &[command("commanded", "/yaw_rate_radps"), state("observed", "/gyro_radps/2")],
+        },
+        PanelSpec {
+            title: "control mode: commanded and reported",
+            y_label: "mode (number)",
+            series: &[command("commanded", "/mode"), state("reported", "/mode")],
+        },
+        PanelSpec { title: "body height", y_label: "height (m)", series: &[state("position z", "/position_m/2")] },
+    ],
+}];
+
+/// A series of the commands the client sent.
+const fn command(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec {
+        name,
+        direction: Direction::Sent,
+        schema: "zsl1.HighLevelCommand",
+        pointer,
+        held: true,
+        range: ANY_VALUE,
+    }
+}
+
+/// A series of the states the client received.
+const fn state(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec {
+        name,
+        direction: Direction::Received,
+        schema: "zsl1.HighLevelState",
+        pointer,
+        held: false,
+        range: ANY_VALUE,
+    }
+}
 
 /// Every ZSL-1 link.
 pub static DESCRIPTIONS: [&dyn LinkDescription; 2] = [&HIGH_LEVEL, &LOW_LEVEL];

@@ -9,6 +9,7 @@ pub(crate) mod encode;
 pub(crate) mod go2;
 pub(crate) mod kmc;
 pub(crate) mod live;
+pub(crate) mod plot;
 pub(crate) mod record;
 pub(crate) mod replay_device;
 pub(crate) mod ros2;

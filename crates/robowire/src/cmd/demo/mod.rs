@@ -14,6 +14,7 @@ pub(crate) use report::{Check, DeviceReport, InjectedFault};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robowire_dds::netns::Loopback;
 use robowire_record::RecordLinks;
@@ -46,6 +47,23 @@ pub(crate) struct DemoArgs {
     /// Record every device's links, both ways, into this one MCAP file.
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
+    /// Draw the run: one PNG per device (DIR/kmc.png, DIR/dog.png, …), from its capture (the
+    /// --record file, else DIR/demo.mcap).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<std::path::PathBuf>,
+}
+
+/// One PNG per device of the run's capture into `dir`.
+fn draw(dir: &std::path::Path, capture: &std::path::Path, out: &Output) -> anyhow::Result<()> {
+    for device in ["kmc", "dog", "spline", "go2"] {
+        let image = dir.join(format!("{device}.png"));
+        let selection = crate::cmd::plot::Selection { device: Some(device.into()), ..Default::default() };
+        // A device whose scenario did not run (--only) has nothing to draw.
+        if !crate::cmd::plot::plot_capture(capture, &image, &selection)?.is_empty() {
+            out.line(format_args!("plot: {}", image.display()));
+        }
+    }
+    Ok(())
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -99,7 +117,15 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         (Device::Spline, spline::run),
         (Device::Lowcmd, lowcmd::run),
     ];
-    let recorder = args.record.start("robowire demo")?;
+    let capture = match (&args.record.record, &args.plot) {
+        (Some(file), _) => Some(file.clone()),
+        (None, Some(dir)) => {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            Some(dir.join("demo.mcap"))
+        }
+        (None, None) => None,
+    };
+    let recorder = crate::cmd::record::start(capture.as_deref(), "robowire demo")?;
     let record = recorder.as_ref().map(robowire_record::Recorder::links);
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
@@ -114,6 +140,9 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         }
     }
     crate::cmd::record::finish(recorder)?;
+    if let (Some(dir), Some(capture)) = (&args.plot, &capture) {
+        draw(dir, capture, &out)?;
+    }
     out.line("");
     out.line("checks");
     for check in reports.iter().flat_map(|r| &r.checks).filter(|c| !c.timing) {
