@@ -3,13 +3,15 @@
 //! - the ZSL-1 HighLevel command stream's send lateness (2 ms period, the client's own figures)
 //!   with its link recorded and without, against the simulated dog, alternating;
 //! - the recorder's throughput: 560-byte states tapped as fast as one thread can, written raw
-//!   and decoded to JSON; frames/s and MB/s of what was written, and what the ring dropped.
+//!   and decoded to JSON (frames/s and MB/s of what was written, what the ring dropped); tapped
+//!   at 1 M frames/s (560-byte and 64-byte frames, raw); 100 links at 1 kHz each, with JSON
+//!   (what was dropped, what went without JSON).
 //!
 //! Figures to `ROBOWIRE_BENCH_META_RECORD` for `cargo xtask bench`.
 
 use std::time::{Duration, Instant};
 
-use robowire_record::{Direction, Recorder};
+use robowire_record::{Compression, Direction, Recorder, RecorderOptions};
 use robowire_sim::dog::{DogSim, DogSimConfig};
 use serde_json::json;
 use zsl::udp::{ClientOptions, Device, HighLevel};
@@ -70,14 +72,17 @@ fn main() {
         HighLevelState { header: HIGH_LEVEL_STATE_HEADER, control_mode: 18.into(), ..Default::default() }.encode();
     let unpaced_raw = throughput(&state, frames, 1, None, false);
     let unpaced_json = throughput(&state, frames, 1, None, true);
-    let million = throughput(&state, frames.max(1_000_000) * 2, 1, Some(1e6), false);
+    let million = throughput(&state, 2_000_000, 1, Some(1e6), false);
+    let million_small = throughput(&state[..64], 2_000_000, 1, Some(1e6), false);
     let hundred_links = throughput(&state, if quick { 100_000 } else { 1_000_000 }, 100, Some(100e3), true);
+    let zstd = RecorderOptions { compression: Compression::Zstd, ..Default::default() };
+    let hundred_links_zstd = throughput_with(&state, if quick { 100_000 } else { 1_000_000 }, 100, Some(100e3), zstd);
     let meta = json!({
         "lateness_plain_p50_us": median(&mut plain, |r| r.0), "lateness_plain_p99_us": median(&mut plain, |r| r.1),
         "lateness_recorded_p50_us": median(&mut recorded, |r| r.0), "lateness_recorded_p99_us": median(&mut recorded, |r| r.1),
         "stream_frames_dropped": dropped,
         "frame_bytes": state.len(),
-        "unpaced_raw": unpaced_raw, "unpaced_json": unpaced_json, "paced_1m_raw": million, "links_100_at_1khz": hundred_links,
+        "unpaced_raw": unpaced_raw, "unpaced_json": unpaced_json, "paced_1m_raw": million, "paced_1m_raw_64b": million_small, "links_100_at_1khz": hundred_links, "links_100_at_1khz_zstd": hundred_links_zstd,
     });
     println!("record: {meta}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_RECORD") {
@@ -89,8 +94,19 @@ fn main() {
 /// or at `rate` frames/s (a busy wait to each frame's due time), into a recorder with its JSON
 /// thread or without: what was written per second of the run, and what was dropped or skipped.
 fn throughput(frame: &[u8], frames: u64, links: u16, rate: Option<f64>, json: bool) -> serde_json::Value {
+    throughput_with(frame, frames, links, rate, RecorderOptions { json, ..Default::default() })
+}
+
+/// As [`throughput`], with `options`; also the file's size.
+fn throughput_with(
+    frame: &[u8],
+    frames: u64,
+    links: u16,
+    rate: Option<f64>,
+    options: RecorderOptions,
+) -> serde_json::Value {
     let path = temp("throughput");
-    let options = robowire_record::RecorderOptions { json, ..Default::default() };
+    let json = options.json;
     let recorder = Recorder::create_with(&path, "bench", options).unwrap();
     let taps: Vec<_> = (0..links).map(|n| recorder.link(&format!("dog{n}/high_level"), &HIGH_LEVEL)).collect();
     let start = Instant::now();
@@ -112,5 +128,6 @@ fn throughput(frame: &[u8], frames: u64, links: u16, rate: Option<f64>, json: bo
         "offered": frames, "offered_per_s": frames as f64 / tapped_s, "written": summary.frames,
         "written_per_s": summary.frames as f64 / elapsed, "mb_per_s": bytes as f64 / elapsed / 1e6,
         "dropped": summary.dropped, "json_skipped": summary.json_skipped, "links": links, "json": json,
+        "file_bytes": bytes,
     })
 }

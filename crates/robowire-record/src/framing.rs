@@ -159,19 +159,51 @@ fn walk(bytes: &[u8], mut at: usize, end: usize, in_chunk: bool) -> Result<Optio
     Ok(None)
 }
 
-/// A chunk: times, sizes, crc, compression (must be none), records that fill it.
+/// The largest chunk a capture may hold, uncompressed: robowire writes chunks of under 1 MiB;
+/// a compressed chunk claiming more is refused before anything is allocated for it.
+const MAX_CHUNK_BYTES: u64 = 64 << 20;
+
+/// A chunk: times, sizes, crc, compression (none, zstd or lz4), records that fill it (once
+/// decompressed, to their uncompressed size exactly).
 fn check_chunk(bytes: &[u8], body: usize, end: usize) -> Result<(), Broken> {
     let f = &mut Fields { body: &bytes[body..end], at: 0, start: body };
-    f.skip(28, "the chunk's times, size and crc")?;
-    if !f.prefixed("the chunk's compression")?.is_empty() {
-        return Err(broken(body + 28, "an uncompressed chunk (robowire writes none compressed)"));
-    }
+    f.skip(16, "the chunk's times")?;
+    let uncompressed_size = f.u64("the chunk's uncompressed size")?;
+    f.skip(4, "the chunk's crc")?;
+    let compression = f.prefixed("the chunk's compression")?;
     let records_len = f.u64("the chunk's records length")?;
     let records = body + f.at;
     if usize::try_from(records_len).ok().and_then(|l| records.checked_add(l)) != Some(end) {
         return Err(broken(records - 8, "records that fill the chunk"));
     }
-    walk(bytes, records, end, true).map(|_| ())
+    if compression.is_empty() {
+        return walk(bytes, records, end, true).map(|_| ());
+    }
+    if uncompressed_size > MAX_CHUNK_BYTES {
+        return Err(broken(body + 16, format!("a chunk of at most {MAX_CHUNK_BYTES} bytes uncompressed")));
+    }
+    let packed = &bytes[records..end];
+    let size = uncompressed_size as usize;
+    let unpacked = match compression {
+        b"zstd" => zstd::bulk::decompress(packed, size).ok(),
+        b"lz4" => {
+            let mut out = Vec::new();
+            lz4::Decoder::new(packed)
+                .and_then(|d| std::io::Read::read_to_end(&mut std::io::Read::take(d, uncompressed_size + 1), &mut out))
+                .ok()
+                .map(|_| out)
+        }
+        _ => return Err(broken(body + 28, "a chunk compressed with zstd or lz4, or not at all")),
+    };
+    let Some(unpacked) = unpacked.filter(|u| u.len() == size) else {
+        return Err(broken(
+            records,
+            format!("{} chunk records that decompress to {size} bytes", String::from_utf8_lossy(compression)),
+        ));
+    };
+    walk(&unpacked, 0, size, true)
+        .map(|_| ())
+        .map_err(|b| broken(records, format!("in the decompressed chunk, at byte {}: {}", b.offset, b.expected)))
 }
 
 /// The whole file: magic, records up to the footer, magic.

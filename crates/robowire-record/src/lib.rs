@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+mod channels;
 mod framing;
 mod json_thread;
 mod read;
@@ -9,7 +10,7 @@ mod write;
 pub use read::{CaptureSummary, ChannelSummary, ReadError, RecordedFrame, read_frames, summarize};
 pub use robowire_core::json::{FrameError, JsonFrame, LinkDescription, WireSchema};
 pub use robowire_tap::{Direction, SampleOrigin, Tap};
-pub use write::{RecordError, RecordLinks, Recorder, RecorderOptions, RecordingSummary};
+pub use write::{Compression, RecordError, RecordLinks, Recorder, RecorderOptions, RecordingSummary};
 
 /// The message encoding of the raw channels: the frame's bytes, as on the wire.
 pub const RAW_ENCODING: &str = "robowire.raw";

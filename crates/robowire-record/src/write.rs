@@ -1,6 +1,6 @@
 //! The recorder: a thread that writes the taps' frames into an MCAP file.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -10,11 +10,11 @@ use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use mcap::records::{MessageHeader, Metadata};
-use robowire_core::json::{LinkDescription, WireSchema};
-use robowire_tap::{Direction, Tap, TapRing, TappedFrame};
+use robowire_core::json::LinkDescription;
+use robowire_tap::{Tap, TapRing, TappedFrame};
 
+use crate::channels::Channels;
 use crate::json_thread::{JsonMessage, JsonThread};
-use crate::{LAYOUT_SCHEMA_ENCODING, RAW_ENCODING};
 
 /// How long the writer sleeps when the ring is empty: at 1 M frames/s, 1 000 frames arrive
 /// meanwhile (a quarter of the default ring).
@@ -30,11 +30,38 @@ pub struct RecorderOptions {
     /// Writes each frame's JSON message beside its raw bytes (default on); off, a capture has the
     /// raw channels only, and `robowire decode --mcap` reads them.
     pub json: bool,
+    /// How the file's chunks are compressed (default none: the writer's thread does nothing
+    /// more per byte than copy it).
+    pub compression: Compression,
 }
 
 impl Default for RecorderOptions {
     fn default() -> Self {
-        Self { ring_slots: 4096, json: true }
+        Self { ring_slots: 4096, json: true, compression: Compression::None }
+    }
+}
+
+/// Chunk compression of a capture: every MCAP reader reads all three. On the demo's capture
+/// zstd makes it about 12 times smaller.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Compression {
+    /// Uncompressed chunks.
+    #[default]
+    None,
+    /// Zstandard, level 1 (`mcap`'s default level).
+    Zstd,
+    /// LZ4 frames.
+    Lz4,
+}
+
+impl Compression {
+    fn mcap(self) -> Option<mcap::Compression> {
+        match self {
+            Self::None => None,
+            Self::Zstd => Some(mcap::Compression::Zstd),
+            Self::Lz4 => Some(mcap::Compression::Lz4),
+        }
     }
 }
 
@@ -109,7 +136,7 @@ impl Recorder {
         let path = path.as_ref().to_path_buf();
         let file = File::create(&path).map_err(|source| RecordError::Create { path: path.clone(), source })?;
         let writer = mcap::WriteOptions::new()
-            .compression(None)
+            .compression(options.compression.mcap())
             .profile("")
             .library(concat!("robowire ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::with_capacity(1 << 20, file))
@@ -128,8 +155,7 @@ impl Recorder {
             command: command.into(),
             links: links.clone(),
             unix_offset_ns: unix_minus_monotonic_ns(),
-            channels: HashMap::new(),
-            schemas: HashMap::new(),
+            channels: Channels::default(),
             summary: RecordingSummary::default(),
         };
         let thread = std::thread::Builder::new()
@@ -228,21 +254,6 @@ fn unix_minus_monotonic_ns() -> i64 {
     i64::try_from(offset).unwrap_or(0)
 }
 
-/// Which channels a frame goes to: its link, direction and writer.
-type ChannelKey = (u16, Direction, Option<[u8; 16]>);
-
-/// The channels of one link, direction and writer: the frames' own (raw, or per wire schema),
-/// and one JSON channel per schema.
-struct LinkChannels {
-    name: String,
-    description: &'static dyn LinkDescription,
-    raw: Option<u16>,
-    wire: HashMap<&'static str, u16>,
-    json: HashMap<&'static str, u16>,
-    /// Messages written per channel id, for their sequence numbers.
-    sequence: HashMap<u16, u32>,
-}
-
 /// The writer thread's state.
 struct WriterState {
     writer: mcap::Writer<BufWriter<File>>,
@@ -251,9 +262,7 @@ struct WriterState {
     links: Links,
     /// Added to a tap's monotonic stamp: Unix time, ns.
     unix_offset_ns: i64,
-    channels: HashMap<ChannelKey, LinkChannels>,
-    /// Schema ids by (encoding, name).
-    schemas: HashMap<(&'static str, &'static str), u16>,
+    channels: Channels,
     summary: RecordingSummary,
 }
 
@@ -303,139 +312,45 @@ impl WriterState {
         |source| RecordError::Write { path: self.path.clone(), source }
     }
 
-    /// The channels of `key`, made on its link's first frame; `None` for a link number no one
-    /// registered (taps are only handed out for registered links).
-    fn link_channels(&mut self, key: ChannelKey) -> Option<&mut LinkChannels> {
-        if !self.channels.contains_key(&key) {
-            let (name, description) = robowire_rt::lock(&self.links).get(usize::from(key.0)).cloned()?;
-            let channels = LinkChannels {
-                name,
-                description,
-                raw: None,
-                wire: HashMap::new(),
-                json: HashMap::new(),
-                sequence: HashMap::new(),
-            };
-            self.channels.insert(key, channels);
-        }
-        self.channels.get_mut(&key)
-    }
-
-    fn schema_id(&mut self, encoding: &'static str, name: &'static str, text: &[u8]) -> Result<u16, RecordError> {
-        if let Some(&id) = self.schemas.get(&(encoding, name)) {
-            return Ok(id);
-        }
-        let id = self.writer.add_schema(name, encoding, text).map_err(self.error())?;
-        self.schemas.insert((encoding, name), id);
-        Ok(id)
-    }
-
-    /// The metadata of a channel of `key`'s link.
-    fn metadata(key: ChannelKey, name: &str, description: &dyn LinkDescription) -> BTreeMap<String, String> {
-        let mut metadata = BTreeMap::from([
-            ("link".to_string(), name.to_string()),
-            ("direction".to_string(), key.1.name().to_string()),
-            ("protocol".to_string(), description.protocol().to_string()),
-        ]);
-        if let Some(writer) = key.2 {
-            metadata.insert("writer_guid".into(), writer.iter().map(|b| format!("{b:02x}")).collect());
-        }
-        metadata
-    }
-
-    /// Writes `frame` on the channel of its own bytes: its wire encoding's, if its description
-    /// names one, else the raw channel. The description to decode it to JSON with if it went
-    /// raw (a wire encoding readers decode themselves).
+    /// Writes `frame` on the channel of its own bytes (its wire encoding's, or raw); the
+    /// description to decode it to JSON with if it went raw.
     fn write_frame(&mut self, frame: &TappedFrame) -> Result<Option<&'static dyn LinkDescription>, RecordError> {
         let key = (frame.link, frame.direction, frame.origin.writer);
-        let Some(channels) = self.link_channels(key) else {
+        let links = &self.links;
+        let registered = |link: usize| robowire_rt::lock(links).get(link).cloned();
+        let channel =
+            self.channels.frame_channel(&mut self.writer, key, frame.bytes(), registered).map_err(self.error())?;
+        let Some(channel) = channel else {
             self.summary.decode_errors += 1;
             return Ok(None);
         };
-        let description = channels.description;
-        let (channel, json) = match description.wire_schema(frame.direction, frame.bytes()) {
-            Some(wire) => (self.wire_channel(key, &wire)?, None),
-            None => (self.raw_channel(key)?, Some(description)),
-        };
-        let unix_ns = frame.monotonic_ns.saturating_add_signed(self.unix_offset_ns);
-        let publish_ns = frame.origin.source_unix_ns.unwrap_or(unix_ns);
-        let sequence = self.next_sequence(key, channel);
-        let header = MessageHeader { channel_id: channel, sequence, log_time: unix_ns, publish_time: publish_ns };
+        let header = self.header(channel.id, frame.monotonic_ns, frame.origin.source_unix_ns);
         self.writer.write_to_known_channel(&header, frame.bytes()).map_err(self.error())?;
         self.summary.frames += 1;
-        Ok(json)
+        Ok(channel.json_by)
     }
 
-    fn next_sequence(&mut self, key: ChannelKey, channel: u16) -> u32 {
-        let Some(channels) = self.channels.get_mut(&key) else { return 0 };
-        let sequence = channels.sequence.entry(channel).or_default();
-        *sequence = sequence.wrapping_add(1);
-        *sequence
+    /// A message's header: logged at the tap's time in Unix ns, published at the source
+    /// timestamp if the middleware gave one.
+    fn header(&mut self, channel_id: u16, monotonic_ns: u64, source_unix_ns: Option<u64>) -> MessageHeader {
+        let log_time = monotonic_ns.saturating_add_signed(self.unix_offset_ns);
+        let sequence = self.channels.next_sequence(channel_id);
+        MessageHeader { channel_id, sequence, log_time, publish_time: source_unix_ns.unwrap_or(log_time) }
     }
 
-    fn raw_channel(&mut self, key: ChannelKey) -> Result<u16, RecordError> {
-        let Some(channels) = self.channels.get(&key) else { return Err(RecordError::Thread) };
-        if let Some(id) = channels.raw {
-            return Ok(id);
-        }
-        let (name, description) = (channels.name.clone(), channels.description);
-        let topic = format!("/{name}/{}/raw", key.1.name());
-        let metadata = Self::metadata(key, &name, description);
-        // The bytes' own layout, named: not a schema a reader decodes with, but every channel
-        // says what its messages are.
-        let schema = self.schema_id(LAYOUT_SCHEMA_ENCODING, description.protocol(), description.layout().as_bytes())?;
-        let id = self.writer.add_channel(schema, &topic, RAW_ENCODING, &metadata).map_err(self.error())?;
-        if let Some(c) = self.channels.get_mut(&key) {
-            c.raw = Some(id);
-        }
-        Ok(id)
-    }
-
-    fn wire_channel(&mut self, key: ChannelKey, wire: &WireSchema) -> Result<u16, RecordError> {
-        let Some(channels) = self.channels.get(&key) else { return Err(RecordError::Thread) };
-        if let Some(&id) = channels.wire.get(wire.name) {
-            return Ok(id);
-        }
-        let (name, description) = (channels.name.clone(), channels.description);
-        let schema = self.schema_id(wire.schema_encoding, wire.name, wire.text.as_bytes())?;
-        let topic = format!("/{name}/{}", key.1.name());
-        let metadata = Self::metadata(key, &name, description);
-        let id = self.writer.add_channel(schema, &topic, wire.encoding, &metadata).map_err(self.error())?;
-        self.channels.get_mut(&key).map(|c| c.wire.insert(wire.name, id));
-        Ok(id)
-    }
-
-    /// Writes a frame's JSON message (made by the JSON thread) on its schema's channel.
+    /// Writes a frame's JSON message (made by the JSON thread) on its message type's channel.
     fn write_json(&mut self, message: &JsonMessage) -> Result<(), RecordError> {
         let Some(json) = &message.json else {
             self.summary.decode_errors += 1;
             return Ok(());
         };
         let key = (message.link, message.direction, message.origin.writer);
-        let Some(channels) = self.channels.get(&key) else { return Ok(()) };
-        let channel = match channels.json.get(message.schema) {
-            Some(&id) => id,
-            None => {
-                let name = channels.name.clone();
-                let text = message.schema_text.as_ref().map(serde_json::to_vec).transpose().ok().flatten();
-                let schema = match text {
-                    Some(text) => self.schema_id("jsonschema", message.schema, &text)?,
-                    None => self.schemas.get(&("jsonschema", message.schema)).copied().unwrap_or(0),
-                };
-                let mut metadata = BTreeMap::from([("link".to_string(), name.clone())]);
-                if let Some(writer) = key.2 {
-                    metadata.insert("writer_guid".into(), writer.iter().map(|b| format!("{b:02x}")).collect());
-                }
-                let topic = format!("/{name}/{}/{}", key.1.name(), message.schema);
-                let id = self.writer.add_channel(schema, &topic, "json", &metadata).map_err(self.error())?;
-                self.channels.get_mut(&key).map(|c| c.json.insert(message.schema, id));
-                id
-            }
-        };
-        let unix_ns = message.monotonic_ns.saturating_add_signed(self.unix_offset_ns);
-        let publish_ns = message.origin.source_unix_ns.unwrap_or(unix_ns);
-        let sequence = self.next_sequence(key, channel);
-        let header = MessageHeader { channel_id: channel, sequence, log_time: unix_ns, publish_time: publish_ns };
+        let channel = self
+            .channels
+            .json_channel(&mut self.writer, key, message.schema, message.schema_text.as_ref())
+            .map_err(self.error())?;
+        let Some(channel) = channel else { return Ok(()) };
+        let header = self.header(channel, message.monotonic_ns, message.origin.source_unix_ns);
         self.writer.write_to_known_channel(&header, json).map_err(self.error())?;
         Ok(())
     }

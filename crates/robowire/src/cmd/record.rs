@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Args;
-use robowire_record::{LinkDescription, Recorder};
+use robowire_record::{Compression, LinkDescription, Recorder, RecorderOptions};
 
 /// Every link description the CLI knows, one list from each codec: what reading a capture back
 /// (`robowire replay`, `robowire decode --mcap`) understands.
@@ -27,18 +27,45 @@ pub(crate) struct RecordArgs {
     /// it; `robowire replay`, `decode --mcap` and `plot` read it).
     #[arg(long, value_name = "FILE.mcap")]
     pub(crate) record: Option<PathBuf>,
+    /// How the capture's chunks are compressed (zstd: about 12 times smaller, at some CPU).
+    #[arg(long, value_enum, default_value_t = CompressionArg::None, requires = "record")]
+    pub(crate) compression: CompressionArg,
+}
+
+/// `--compression`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum CompressionArg {
+    None,
+    Zstd,
+    Lz4,
 }
 
 impl RecordArgs {
     /// The recorder, if asked for; `command` names what records in the capture's metadata.
     pub(crate) fn start(&self, command: &str) -> anyhow::Result<Option<Recorder>> {
-        start(self.record.as_deref(), command)
+        start_with(self.record.as_deref(), command, self.compression)
     }
 }
 
 /// A recorder on `path`, if given.
 pub(crate) fn start(path: Option<&Path>, command: &str) -> anyhow::Result<Option<Recorder>> {
-    path.map(|p| Recorder::create(p, command).with_context(|| format!("recording to {}", p.display()))).transpose()
+    start_with(path, command, CompressionArg::None)
+}
+
+/// A recorder on `path`, if given, its chunks compressed with `compression`.
+pub(crate) fn start_with(
+    path: Option<&Path>,
+    command: &str,
+    compression: CompressionArg,
+) -> anyhow::Result<Option<Recorder>> {
+    let compression = match compression {
+        CompressionArg::None => Compression::None,
+        CompressionArg::Zstd => Compression::Zstd,
+        CompressionArg::Lz4 => Compression::Lz4,
+    };
+    let options = RecorderOptions { compression, ..RecorderOptions::default() };
+    path.map(|p| Recorder::create_with(p, command, options).with_context(|| format!("recording to {}", p.display())))
+        .transpose()
 }
 
 /// Closes the capture and says what it holds.

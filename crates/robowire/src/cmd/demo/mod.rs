@@ -125,7 +125,7 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         }
         (None, None) => None,
     };
-    let recorder = crate::cmd::record::start(capture.as_deref(), "robowire demo")?;
+    let recorder = crate::cmd::record::start_with(capture.as_deref(), "robowire demo", args.record.compression)?;
     let record = recorder.as_ref().map(robowire_record::Recorder::links);
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
