@@ -1,6 +1,9 @@
 //! ZSL-1 links described to a recorder (feature `serde`): the HighLevel and LowLevel UDP links,
 //! each frame one datagram decoded strictly by its length (either link's datagrams decode on
-//! either description, as they always have in captures), as JSON under `zsl1.<datagram>`.
+//! either description, as they always have in captures), as JSON under `zsl1.<datagram>`; and
+//! the shared-memory links (spec `spline-shm.md`), each frame the bytes of one handshake as they
+//! were copied in or out of the region: `/spline_shm` seen by a client ([`SPLINE_CLIENT`]) or by
+//! the daemon ([`SPLINE_DAEMON`]), and `/imu_shm` ([`IMU`]).
 //!
 //! ```
 //! use robowire_core::Direction;
@@ -17,7 +20,10 @@
 
 use robowire_core::Direction;
 use robowire_core::json::{FrameError, JsonFrame, LinkDescription, LinkProtocol};
+use zerocopy::FromBytes;
 
+use crate::serde_impl::Legs;
+use crate::shm::{LegControl, LegState, NavImu};
 use crate::udp::AnyDatagram;
 
 /// The layout both links follow.
@@ -31,8 +37,90 @@ pub static HIGH_LEVEL: LinkProtocol =
 pub static LOW_LEVEL: LinkProtocol =
     LinkProtocol { name: "zsl1.low_level", layout: LAYOUT, decode: datagram, wire_schema: None };
 
+/// The layout the shared-memory links follow.
+const SHM_LAYOUT: &str = "zsl1-spline-shm, vendor SDK v0.2.7 lowlevel.h";
+
+/// `/spline_shm` recorded by the motion controller or a monitor (`zsl1.spline.client`): it
+/// sends the 336 bytes of leg commands it publishes (`zsl1.SplineCommand`, the command block
+/// without its consumer flags) and receives the 256 bytes of leg states it takes
+/// (`zsl1.SplineState`, the state block without its flags).
+pub static SPLINE_CLIENT: LinkProtocol = LinkProtocol {
+    name: "zsl1.spline.client",
+    layout: SHM_LAYOUT,
+    decode: |p, direction, f| spline(p, direction == Direction::Sent, f),
+    wire_schema: None,
+};
+
+/// `/spline_shm` recorded by the daemon (`zsl1.spline.daemon`): the same frames as
+/// [`SPLINE_CLIENT`], the other way round: it receives leg commands and sends leg states.
+pub static SPLINE_DAEMON: LinkProtocol = LinkProtocol {
+    name: "zsl1.spline.daemon",
+    layout: SHM_LAYOUT,
+    decode: |p, direction, f| spline(p, direction == Direction::Received, f),
+    wire_schema: None,
+};
+
+/// `/imu_shm` (`zsl1.imu`): each frame one 48-byte `nav_imu` record as read or written, the
+/// timestamp (its version) then the sample (`zsl1.ImuSample`), either way.
+pub static IMU: LinkProtocol = LinkProtocol {
+    name: "zsl1.imu",
+    layout: SHM_LAYOUT,
+    decode: |p, _, f| exact::<NavImu>(p, "zsl1.ImuSample", f),
+    wire_schema: None,
+};
+
 /// Every ZSL-1 link.
-pub static DESCRIPTIONS: [&dyn LinkDescription; 2] = [&HIGH_LEVEL, &LOW_LEVEL];
+pub static DESCRIPTIONS: [&dyn LinkDescription; 5] = [&HIGH_LEVEL, &LOW_LEVEL, &SPLINE_CLIENT, &SPLINE_DAEMON, &IMU];
+
+/// A frame of a shared-memory link that is not the length of the block it must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("a {message} frame is {expected} bytes, not {found}")]
+pub struct WrongLength {
+    /// The message the frame should be (`zsl1.SplineState`).
+    pub message: &'static str,
+    /// Its length, bytes.
+    pub expected: usize,
+    /// The frame's length, bytes.
+    pub found: usize,
+}
+
+/// A spline frame as JSON: leg commands if `command`, else leg states.
+fn spline(protocol: &'static str, command: bool, frame: &[u8]) -> Result<JsonFrame, FrameError> {
+    if command {
+        exact::<[LegControl; 4]>(protocol, "zsl1.SplineCommand", frame)
+    } else {
+        exact::<[LegState; 4]>(protocol, "zsl1.SplineState", frame)
+    }
+}
+
+/// `frame` read as exactly one `T`, as JSON under `schema`; any other length is a
+/// [`WrongLength`].
+fn exact<T: FromBytes + ToJson>(
+    protocol: &'static str,
+    schema: &'static str,
+    frame: &[u8],
+) -> Result<JsonFrame, FrameError> {
+    let wrong = WrongLength { message: schema, expected: size_of::<T>(), found: frame.len() };
+    let block = T::read_from_bytes(frame).map_err(|_| FrameError::decode(protocol, frame, wrong))?;
+    block.to_json(protocol, schema)
+}
+
+/// A shared-memory block's JSON form.
+trait ToJson {
+    fn to_json(&self, protocol: &'static str, schema: &'static str) -> Result<JsonFrame, FrameError>;
+}
+
+impl<T: serde::Serialize> ToJson for [T; 4] {
+    fn to_json(&self, protocol: &'static str, schema: &'static str) -> Result<JsonFrame, FrameError> {
+        JsonFrame::serialize(protocol, schema, &Legs(self))
+    }
+}
+
+impl ToJson for NavImu {
+    fn to_json(&self, protocol: &'static str, schema: &'static str) -> Result<JsonFrame, FrameError> {
+        JsonFrame::serialize(protocol, schema, self)
+    }
+}
 
 /// A datagram of either link as JSON: `zsl1.HighLevelState`, ….
 fn datagram(protocol: &'static str, _: Direction, frame: &[u8]) -> Result<JsonFrame, FrameError> {
