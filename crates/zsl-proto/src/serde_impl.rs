@@ -157,6 +157,14 @@ impl Serialize for crate::udp::AnyDatagram {
 /// Joint names in memory order, as the shared-memory JSON keys them.
 const JOINT_NAMES: [&str; 4] = ["abad", "hip", "knee", "foot"];
 
+/// One entry per joint of a leg: `"abad"`, `"hip"`, `"knee"`, `"foot"`.
+fn by_joint_name<M: SerializeMap, T: Serialize>(map: &mut M, joints: &[T; 4]) -> Result<(), M::Error> {
+    for (name, joint) in JOINT_NAMES.iter().zip(joints) {
+        map.serialize_entry(name, joint)?;
+    }
+    Ok(())
+}
+
 /// Four legs of a shared-memory block as `{"FR": …, "FL": …, "RR": …, "RL": …}`.
 pub(crate) struct Legs<'a, T>(pub(crate) &'a [T; 4]);
 
@@ -186,9 +194,7 @@ impl Serialize for JointControl {
 impl Serialize for LegControl {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut map = s.serialize_map(Some(5))?;
-        for (name, joint) in JOINT_NAMES.iter().zip(&self.joints) {
-            map.serialize_entry(name, joint)?;
-        }
+        by_joint_name(&mut map, &self.joints)?;
         map.serialize_entry("flags", &self.flags.get())?;
         map.end()
     }
@@ -229,9 +235,7 @@ impl Serialize for JointState {
 impl Serialize for LegState {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut map = s.serialize_map(Some(4))?;
-        for (name, joint) in JOINT_NAMES.iter().zip(&self.joints) {
-            map.serialize_entry(name, joint)?;
-        }
+        by_joint_name(&mut map, &self.joints)?;
         map.end()
     }
 }
