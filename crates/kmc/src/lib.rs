@@ -16,4 +16,4 @@ pub use kmc_proto::{AllState, BatteryVoltage, ChassisFrame, VehicleSpeed};
 pub use robowire_core::NonFinite;
 pub use robowire_rt::device::{Connection, Device, Stamped};
 pub use robowire_rt::{Placement, RtError};
-pub use robowire_serial::{Backoff, LinkCounters, SerialPortOptions};
+pub use robowire_serial::{Backoff, LinkCounters, SerialPortOptions, SerialTaps};

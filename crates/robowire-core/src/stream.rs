@@ -161,12 +161,27 @@ impl<D: StreamDecoder, const N: usize> FrameBuffer<D, N> {
     }
 
     /// Feeds all of `bytes`, calling `on_frame` for every frame completed on the way.
-    pub fn push_all(&mut self, mut bytes: &[u8], mut on_frame: impl FnMut(D::Frame)) {
+    pub fn push_all(&mut self, bytes: &[u8], on_frame: impl FnMut(D::Frame)) {
+        self.push_all_by(bytes, Self::next_frame, on_frame);
+    }
+
+    /// As [`push_all`](Self::push_all), showing `seen` the bytes each step consumed
+    /// ([`next_frame_seen`](Self::next_frame_seen)).
+    pub fn push_all_seen(&mut self, bytes: &[u8], mut seen: impl FnMut(Consumed<'_>), on_frame: impl FnMut(D::Frame)) {
+        self.push_all_by(bytes, |rx| rx.next_frame_seen(&mut seen), on_frame);
+    }
+
+    fn push_all_by(
+        &mut self,
+        mut bytes: &[u8],
+        mut next_frame: impl FnMut(&mut Self) -> Option<D::Frame>,
+        mut on_frame: impl FnMut(D::Frame),
+    ) {
         loop {
             let taken = self.push(bytes);
             bytes = &bytes[taken..];
             let mut progressed = taken > 0;
-            while let Some(frame) = self.next_frame() {
+            while let Some(frame) = next_frame(self) {
                 on_frame(frame);
                 progressed = true;
             }

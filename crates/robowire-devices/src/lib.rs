@@ -23,6 +23,7 @@ pub use sim::Simulator;
 pub use zsl::state_line as zsl_state_line;
 
 use link::Link;
+use robowire_core::json::LinkProtocol;
 use robowire_record::RecordLinks;
 use serde_json::Value;
 use tokio::sync::watch;
@@ -45,7 +46,8 @@ pub struct OpenOptions {
     pub state_timeout: Option<Duration>,
     /// Record the device's links with this recorder (`None`: not recorded), named after the
     /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `dog/high_level`,
-    /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `spline/…`.
+    /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `spline/spline` (the states a
+    /// monitor takes from `/spline_shm`).
     pub record: Option<RecordLinks>,
 }
 
@@ -176,9 +178,7 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
         DeviceAddress::Hg(interface) => {
             Box::new(go2::LowLevel::<go2::Hg>::open(go2_options::<go2::Hg>(Some(interface), options))?)
         }
-        DeviceAddress::Spline(name) => {
-            Box::new(::zsl::spline::SplineMonitor::open(::zsl::spline::SplineMonitorOptions::new(name))?)
-        }
+        DeviceAddress::Spline(name) => Box::new(::zsl::spline::SplineMonitor::open(spline_options(name, options))?),
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
     };
     Ok(AnyDevice {
@@ -196,11 +196,32 @@ fn kmc_options(options: &OpenOptions) -> ::kmc::DriverOptions {
         poll_battery: options.kmc_polls,
         poll_allstate: options.kmc_polls,
         state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
-        taps: robowire_serial::SerialTaps {
-            frames: record.map(|r| r.link("kmc/serial", &kmc_proto::description::HOST)),
-            skipped: record.map(|r| r.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES)),
-        },
+        taps: record.map(|r| kmc_taps(r, &kmc_proto::description::HOST)).unwrap_or_default(),
         ..defaults
+    }
+}
+
+/// The taps of a KMC serial line recorded with `record`: its frames as `kmc/serial`, described by
+/// `side` (`kmc_proto::description::HOST` at the host, `CHASSIS` at a chassis), and the bytes the
+/// decoder skipped as `kmc/serial_skipped` (`robowire_core::json::SKIPPED_BYTES`).
+pub fn kmc_taps(record: &RecordLinks, side: &'static LinkProtocol) -> robowire_serial::SerialTaps {
+    robowire_serial::SerialTaps {
+        frames: Some(record.link("kmc/serial", side)),
+        skipped: Some(record.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES)),
+    }
+}
+
+/// The link `/spline_shm` is recorded as, seen by the controller or a monitor
+/// (`zsl_proto::description::SPLINE_CLIENT`).
+pub const SPLINE_LINK: &str = "spline/spline";
+/// The link `/imu_shm` is recorded as, seen by a reader (`zsl_proto::description::IMU`).
+pub const SPLINE_IMU_LINK: &str = "spline/imu";
+
+fn spline_options(name: &str, options: &OpenOptions) -> ::zsl::spline::SplineMonitorOptions {
+    let monitor = ::zsl::spline::SplineMonitorOptions::new(name);
+    match &options.record {
+        Some(record) => monitor.with_tap(record.link(SPLINE_LINK, &zsl_proto::description::SPLINE_CLIENT)),
+        None => monitor,
     }
 }
 

@@ -52,8 +52,7 @@ pub(crate) fn open(
             let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let tag = format!("devices-{}-{n}", std::process::id());
             let sim = SplineSim::spawn(SplineSimConfig::private(&tag)).map_err(|e| failed(e.into()))?;
-            let options = zsl::spline::SplineMonitorOptions::new(&sim.config().spline_name);
-            let monitor = zsl::spline::SplineMonitor::open(options)?;
+            let monitor = zsl::spline::SplineMonitor::open(crate::spline_options(&sim.config().spline_name, options))?;
             (Simulator::Spline(sim), Box::new(monitor))
         }
         SimKind::Go2 => {

@@ -7,7 +7,7 @@ use std::io;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use robowire_core::{DecoderCounters, FrameBuffer, StreamDecoder};
+use robowire_core::{Consumed, DecoderCounters, FrameBuffer, StreamDecoder};
 use robowire_tap::{Direction, Tap};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio_serial::{DataBits, FlowControl, Parity, SerialPort, SerialStream, StopBits};
@@ -112,6 +112,30 @@ pub struct SerialTaps {
     pub frames: Option<Tap>,
     /// Bytes skipped by the decoder (received), one record per decoding step that skipped any.
     pub skipped: Option<Tap>,
+}
+
+impl SerialTaps {
+    /// No tap at all.
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_none() && self.skipped.is_none()
+    }
+
+    /// Records what one decoding step consumed: the bytes it skipped, then its frame.
+    pub(crate) fn received(&self, consumed: Consumed<'_>) {
+        if let (Some(tap), false) = (&self.skipped, consumed.skipped.is_empty()) {
+            tap.record(Direction::Received, consumed.skipped);
+        }
+        if let (Some(tap), false) = (&self.frames, consumed.frame.is_empty()) {
+            tap.record(Direction::Received, consumed.frame);
+        }
+    }
+
+    /// Records a frame written.
+    pub fn sent(&self, frame: &[u8]) {
+        if let Some(tap) = &self.frames {
+            tap.record(Direction::Sent, frame);
+        }
+    }
 }
 
 /// Receive buffer size: at least one frame of any robowire stream codec, plus room to read
@@ -222,18 +246,8 @@ impl<D: StreamDecoder> SerialLink<D> {
     pub async fn recv(&mut self) -> Result<D::Frame, SerialError> {
         loop {
             let taps = &self.taps;
-            let frame = if taps.frames.is_none() && taps.skipped.is_none() {
-                self.rx.next_frame()
-            } else {
-                self.rx.next_frame_seen(|consumed| {
-                    if let (Some(tap), false) = (&taps.skipped, consumed.skipped.is_empty()) {
-                        tap.record(Direction::Received, consumed.skipped);
-                    }
-                    if let (Some(tap), false) = (&taps.frames, consumed.frame.is_empty()) {
-                        tap.record(Direction::Received, consumed.frame);
-                    }
-                })
-            };
+            let frame =
+                if taps.is_empty() { self.rx.next_frame() } else { self.rx.next_frame_seen(|c| taps.received(c)) };
             if let Some(frame) = frame {
                 return Ok(frame);
             }
@@ -263,9 +277,7 @@ impl<D: StreamDecoder> SerialLink<D> {
             Ok(()) => {
                 self.counters.bytes_written += frame.len() as u64;
                 self.counters.frames_written += 1;
-                if let Some(tap) = &self.taps.frames {
-                    tap.record(Direction::Sent, frame);
-                }
+                self.taps.sent(frame);
                 Ok(())
             }
             Err(e) => Err(self.disconnected(Some(e))),

@@ -23,7 +23,7 @@ use rustix::termios::{OptionalActions, tcgetattr, tcsetattr};
 
 use robowire_core::{FrameBuffer, StreamDecoder};
 
-use crate::{LinkCounters, RX_BUFFER_LEN};
+use crate::{LinkCounters, RX_BUFFER_LEN, SerialTaps};
 
 /// A pseudo-terminal pair; the master side is ours.
 #[derive(Debug)]
@@ -122,6 +122,7 @@ pub struct PtyDevice<D: StreamDecoder> {
     rx: FrameBuffer<D, RX_BUFFER_LEN>,
     counters: LinkCounters,
     buf: [u8; 512],
+    taps: SerialTaps,
 }
 
 impl<D: StreamDecoder> PtyDevice<D> {
@@ -140,7 +141,16 @@ impl<D: StreamDecoder> PtyDevice<D> {
             rx: FrameBuffer::new(new_decoder()),
             counters: LinkCounters::default(),
             buf: [0; 512],
+            taps: SerialTaps::default(),
         })
+    }
+
+    /// Hands the frames decoded (received) and the bytes the decoder skipped to `taps` from now
+    /// on, as [`SerialLink::set_taps`](crate::SerialLink::set_taps) does on the host side; what
+    /// the device writes is its own to record ([`SerialTaps::sent`]), as it alone knows where its
+    /// frames start.
+    pub fn set_taps(&mut self, taps: SerialTaps) {
+        self.taps = taps;
     }
 
     /// The path a host opens: the symlink if configured, else the pseudo-terminal.
@@ -176,7 +186,12 @@ impl<D: StreamDecoder> PtyDevice<D> {
             Err(e) => return Err(e),
         };
         self.counters.bytes_read += n as u64;
-        self.rx.push_all(&self.buf[..n], &mut on_frame);
+        let taps = &self.taps;
+        if taps.is_empty() {
+            self.rx.push_all(&self.buf[..n], &mut on_frame);
+        } else {
+            self.rx.push_all_seen(&self.buf[..n], |c| taps.received(c), &mut on_frame);
+        }
         Ok(n)
     }
 

@@ -25,7 +25,7 @@ use kmc_proto::{
     ParamId, PcControl, Rw, VehicleSpeed,
 };
 use robowire_rt::lock;
-use robowire_serial::{Pty, PtyDevice};
+use robowire_serial::{Pty, PtyDevice, SerialTaps};
 
 use crate::handover::{Published, Requests};
 
@@ -45,6 +45,12 @@ pub struct ChassisSimConfig {
     pub link: Option<PathBuf>,
     /// Seed of the garbage generator, so runs are repeatable.
     pub seed: u64,
+    /// Where the line's traffic goes for a recorder, as the chassis sees it (a link described by
+    /// `kmc_proto::description::CHASSIS`): each host frame decoded (received), each response
+    /// written (sent), and the bytes the chassis's decoder skipped (`skipped`, described by
+    /// `robowire_core::json::SKIPPED_BYTES`). Injected garbage is noise, not a frame: it is not
+    /// recorded here (the host's decoder records it as skipped). Default: nowhere.
+    pub taps: SerialTaps,
 }
 
 impl Default for ChassisSimConfig {
@@ -56,6 +62,7 @@ impl Default for ChassisSimConfig {
             command_watchdog: Some(Duration::from_secs(1)),
             link: None,
             seed: 0x5eed_cafe,
+            taps: SerialTaps::default(),
         }
     }
 }
@@ -286,6 +293,8 @@ struct Model {
     frames: Vec<HostFrame>,
     responses: Vec<ChassisFrame>,
     out: Vec<u8>,
+    /// Where each response sits in `out`, for the taps.
+    out_frames: Vec<std::ops::Range<usize>>,
 }
 
 impl Model {
@@ -304,10 +313,12 @@ impl Model {
             frames: Vec::new(),
             responses: Vec::new(),
             out: Vec::new(),
+            out_frames: Vec::new(),
         }
     }
 
     fn run(mut self, mut line: Line, handover: &Handover, stop: &AtomicBool) {
+        line.set_taps(self.config.taps.clone());
         while !stop.load(Ordering::Relaxed) {
             self.frames.clear();
             // A read error other than "no client yet" leaves the line as it is; try again.
@@ -332,7 +343,11 @@ impl Model {
             handover.requests.confirm(taken);
             if !self.out.is_empty() {
                 // A client that does not read: the answer is lost, as on a real line.
-                let _ = line.send(&self.out, WRITE_TIMEOUT);
+                if line.send(&self.out, WRITE_TIMEOUT).is_ok() {
+                    for frame in &self.out_frames {
+                        self.config.taps.sent(&self.out[frame.clone()]);
+                    }
+                }
             }
         }
     }
@@ -361,6 +376,7 @@ impl Model {
     /// This round's answers as bytes in `out`, after the garbage and without the dropped ones.
     fn emit_responses(&mut self) {
         self.out.clear();
+        self.out_frames.clear();
         if !self.responses.is_empty() && self.garbage_pending > 0 {
             let count = std::mem::take(&mut self.garbage_pending);
             for _ in 0..count {
@@ -377,6 +393,7 @@ impl Model {
             }
             let mut frame = [0u8; MAX_FRAME_LEN];
             if let Ok(len) = response.emit(&mut frame) {
+                self.out_frames.push(self.out.len()..self.out.len() + len);
                 self.out.extend_from_slice(&frame[..len]);
                 self.stats.responses_sent += 1;
             }

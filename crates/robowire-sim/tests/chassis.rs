@@ -114,3 +114,69 @@ fn requests_are_answered_while_the_api_is_hammered() {
     assert_eq!((stats.speed_requests, stats.responses_sent, stats.responses_dropped), (200, 200, 0), "{stats:?}");
     assert_eq!(sim.received().len(), 200);
 }
+
+/// Every frame in `ring`, oldest first: (link, direction, bytes).
+fn tapped(ring: &robowire_tap::TapRing) -> Vec<(u16, robowire_tap::Direction, Vec<u8>)> {
+    std::iter::from_fn(|| ring.pop(|f| (f.link, f.direction, f.bytes().to_vec()))).collect()
+}
+
+#[test]
+fn taps_record_the_line_at_both_ends_byte_for_byte() {
+    use robowire_core::json::{LinkDescription, SKIPPED_BYTES};
+    use robowire_serial::SerialTaps;
+    use robowire_tap::{Direction, TapRing};
+    let (host_ring, chassis_ring) = (TapRing::with_slots(64), TapRing::with_slots(64));
+    let taps = |ring: &TapRing| SerialTaps { frames: Some(ring.tap(0)), skipped: Some(ring.tap(1)) };
+    runtime().block_on(async {
+        let sim = ChassisSim::spawn(ChassisSimConfig { taps: taps(&chassis_ring), ..Default::default() }).unwrap();
+        let mut link = SerialLink::open(sim.path(), &SerialPortOptions::default(), ChassisFrameDecoder::new()).unwrap();
+        link.set_taps(taps(&host_ring));
+        let requests = [
+            HostFrame::PcControl(PcControl { velocity_mps: 0.25, curvature_per_m: 0.5 }),
+            HostFrame::VehicleSpeedRequest,
+            HostFrame::Af(AfFrame::battery_read(1)),
+        ];
+        let mut sent = Vec::new();
+        // Line noise the chassis's decoder must skip (no frame start among it).
+        let noise = [0x01, 0x02, 0x7e];
+        link.send(&noise).await.unwrap();
+        for request in requests {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let n = request.emit(&mut buf).unwrap();
+            link.send(&buf[..n]).await.unwrap();
+            sent.push(buf[..n].to_vec());
+        }
+        sim.inject(Fault::Garbage { bytes: 5 });
+        send(&mut link, HostFrame::Af(AfFrame::all_state_read(0))).await;
+        for _ in 0..3 {
+            recv(&mut link).await;
+        }
+        drop(link);
+        drop(sim);
+
+        let host = tapped(&host_ring);
+        let chassis = tapped(&chassis_ring);
+        let of = |frames: &[(u16, Direction, Vec<u8>)], link, direction| -> Vec<Vec<u8>> {
+            frames.iter().filter(|f| (f.0, f.1) == (link, direction)).map(|f| f.2.clone()).collect()
+        };
+        // What the host wrote, the chassis decoded, frame by frame; the noise it skipped.
+        let host_sent = of(&host, 0, Direction::Sent);
+        assert_eq!(host_sent[0], noise, "the host's own write, as it was");
+        assert_eq!(of(&chassis, 0, Direction::Received), host_sent[1..].to_vec());
+        assert_eq!(of(&chassis, 0, Direction::Received)[..3], sent[..]);
+        assert_eq!(of(&chassis, 1, Direction::Received).concat(), noise);
+        // What the chassis wrote (speed, battery, all-state), the host decoded; the garbage in
+        // front of it is only the host's skipped bytes.
+        let answers = of(&chassis, 0, Direction::Sent);
+        assert_eq!(answers.len(), 3);
+        assert_eq!(of(&host, 0, Direction::Received), answers);
+        assert_eq!(of(&host, 1, Direction::Received).concat().len(), 5);
+        assert!(of(&chassis, 1, Direction::Sent).is_empty() && of(&host, 1, Direction::Sent).is_empty());
+        for (link, direction, bytes) in &chassis {
+            let description: &dyn LinkDescription =
+                if *link == 0 { &kmc_proto::description::CHASSIS } else { &SKIPPED_BYTES };
+            description.decode(*direction, bytes).unwrap_or_else(|e| panic!("{direction:?} {bytes:02x?}: {e}"));
+        }
+        assert_eq!(host_ring.counters().dropped() + chassis_ring.counters().dropped(), 0);
+    });
+}

@@ -1,11 +1,13 @@
 //! JSON shapes of the datagrams (feature `serde`): what `robowire decode zsl --json` and
 //! `robowire dog status --json` print. Units are in the key names; joint arrays are per leg
-//! (FR, FL, RR, RL); floats in robowire-core's one JSON form.
+//! (FR, FL, RR, RL); floats in robowire-core's one JSON form. The shared-memory blocks (leg
+//! commands, leg states, an IMU record) are objects per leg (`FR`, …) and joint (`abad`, …).
 
 use robowire_core::serde_f32::F32 as Float;
 use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
 use zerocopy::little_endian::F32;
 
+use crate::shm::{JointControl, JointFaults, JointState, Leg, LegControl, LegState, NavImu};
 use crate::udp::{HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState, Model};
 
 /// Little-endian floats as a JSON array.
@@ -149,5 +151,103 @@ impl Serialize for crate::udp::AnyDatagram {
             Self::LowLevelCommand(d) => d.serialize(s),
             Self::LowLevelState(d) => d.serialize(s),
         }
+    }
+}
+
+/// Joint names in memory order, as the shared-memory JSON keys them.
+const JOINT_NAMES: [&str; 4] = ["abad", "hip", "knee", "foot"];
+
+/// One entry per joint of a leg: `"abad"`, `"hip"`, `"knee"`, `"foot"`.
+fn by_joint_name<M: SerializeMap, T: Serialize>(map: &mut M, joints: &[T; 4]) -> Result<(), M::Error> {
+    for (name, joint) in JOINT_NAMES.iter().zip(joints) {
+        map.serialize_entry(name, joint)?;
+    }
+    Ok(())
+}
+
+/// Four legs of a shared-memory block as `{"FR": …, "FL": …, "RR": …, "RL": …}`.
+pub(crate) struct Legs<'a, T>(pub(crate) &'a [T; 4]);
+
+impl<T: Serialize> Serialize for Legs<'_, T> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(4))?;
+        for (leg, value) in Leg::ALL.iter().zip(self.0) {
+            map.serialize_entry(leg.abbreviation(), value)?;
+        }
+        map.end()
+    }
+}
+
+/// `{"p_des_rad":…,"v_des_radps":…,"kp":…,"kd":…,"t_ff_nm":…}`.
+impl Serialize for JointControl {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(5))?;
+        let names = ["p_des_rad", "v_des_radps", "kp", "kd", "t_ff_nm"];
+        for (name, value) in names.iter().zip(self.values()) {
+            map.serialize_entry(name, &Float(value))?;
+        }
+        map.end()
+    }
+}
+
+/// `{"abad":{…},"hip":{…},"knee":{…},"foot":{…},"flags":1}`.
+impl Serialize for LegControl {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(5))?;
+        by_joint_name(&mut map, &self.joints)?;
+        map.serialize_entry("flags", &self.flags.get())?;
+        map.end()
+    }
+}
+
+/// `{"overvoltage":false,"overcurrent":false,…}`.
+impl Serialize for JointFaults {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(5))?;
+        map.serialize_entry("overvoltage", &self.overvoltage)?;
+        map.serialize_entry("overcurrent", &self.overcurrent)?;
+        map.serialize_entry("over_temperature", &self.over_temperature)?;
+        map.serialize_entry("overspeed", &self.overspeed)?;
+        map.serialize_entry("dual_encoder", &self.dual_encoder)?;
+        map.end()
+    }
+}
+
+/// `{"p_rad":…,"v_radps":…,"t_nm":…,"flags":…,"enabled":true,"faults":{…},"voltage_v":48,
+/// "temperature_c":25}`: the flag word as it is and decoded (spec §4.4).
+impl Serialize for JointState {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let flags = self.joint_flags();
+        let mut map = s.serialize_map(Some(8))?;
+        map.serialize_entry("p_rad", &Float(self.p.get()))?;
+        map.serialize_entry("v_radps", &Float(self.v.get()))?;
+        map.serialize_entry("t_nm", &Float(self.t.get()))?;
+        map.serialize_entry("flags", &flags.0)?;
+        map.serialize_entry("enabled", &flags.enabled())?;
+        map.serialize_entry("faults", &flags.faults())?;
+        map.serialize_entry("voltage_v", &flags.voltage_v())?;
+        map.serialize_entry("temperature_c", &flags.temperature_c())?;
+        map.end()
+    }
+}
+
+/// `{"abad":{…},"hip":{…},"knee":{…},"foot":{…}}`.
+impl Serialize for LegState {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(4))?;
+        by_joint_name(&mut map, &self.joints)?;
+        map.end()
+    }
+}
+
+/// `{"timestamp_ns":…,"acc_mps2":[…],"gyro_radps":[…],"quaternion_wxyz":[…]}`.
+impl Serialize for NavImu {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut map = s.serialize_map(Some(4))?;
+        map.serialize_entry("timestamp_ns", &self.timestamp_ns.get())?;
+        map.serialize_entry("acc_mps2", &Floats(&self.sample.acc))?;
+        map.serialize_entry("gyro_radps", &Floats(&self.sample.gyro))?;
+        map.serialize_entry("quaternion_wxyz", &Floats(&self.sample.q))?;
+        map.end()
     }
 }

@@ -186,3 +186,71 @@ fn imu_writer_racing_the_reader_never_yields_a_torn_sample() {
     let written = writer.join().unwrap();
     assert!(consistent > 0 && written > 1, "the race happened: {consistent} reads, {written} writes");
 }
+
+/// Every frame in `ring`, oldest first: (direction, bytes).
+fn tapped(ring: &robowire_tap::TapRing) -> Vec<(robowire_tap::Direction, Vec<u8>)> {
+    std::iter::from_fn(|| ring.pop(|f| (f.direction, f.bytes().to_vec()))).collect()
+}
+
+#[test]
+fn taps_record_each_side_byte_for_byte_both_ways() {
+    use robowire_core::json::LinkDescription;
+    use robowire_tap::{Direction, TapRing};
+    use zsl_proto::description::{IMU, SPLINE_CLIENT, SPLINE_DAEMON};
+    use zsl_proto::zerocopy::IntoBytes;
+
+    let shared = region();
+    let (client_ring, daemon_ring) = (TapRing::with_slots(16), TapRing::with_slots(16));
+    let mut client = SplineClient::new(shared.clone()).unwrap().with_tap(client_ring.tap(0));
+    let mut daemon = SplineDaemon::new(shared.clone()).unwrap().with_tap(daemon_ring.tap(0));
+    let mut cmd = command(0.5);
+    cmd.legs[1].flags = 7.into();
+    client.write_command(&cmd).unwrap();
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Fresh);
+    assert_eq!(daemon.take_command().unwrap(), CommandUpdate::Repeated, "nothing fresh: nothing recorded");
+    let mut state = SplineStateBlock::default();
+    state.joint_mut(Leg::RearRight, JointIndex::Knee).p = (-1.5).into();
+    state.joint_mut(Leg::RearRight, JointIndex::Knee).flags = 0x0030_4101.into();
+    daemon.publish_state(&state).unwrap();
+    assert!(client.try_read_state().unwrap().is_some());
+    assert_eq!(client.try_read_state().unwrap(), None, "nothing fresh: nothing recorded");
+    // A refused command never reached the region: not recorded.
+    let mut bad = command(0.1);
+    bad.joint_mut(Leg::FrontRight, JointIndex::Hip).kd = f32::NAN.into();
+    assert!(client.write_command(&bad).is_err());
+
+    // What went through the region, as published (leg flags written as 1) and as taken.
+    let sent = cmd.normalized().legs.as_bytes().to_vec();
+    let states = state.legs.as_bytes().to_vec();
+    assert_eq!(tapped(&client_ring), [(Direction::Sent, sent.clone()), (Direction::Received, states.clone())]);
+    assert_eq!(tapped(&daemon_ring), [(Direction::Received, sent.clone()), (Direction::Sent, states.clone())]);
+    let command_json = SPLINE_CLIENT.decode(Direction::Sent, &sent).unwrap().value;
+    assert_eq!(command_json, SPLINE_DAEMON.decode(Direction::Received, &sent).unwrap().value);
+    assert_eq!(command_json["FL"]["flags"], 1);
+    let state_json = SPLINE_CLIENT.decode(Direction::Received, &states).unwrap().value;
+    assert_eq!(
+        (&state_json["RR"]["knee"]["p_rad"], &state_json["RR"]["knee"]["temperature_c"]),
+        (&(-1.5).into(), &25.into())
+    );
+
+    // The IMU: the record as published and as read, timestamp first.
+    let imu_region = Arc::new(HeapRegion::new(1024));
+    let (writer_ring, reader_ring) = (TapRing::with_slots(4), TapRing::with_slots(4));
+    let mut writer = ImuWriter::new(imu_region.clone()).unwrap().with_tap(writer_ring.tap(0));
+    let mut reader = ImuReader::new(imu_region).unwrap().with_tap(reader_ring.tap(0));
+    assert!(matches!(reader.read(), Err(ImuError::NoSample)), "no sample: nothing recorded");
+    let record = NavImu {
+        timestamp_ns: 123_456_789.into(),
+        sample: NavImuSample {
+            acc: [0.25, -0.5, 9.75].map(Into::into),
+            gyro: [0.0; 3].map(Into::into),
+            q: [1.0, 0.0, 0.0, 0.0].map(Into::into),
+        },
+    };
+    writer.publish(&record).unwrap();
+    assert_eq!(reader.read().unwrap().timestamp_ns, 123_456_789);
+    assert_eq!(tapped(&writer_ring), [(Direction::Sent, record.as_bytes().to_vec())]);
+    assert_eq!(tapped(&reader_ring), [(Direction::Received, record.as_bytes().to_vec())]);
+    let imu_json = IMU.decode(Direction::Received, record.as_bytes()).unwrap().value;
+    assert_eq!((&imu_json["timestamp_ns"], &imu_json["acc_mps2"][2]), (&123_456_789.into(), &9.75.into()));
+}

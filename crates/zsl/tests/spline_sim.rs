@@ -157,3 +157,47 @@ fn a_monitor_sees_every_state_and_a_stall_without_taking_the_controllers_flag() 
         Err(SplineError::DaemonNotRunning { .. })
     ));
 }
+
+#[test]
+fn the_daemon_and_a_monitor_record_the_same_states_and_the_daemon_each_command_taken() {
+    use robowire_tap::{Direction, TapRing};
+    use zsl::spline::{SplineMonitor, SplineMonitorOptions};
+    use zsl::udp::Device;
+    use zsl_proto::zerocopy::IntoBytes;
+    let _turn = one_at_a_time();
+    let (daemon_ring, imu_ring, monitor_ring) =
+        (TapRing::with_slots(1 << 12), TapRing::with_slots(1 << 12), TapRing::with_slots(1 << 10));
+    let config = SplineSimConfig {
+        tap: Some(daemon_ring.tap(0)),
+        imu_tap: Some(imu_ring.tap(0)),
+        ..SplineSimConfig::private("taps")
+    };
+    let sim = SplineSim::spawn(config).expect("simulator");
+    let monitor =
+        SplineMonitor::open(SplineMonitorOptions::new(&sim.config().spline_name).with_tap(monitor_ring.tap(0)))
+            .unwrap();
+    let mut controller = client(&sim, WATCHDOG);
+    let command = hold(STANDING_POSE_RAD, 20.0, 1.0);
+    controller.write_command(&command).unwrap();
+    wait_until("the command taken", || sim.stats().daemon.fresh == 1);
+    wait_until("a few states monitored", || monitor.stats().states >= 5);
+    monitor.close();
+    drop(sim);
+
+    let frames = |ring: &TapRing| -> Vec<(Direction, Vec<u8>)> {
+        std::iter::from_fn(|| ring.pop(|f| (f.direction, f.bytes().to_vec()))).collect()
+    };
+    let daemon = frames(&daemon_ring);
+    let taken: Vec<_> = daemon.iter().filter(|(d, _)| *d == Direction::Received).collect();
+    assert_eq!(taken, [&(Direction::Received, command.normalized().legs.as_bytes().to_vec())]);
+    let published: Vec<_> = daemon.iter().filter(|(d, _)| *d == Direction::Sent).map(|(_, b)| b).collect();
+    let monitored = frames(&monitor_ring);
+    assert!(monitored.len() >= 5, "{} states monitored", monitored.len());
+    assert!(monitored.iter().all(|(d, state)| (*d, state.len()) == (Direction::Received, 256)));
+    // A copy may mix two daemon cycles (spec §6.3); one taken between two cycles is, byte for
+    // byte, a state the daemon published.
+    let as_published = monitored.iter().filter(|(_, state)| published.contains(&state)).count();
+    assert!(as_published * 2 >= monitored.len(), "{as_published} of {} states as published", monitored.len());
+    let imu = frames(&imu_ring);
+    assert!(!imu.is_empty() && imu.iter().all(|(d, b)| *d == Direction::Sent && b.len() == 48));
+}

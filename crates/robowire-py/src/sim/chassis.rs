@@ -61,6 +61,7 @@ impl Chassis {
             command_watchdog: command_watchdog_s.map(|s| seconds("command_watchdog_s", s)).transpose()?,
             link,
             seed,
+            ..ChassisSimConfig::default()
         };
         if config.speed_time_constant.is_zero() || config.command_watchdog.is_some_and(|w| w < Duration::from_millis(1))
         {

@@ -3,6 +3,7 @@
 //! `zsl-proto`'s layouts. Usable by any daemon; the simulator's loop is built on it.
 
 use robowire_shm::{CreateOptions, MappedRegion, RegionError, SharedRegion, ShmError};
+use robowire_tap::{Direction, SampleOrigin, Tap};
 use zsl_proto::shm::{
     IMU_RECORD, IMU_SHM_SIZE, LegControl, NAV_IMU_LEN, NavImu, SPLINE_COMMAND, SPLINE_DATA_LEN, SPLINE_SHM_SIZE,
     SPLINE_STATE, SplineCommandBlock, SplineStateBlock,
@@ -67,6 +68,7 @@ pub struct SplineDaemon<R: SharedRegion = MappedRegion> {
     missed: u32,
     clear_after: u32,
     counters: SplineDaemonCounters,
+    tap: Option<Tap>,
 }
 
 impl SplineDaemon<MappedRegion> {
@@ -88,7 +90,17 @@ impl<R: SharedRegion> SplineDaemon<R> {
             missed: 0,
             clear_after: DEFAULT_CLEAR_AFTER_CYCLES,
             counters: SplineDaemonCounters::default(),
+            tap: None,
         })
+    }
+
+    /// Hands each command taken (received: its 336 bytes of legs as copied out, rejected ones
+    /// too) and each state published (sent: its 256 bytes of legs) to `tap`, a link described by
+    /// `zsl_proto::description::SPLINE_DAEMON`. A copy into the tap's ring: no allocation, no lock.
+    #[must_use]
+    pub fn with_tap(mut self, tap: Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// Clears the command after this many cycles without a fresh one (default 10).
@@ -104,6 +116,9 @@ impl<R: SharedRegion> SplineDaemon<R> {
         let spare = 1 - self.active;
         let legs: &mut [LegControl; 4] = &mut self.buffers[spare].legs;
         if self.region.take(&SPLINE_COMMAND, legs.as_mut_bytes())? {
+            if let Some(tap) = &self.tap {
+                tap.record(Direction::Received, legs.as_bytes());
+            }
             if self.buffers[spare].first_non_finite().is_none() {
                 self.active = spare;
                 self.cleared = false;
@@ -143,6 +158,9 @@ impl<R: SharedRegion> SplineDaemon<R> {
     pub fn publish_state(&mut self, state: &SplineStateBlock) -> Result<(), DaemonError> {
         self.region.publish(&SPLINE_STATE, state.legs.as_bytes())?;
         self.counters.states_published += 1;
+        if let Some(tap) = &self.tap {
+            tap.record(Direction::Sent, state.legs.as_bytes());
+        }
         Ok(())
     }
 
@@ -157,6 +175,7 @@ impl<R: SharedRegion> SplineDaemon<R> {
 #[derive(Debug)]
 pub struct ImuWriter<R: SharedRegion = MappedRegion> {
     region: R,
+    tap: Option<Tap>,
 }
 
 impl ImuWriter<MappedRegion> {
@@ -170,12 +189,25 @@ impl<R: SharedRegion> ImuWriter<R> {
     /// A writer on `region` (at least 48 bytes).
     pub fn new(region: R) -> Result<Self, DaemonError> {
         region.check_fits(NAV_IMU_LEN)?;
-        Ok(Self { region })
+        Ok(Self { region, tap: None })
+    }
+
+    /// Hands each record published (sent: the 48-byte `nav_imu`, its timestamp as published,
+    /// then the sample) to `tap`, a link described by `zsl_proto::description::IMU`.
+    #[must_use]
+    pub fn with_tap(mut self, tap: Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// Publishes `record` (a timestamp of 0 is published as 1: 0 means "no record").
     pub fn publish(&mut self, record: &NavImu) -> Result<(), DaemonError> {
         let version = record.timestamp_ns.get().max(1);
-        Ok(self.region.write_versioned(&IMU_RECORD, version, record.sample.as_bytes())?)
+        self.region.write_versioned(&IMU_RECORD, version, record.sample.as_bytes())?;
+        if let Some(tap) = &self.tap {
+            let parts: [&[u8]; 2] = [&version.to_le_bytes(), record.sample.as_bytes()];
+            tap.record_parts(Direction::Sent, &parts, SampleOrigin::NONE);
+        }
+        Ok(())
     }
 }

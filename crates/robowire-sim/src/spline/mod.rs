@@ -19,6 +19,7 @@ use robowire_rt::Latest;
 use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions, Waker};
 use robowire_rt::stats::Counter;
 use robowire_shm::CreateOptions;
+use robowire_tap::Tap;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 use zsl_proto::shm::{
     IMU_SHM_NAME, JointFlags, JointIndex, Leg, NavImu, NavImuSample, SPLINE_SHM_NAME, SplineCommandBlock,
@@ -48,6 +49,13 @@ pub struct SplineSimConfig {
     pub period: Duration,
     /// The last part of each wait, spent spinning (default the runner's [`DEFAULT_SPIN`]).
     pub spin: Duration,
+    /// Where `/spline_shm`'s traffic goes for a recorder, as the daemon sees it: each command
+    /// taken (received) and each state published (sent), a link described by
+    /// `zsl_proto::description::SPLINE_DAEMON` ([`SplineDaemon::with_tap`]). Default: nowhere.
+    pub tap: Option<Tap>,
+    /// Where each IMU record published goes (sent; `zsl_proto::description::IMU`). Default:
+    /// nowhere.
+    pub imu_tap: Option<Tap>,
 }
 
 impl Default for SplineSimConfig {
@@ -58,6 +66,8 @@ impl Default for SplineSimConfig {
             create: CreateOptions::default(),
             period: Duration::from_millis(1),
             spin: DEFAULT_SPIN,
+            tap: None,
+            imu_tap: None,
         }
     }
 }
@@ -153,8 +163,14 @@ pub struct SplineSim {
 impl SplineSim {
     /// Creates both objects and starts the 1 kHz loop.
     pub fn spawn(config: SplineSimConfig) -> Result<Self, SplineSimError> {
-        let daemon = SplineDaemon::create(&config.spline_name, &config.create)?;
-        let imu = ImuWriter::create(&config.imu_name, &config.create)?;
+        let mut daemon = SplineDaemon::create(&config.spline_name, &config.create)?;
+        if let Some(tap) = &config.tap {
+            daemon = daemon.with_tap(tap.clone());
+        }
+        let mut imu = ImuWriter::create(&config.imu_name, &config.create)?;
+        if let Some(tap) = &config.imu_tap {
+            imu = imu.with_tap(tap.clone());
+        }
         let handover = Arc::new(Handover {
             requests: Requests::new(REQUESTS),
             stream: StreamStats::default(),

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Args;
 use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
+use robowire_record::RecordLinks;
 
 /// A device and how to reach it.
 #[derive(Debug, Args)]
@@ -22,6 +23,10 @@ pub(crate) struct DeviceArgs {
     /// Seconds to wait for the device's first state.
     #[arg(long, default_value_t = 5.0)]
     connect_timeout_s: f64,
+    /// Record the device's links, both ways, named after the device (`kmc/serial`,
+    /// `dog/high_level`, `go2/low_level`, `spline/spline`, …).
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Debug, Args)]
@@ -39,10 +44,29 @@ impl DeviceArgs {
         self.address.is_simulated() && self.address.uses_dds()
     }
 
-    /// Opens the device and waits for its first state.
-    async fn open(&self) -> anyhow::Result<AnyDevice> {
+    /// Opens the device (recording it with `--record`), waits for its first state, hands it to
+    /// `run`, then prints its statistics and closes it, and the capture after it.
+    fn recording<F: Future<Output = anyhow::Result<AnyDevice>>>(
+        &self,
+        command: &str,
+        run: impl FnOnce(AnyDevice) -> F,
+    ) -> anyhow::Result<ExitCode> {
+        let recorder = self.record.start(&format!("{command} {}", self.address))?;
+        let ran = runtime()?.block_on(async {
+            let device = run(self.open(recorder.as_ref().map(robowire_record::Recorder::links)).await?).await?;
+            eprintln!("{}", device.stats_line());
+            device.close().context("closing the device")
+        });
+        // The device is closed (or never opened): the capture holds all it saw.
+        crate::cmd::record::finish(recorder)?;
+        ran.map(|()| ExitCode::SUCCESS)
+    }
+
+    /// Opens the device, its links recorded with `record` if given, and waits for its first
+    /// state.
+    async fn open(&self, record: Option<RecordLinks>) -> anyhow::Result<AnyDevice> {
         let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
-        let options = OpenOptions { domain: self.domain, zsl_local: self.local, ..OpenOptions::default() };
+        let options = OpenOptions { domain: self.domain, zsl_local: self.local, record, ..OpenOptions::default() };
         let address = &self.address;
         let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
         if !device.wait_state(timeout).await {
@@ -87,28 +111,22 @@ fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
 
 /// `robowire status ADDRESS`: one state.
 pub(crate) fn status(args: &StatusArgs) -> anyhow::Result<ExitCode> {
-    runtime()?.block_on(async {
-        let device = args.device.open().await?;
+    args.device.recording("robowire status", |device| async move {
         if args.json {
             let state = device.status_json().context("no state")?;
             println!("{}", serde_json::to_string_pretty(&state)?);
         } else {
             println!("{}", device.status_text().context("no state")?);
         }
-        eprintln!("{}", device.stats_line());
-        device.close().context("closing the device")?;
-        Ok(ExitCode::SUCCESS)
+        Ok(device)
     })
 }
 
 /// `robowire watch ADDRESS`: the state ten times a second and every connection change, until
 /// Ctrl-C.
 pub(crate) fn watch(args: &DeviceArgs) -> anyhow::Result<ExitCode> {
-    runtime()?.block_on(async {
-        let device = args.open().await?;
+    args.recording("robowire watch", |device| async move {
         crate::cmd::live::watch_until_ctrl_c(device.connection_events(), || device.status_line()).await?;
-        eprintln!("{}", device.stats_line());
-        device.close().context("closing the device")?;
-        Ok(ExitCode::SUCCESS)
+        Ok(device)
     })
 }

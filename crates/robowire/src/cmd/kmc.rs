@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use kmc::{BlockingUartClient, ChassisFrame, Driver, DriverOptions, SerialPortOptions};
+use kmc::{BlockingUartClient, ChassisFrame, Driver, DriverOptions, SerialPortOptions, SerialTaps};
 use robowire_devices::Describe;
 
 #[derive(Debug, Args)]
@@ -20,6 +20,9 @@ pub(crate) struct KmcArgs {
     /// Turn RTS/CTS hardware flow control off (it is on by default, as the chassis expects).
     #[arg(long)]
     no_flow_control: bool,
+    /// Record the line's frames, both ways, and the bytes skipped between them.
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
     #[command(subcommand)]
     command: KmcCommand,
 }
@@ -68,24 +71,33 @@ pub(crate) fn run(args: KmcArgs) -> anyhow::Result<ExitCode> {
         rts_cts_flow_control: !args.no_flow_control,
         ..SerialPortOptions::default()
     };
-    match args.command {
-        KmcCommand::Drive(drive) => run_drive(&args.port, serial, &drive),
+    let recorder = args.record.start("robowire kmc")?;
+    let taps = recorder
+        .as_ref()
+        .map(|r| robowire_devices::kmc_taps(&r.links(), &kmc_proto::description::HOST))
+        .unwrap_or_default();
+    let port = &args.port;
+    let result = match args.command {
+        KmcCommand::Drive(drive) => run_drive(port, DriverOptions { serial, taps, ..Default::default() }, &drive),
         KmcCommand::Speed(one) => {
-            one_shot(&args.port, &serial, &one, "vehicle speed", |c, _| c.request_vehicle_speed())
+            one_shot(port, &serial, taps, &one, "vehicle speed", |c, _| c.request_vehicle_speed())
         }
         KmcCommand::Battery(one) => {
-            one_shot(&args.port, &serial, &one, "battery voltage", |c, m| c.request_battery_voltage(m))
+            one_shot(port, &serial, taps, &one, "battery voltage", |c, m| c.request_battery_voltage(m))
         }
-        KmcCommand::AllState(one) => one_shot(&args.port, &serial, &one, "all-state", |c, m| c.request_all_state(m)),
-    }
+        KmcCommand::AllState(one) => one_shot(port, &serial, taps, &one, "all-state", |c, m| c.request_all_state(m)),
+    };
+    // The link is closed by now: the capture holds all it saw, the stop burst too.
+    crate::cmd::record::finish(recorder)?;
+    result
 }
 
-fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> anyhow::Result<ExitCode> {
+/// Drives with `options` (its serial port and taps), polling as `args` says.
+fn run_drive(port: &PathBuf, options: DriverOptions, args: &DriveArgs) -> anyhow::Result<ExitCode> {
     if !(args.duration.is_finite() && args.duration >= 0.0) {
         bail!("--duration must be a finite number of seconds, got {}", args.duration);
     }
-    let options =
-        DriverOptions { serial, poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..Default::default() };
+    let options = DriverOptions { poll_battery: !args.no_polls, poll_allstate: !args.no_polls, ..options };
     // Validate before the port is even opened.
     Driver::command(args.velocity, args.yaw_rate).context("refusing to drive")?;
     let stop_burst = options.stop_burst_count;
@@ -113,11 +125,13 @@ fn run_drive(port: &PathBuf, serial: SerialPortOptions, args: &DriveArgs) -> any
 fn one_shot(
     port: &PathBuf,
     serial: &SerialPortOptions,
+    taps: SerialTaps,
     args: &OneShotArgs,
     what: &str,
     request: impl Fn(&mut BlockingUartClient, u8) -> Result<(), kmc::KmcError>,
 ) -> anyhow::Result<ExitCode> {
     let mut client = BlockingUartClient::open(port, serial)?;
+    client.client_mut().link_mut().set_taps(taps);
     request(&mut client, args.motor)?;
     match client.poll(Duration::from_millis(args.timeout_ms))? {
         Some(frame) => {

@@ -71,6 +71,10 @@ pub(crate) struct SplineSimArgs {
     /// Print the simulator's counters every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
+    /// Record the daemon's side of /spline_shm (commands taken, states published) and the IMU
+    /// records it publishes.
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 fn parse_octal(text: &str) -> Result<u32, String> {
@@ -88,6 +92,10 @@ pub(crate) struct KmcSimArgs {
     /// Print the simulator's counters every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
+    /// Record the chassis's side of the line (host frames decoded, responses sent, bytes
+    /// skipped).
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
@@ -122,10 +130,14 @@ fn until_ctrl_c(every_s: f64, mut report: impl FnMut()) -> anyhow::Result<()> {
 }
 
 fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
+    use zsl_proto::description::{IMU, SPLINE_DAEMON};
+    let recorder = args.record.start("robowire sim spline")?;
     let config = robowire_sim::spline::SplineSimConfig {
         spline_name: args.name.clone(),
         imu_name: args.imu_name.clone(),
         create: robowire_shm::CreateOptions { mode: args.mode, unlink_on_drop: true },
+        tap: recorder.as_ref().map(|r| r.link(robowire_devices::SPLINE_LINK, &SPLINE_DAEMON)),
+        imu_tap: recorder.as_ref().map(|r| r.link(robowire_devices::SPLINE_IMU_LINK, &IMU)),
         ..Default::default()
     };
     let sim = robowire_sim::spline::SplineSim::spawn(config).context("starting the spline daemon simulator")?;
@@ -149,13 +161,20 @@ fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
             s.daemon.rejected
         );
     })?;
+    drop(sim);
+    crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)
 }
 
 fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
+    let recorder = args.record.start("robowire sim kmc")?;
     let config = ChassisSimConfig {
         link: args.link.clone(),
         command_watchdog: (args.watchdog_ms > 0).then(|| Duration::from_millis(args.watchdog_ms)),
+        taps: recorder
+            .as_ref()
+            .map(|r| robowire_devices::kmc_taps(&r.links(), &kmc_proto::description::CHASSIS))
+            .unwrap_or_default(),
         ..ChassisSimConfig::default()
     };
     let sim = ChassisSim::spawn(config).context("starting the chassis simulator")?;
@@ -184,6 +203,8 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
             s.decoder.rejected_candidates
         );
     })?;
+    drop(sim);
+    crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -5,6 +5,7 @@ use std::time::Duration;
 use robowire_rt::Time;
 
 use robowire_shm::{MappedRegion, RegionError, SharedRegion, ShmError};
+use robowire_tap::{Direction, Tap};
 use zsl_proto::shm::{
     ConsumerIndex, JointIndex, Leg, SPLINE_COMMAND, SPLINE_DATA_LEN, SplineCommandBlock, SplineStateBlock,
 };
@@ -98,6 +99,7 @@ pub struct SplineClient<R: SharedRegion = MappedRegion> {
     waiting_since: Option<Time>,
     stalled: bool,
     counters: SplineClientCounters,
+    tap: Option<Tap>,
 }
 
 impl SplineClient<MappedRegion> {
@@ -122,7 +124,18 @@ impl<R: SharedRegion> SplineClient<R> {
             waiting_since: None,
             stalled: false,
             counters: SplineClientCounters::default(),
+            tap: None,
         })
+    }
+
+    /// Hands each command published (sent: its 336 bytes of legs, as written) and each fresh
+    /// state taken (received: its 256 bytes of legs, as copied out) to `tap`, a link described by
+    /// `zsl_proto::description::SPLINE_CLIENT`. A copy into the tap's ring: no allocation, no
+    /// lock, no clock but the monotonic one.
+    #[must_use]
+    pub fn with_tap(mut self, tap: Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// Reads state as another consumer (a monitor): uses `consumer_flags[OTHER]`, so the
@@ -162,8 +175,12 @@ impl<R: SharedRegion> SplineClient<R> {
         if let Some((leg, joint, field)) = command.first_non_finite() {
             return Err(SplineError::NonFinite { leg, joint, field: FIELD_NAMES[field] });
         }
-        self.region.publish(&[SPLINE_COMMAND], command.normalized().legs.as_bytes())?;
+        let legs = command.normalized().legs;
+        self.region.publish(&[SPLINE_COMMAND], legs.as_bytes())?;
         self.counters.commands_written += 1;
+        if let Some(tap) = &self.tap {
+            tap.record(Direction::Sent, legs.as_bytes());
+        }
         Ok(())
     }
 
@@ -201,6 +218,9 @@ impl<R: SharedRegion> SplineClient<R> {
             return Ok(None);
         }
         self.counters.states_read += 1;
+        if let Some(tap) = &self.tap {
+            tap.record(Direction::Received, state.legs.as_bytes());
+        }
         self.waiting_since = None;
         self.stalled = false;
         Ok(Some(state))

@@ -3,6 +3,7 @@
 use std::time::Duration;
 
 use robowire_shm::{MappedRegion, RegionError, SharedRegion, ShmError, VersionedReadError};
+use robowire_tap::{Direction, SampleOrigin, Tap};
 use zsl_proto::shm::{IMU_RECORD, NAV_IMU_LEN, NavImuSample};
 use zsl_proto::zerocopy::{FromZeros, IntoBytes};
 
@@ -83,6 +84,7 @@ pub struct ImuReader<R: SharedRegion = MappedRegion> {
     region: R,
     max_attempts: u32,
     counters: ImuReaderCounters,
+    tap: Option<Tap>,
 }
 
 impl ImuReader<MappedRegion> {
@@ -100,7 +102,16 @@ impl<R: SharedRegion> ImuReader<R> {
     /// A reader on `region` (at least 48 bytes), 16 attempts per read.
     pub fn new(region: R) -> Result<Self, ImuError> {
         region.check_fits(NAV_IMU_LEN)?;
-        Ok(Self { region, max_attempts: 16, counters: ImuReaderCounters::default() })
+        Ok(Self { region, max_attempts: 16, counters: ImuReaderCounters::default(), tap: None })
+    }
+
+    /// Hands each sample read (received) to `tap`, a link described by
+    /// `zsl_proto::description::IMU`: the 48-byte `nav_imu` record as accepted, its timestamp
+    /// (little-endian) then the sample. A copy into the tap's ring: no allocation, no lock.
+    #[must_use]
+    pub fn with_tap(mut self, tap: Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 
     /// Attempts per read (at least 1).
@@ -117,6 +128,10 @@ impl<R: SharedRegion> ImuReader<R> {
             Ok(read) => {
                 self.counters.reads += 1;
                 self.counters.retries += u64::from(read.attempts - 1);
+                if let Some(tap) = &self.tap {
+                    let parts: [&[u8]; 2] = [&read.version.to_le_bytes(), sample.as_bytes()];
+                    tap.record_parts(Direction::Received, &parts, SampleOrigin::NONE);
+                }
                 Ok(ImuSample {
                     timestamp_ns: read.version,
                     acc_mps2: sample.acc.map(|v| v.get()),

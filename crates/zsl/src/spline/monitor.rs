@@ -12,6 +12,7 @@ use std::time::Duration;
 use robowire_rt::Time;
 use robowire_rt::device::{Device, FeedStats, Receive, Received, Receiving};
 use robowire_rt::schedule::Watchdog;
+use robowire_tap::Tap;
 use zsl_proto::shm::{ConsumerIndex, SplineStateBlock};
 
 use super::{SplineClient, SplineError};
@@ -25,12 +26,22 @@ pub struct SplineMonitorOptions {
     pub poll: Duration,
     /// No fresh state for this long: `Disconnected`. Default 100 ms.
     pub stall_after: Duration,
+    /// Where each fresh state read goes for a recorder (received, its 256 bytes of legs; a link
+    /// described by `zsl_proto::description::SPLINE_CLIENT`). Default: nowhere.
+    pub tap: Option<Tap>,
 }
 
 impl SplineMonitorOptions {
     /// The daemon's object `name`, polled every 1 ms, stalled after 100 ms.
     pub fn new(name: impl Into<String>) -> Self {
-        Self { name: name.into(), poll: Duration::from_millis(1), stall_after: Duration::from_millis(100) }
+        Self { name: name.into(), poll: Duration::from_millis(1), stall_after: Duration::from_millis(100), tap: None }
+    }
+
+    /// The same, each state read handed to `tap` ([`tap`](Self::tap)).
+    #[must_use]
+    pub fn with_tap(mut self, tap: Tap) -> Self {
+        self.tap = Some(tap);
+        self
     }
 }
 
@@ -86,9 +97,13 @@ impl SplineMonitor {
     pub fn open(options: SplineMonitorOptions) -> Result<Self, SplineError> {
         let watchdog = Watchdog::new(robowire_rt::now(), options.stall_after);
         let (receiving, ()) = Receiving::spawn("spline-monitor", watchdog, {
-            let (name, poll) = (options.name.clone(), options.poll);
+            let (name, poll, tap) = (options.name.clone(), options.poll, options.tap.clone());
             move || async move {
                 let client = SplineClient::open(&name)?.with_consumer(ConsumerIndex::Other);
+                let client = match tap {
+                    Some(tap) => client.with_tap(tap),
+                    None => client,
+                };
                 Ok::<_, SplineError>((SplineLink { client, poll }, ()))
             }
         })?;

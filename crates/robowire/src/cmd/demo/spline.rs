@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use robowire_core::timing::LatenessRing;
+use robowire_devices::{SPLINE_IMU_LINK, SPLINE_LINK};
 use robowire_sim::spline::{LYING_POSE_RAD, STANDING_POSE_RAD, SplineSim, SplineSimConfig};
 use zsl::spline::{ImuReader, SplineError};
 use zsl::{JointControl, JointIndex, Leg, SplineClient, SplineCommandBlock};
@@ -33,13 +34,20 @@ fn command(pose: [f32; 3]) -> SplineCommandBlock {
     cmd
 }
 
-pub(super) fn run(duration_s: f64, out: &Output, _record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
+/// The controller reads the IMU every this many cycles.
+const IMU_EVERY: u64 = 10;
+
+pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== ZSL-1 low level (spline daemon on shared memory, 1 kHz) =="));
     let sim = SplineSim::spawn(SplineSimConfig::private("demo")).context("starting the spline daemon simulator")?;
     let names = sim.config().clone();
     out.line(format_args!("simulator on {} and {}", names.spline_name, names.imu_name));
     let mut client = SplineClient::open(&names.spline_name)?;
     let mut imu = ImuReader::open(&names.imu_name)?;
+    if let Some(record) = record {
+        client = client.with_tap(record.link(SPLINE_LINK, &zsl_proto::description::SPLINE_CLIENT));
+        imu = imu.with_tap(record.link(SPLINE_IMU_LINK, &zsl_proto::description::IMU));
+    }
 
     let move_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
     let hold_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
@@ -75,6 +83,10 @@ pub(super) fn run(duration_s: f64, out: &Output, _record: Option<&RecordLinks>) 
         let fraction = elapsed.as_secs_f32() / move_time.as_secs_f32();
         client.write_command(&command(pose_at(fraction)))?;
         cycles += 1;
+        if cycles.is_multiple_of(IMU_EVERY) {
+            // The attitude, as a controller would read it (the demo itself only uses its age).
+            let _ = imu.read();
+        }
         if progress.due() {
             progress.show(&Status {
                 mode: if elapsed < move_time { "stand-up" } else { "hold" },
@@ -151,6 +163,7 @@ pub(super) fn run(duration_s: f64, out: &Output, _record: Option<&RecordLinks>) 
         ("commands", client.counters().commands_written),
         ("states", client.counters().states_read),
         ("wait timeouts", timeouts),
+        ("IMU reads", imu.counters().reads),
         ("daemon missed", sim_stats.missed_cycles),
     ];
     report.faults = vec![InjectedFault::new(
