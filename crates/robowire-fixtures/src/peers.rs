@@ -1,6 +1,6 @@
 //! The vendors' own software as the other end of the wire in interop tests
 //! (`../shared/peers/`, see its README): a CPython 3.10 environment with `cyclonedds` 0.10.2
-//! (Unitree's pin; its wheel bundles libddsc), numpy, mcap (the capture reader) and Unitree's Python SDK installed as its
+//! (Unitree's pin; its wheel bundles libddsc), numpy, mcap, mcap-ros2-support and rosbags (the capture readers) and Unitree's Python SDK installed as its
 //! README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
 //! tree stays untouched).
 //!
@@ -16,6 +16,10 @@ use std::process::Command;
 pub const CYCLONEDDS_VERSION: &str = "0.10.2";
 /// The `mcap` Python package: the independent reader of robowire's captures.
 pub const MCAP_PY_VERSION: &str = "1.6.0";
+/// `mcap-ros2-support`: the `mcap` package's ROS 2 decoder (`ros2msg` schemas, CDR).
+pub const MCAP_ROS2_PY_VERSION: &str = "0.6.0";
+/// `rosbags`: an independent ROS 2 bag reader and CDR decoder (no ROS install).
+pub const ROSBAGS_VERSION: &str = "0.11.9";
 
 /// The workspace root.
 fn workspace() -> PathBuf {
@@ -114,7 +118,7 @@ pub fn unitree_python() -> Result<PathBuf, String> {
     let venv = dir.join("py310");
     let python = venv.join("bin/python");
     // Versioned: an environment made before a package was added is made again.
-    let stamp = venv.join(".robowire-ready-2");
+    let stamp = venv.join(".robowire-ready-3");
     if stamp.exists() {
         return Ok(python);
     }
@@ -130,8 +134,14 @@ pub fn unitree_python() -> Result<PathBuf, String> {
         c
     };
     run(
-        "pip install cyclonedds numpy mcap",
-        &mut pip(&[&format!("cyclonedds=={CYCLONEDDS_VERSION}"), "numpy", &format!("mcap=={MCAP_PY_VERSION}")]),
+        "pip install cyclonedds numpy mcap mcap-ros2-support rosbags",
+        &mut pip(&[
+            &format!("cyclonedds=={CYCLONEDDS_VERSION}"),
+            "numpy",
+            &format!("mcap=={MCAP_PY_VERSION}"),
+            &format!("mcap-ros2-support=={MCAP_ROS2_PY_VERSION}"),
+            &format!("rosbags=={ROSBAGS_VERSION}"),
+        ]),
     )?;
     let copy = dir.join("unitree_sdk2_python");
     let _ = std::fs::remove_dir_all(&copy);

@@ -34,6 +34,16 @@ pub(crate) struct FrameChannel {
     pub(crate) json_by: Option<&'static dyn LinkDescription>,
 }
 
+/// What became of a frame.
+pub(crate) enum Placed {
+    /// It goes on this channel.
+    On(FrameChannel),
+    /// Its link number was never registered.
+    UnknownLink,
+    /// It is not in a wire encoding, and only those are written.
+    NotWire,
+}
+
 /// Every channel and schema made so far.
 #[derive(Default)]
 pub(crate) struct Channels {
@@ -94,25 +104,28 @@ impl Channels {
     }
 
     /// The channel of `frame`, of link, direction and writer `key`: its wire encoding's if its
-    /// description names one, else the raw channel; made on first use. `None` for a link no one
-    /// registered.
+    /// description names one, else (unless `wire_only`) the raw channel; made on first use.
     pub(crate) fn frame_channel<W: Write + std::io::Seek>(
         &mut self,
         writer: &mut mcap::Writer<W>,
         key: ChannelKey,
         frame: &[u8],
+        wire_only: bool,
         registered: impl FnOnce(usize) -> Option<(String, &'static dyn LinkDescription)>,
-    ) -> Result<Option<FrameChannel>, McapError> {
-        let Some(entry) = self.entry(key, registered) else { return Ok(None) };
+    ) -> Result<Placed, McapError> {
+        let Some(entry) = self.entry(key, registered) else { return Ok(Placed::UnknownLink) };
         let description = entry.description;
         let wire = description.wire_schema(key.1, frame);
+        if wire.is_none() && wire_only {
+            return Ok(Placed::NotWire);
+        }
         let known = match &wire {
             Some(wire) => entry.wire.iter().find(|(name, _)| *name == wire.name).map(|(_, id)| *id),
             None => entry.raw,
         };
         let json_by = if wire.is_some() { None } else { Some(description) };
         if let Some(id) = known {
-            return Ok(Some(FrameChannel { id, json_by }));
+            return Ok(Placed::On(FrameChannel { id, json_by }));
         }
         let name = entry.name.clone();
         let metadata = metadata(key, &name, Some(description));
@@ -131,7 +144,7 @@ impl Channels {
                 id
             }
         };
-        Ok(Some(FrameChannel { id, json_by }))
+        Ok(Placed::On(FrameChannel { id, json_by }))
     }
 
     fn add_wire_channel<W: Write + std::io::Seek>(
@@ -143,7 +156,10 @@ impl Channels {
         metadata: &BTreeMap<String, String>,
     ) -> Result<u16, McapError> {
         let schema = self.schema(writer, wire.schema_encoding, wire.name, wire.text.as_bytes())?;
-        let topic = format!("/{name}/{}", key.1.name());
+        // A ROS 2 message goes on its ROS topic (`/kmc/odom`), as `ros2 bag` records it; its
+        // direction is in the metadata.
+        let topic =
+            if wire.schema_encoding == "ros2msg" { format!("/{name}") } else { format!("/{name}/{}", key.1.name()) };
         let id = writer.add_channel(schema, &topic, wire.encoding, metadata)?;
         if let Some(entry) = self.entry(key, |_| None) {
             entry.wire.push((wire.name, id));

@@ -13,7 +13,7 @@ use mcap::records::{MessageHeader, Metadata};
 use robowire_core::json::LinkDescription;
 use robowire_tap::{Tap, TapRing, TappedFrame};
 
-use crate::channels::Channels;
+use crate::channels::{Channels, Placed};
 use crate::json_thread::{JsonMessage, JsonThread};
 
 /// How long the writer sleeps when the ring is empty: at 1 M frames/s, 1 000 frames arrive
@@ -33,11 +33,17 @@ pub struct RecorderOptions {
     /// How the file's chunks are compressed (default none: the writer's thread does nothing
     /// more per byte than copy it).
     pub compression: Compression,
+    /// The MCAP profile in the file's header: `""` (default), or `"ros2"` for a capture of ROS 2
+    /// topics that `ros2 bag` plays.
+    pub profile: &'static str,
+    /// Writes only frames in a wire encoding (a ROS 2 capture that ROS 2 tools read whole); the
+    /// others are counted ([`RecordingSummary::not_wire`]), not written. Default off.
+    pub wire_only: bool,
 }
 
 impl Default for RecorderOptions {
     fn default() -> Self {
-        Self { ring_slots: 4096, json: true, compression: Compression::None }
+        Self { ring_slots: 4096, json: true, compression: Compression::None, profile: "", wire_only: false }
     }
 }
 
@@ -104,6 +110,9 @@ pub struct RecordingSummary {
     /// Frames whose JSON message was skipped because the JSON thread fell behind (their raw frame
     /// is written; `robowire decode --mcap` decodes it).
     pub json_skipped: u64,
+    /// Frames not written because they were not in a wire encoding, with
+    /// [`RecorderOptions::wire_only`].
+    pub not_wire: u64,
 }
 
 /// Every link's name and description, by link number.
@@ -137,7 +146,7 @@ impl Recorder {
         let file = File::create(&path).map_err(|source| RecordError::Create { path: path.clone(), source })?;
         let writer = mcap::WriteOptions::new()
             .compression(options.compression.mcap())
-            .profile("")
+            .profile(options.profile)
             .library(concat!("robowire ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::with_capacity(1 << 20, file))
             .map_err(|source| RecordError::Write { path: path.clone(), source })?;
@@ -156,6 +165,7 @@ impl Recorder {
             links: links.clone(),
             unix_offset_ns: unix_minus_monotonic_ns(),
             channels: Channels::default(),
+            wire_only: options.wire_only,
             summary: RecordingSummary::default(),
         };
         let thread = std::thread::Builder::new()
@@ -181,7 +191,7 @@ impl Recorder {
     /// A handle that registers links with this recorder, for code that opens devices on its
     /// behalf (`robowire_devices::OpenOptions::record`).
     pub fn links(&self) -> RecordLinks {
-        RecordLinks { ring: self.ring.clone(), links: self.links.clone() }
+        RecordLinks { ring: self.ring.clone(), links: self.links.clone(), prefix: String::new() }
     }
 
     /// Frames dropped so far because the ring was full.
@@ -227,14 +237,23 @@ impl Drop for Recorder {
 pub struct RecordLinks {
     ring: TapRing,
     links: Links,
+    /// Put before each link's name (`kmc0/`), or empty.
+    prefix: String,
 }
 
 impl RecordLinks {
     /// As [`Recorder::link`].
     pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
         let mut links = robowire_rt::lock(&self.links);
-        links.push((name.trim_matches('/').into(), description));
+        links.push((format!("{}{}", self.prefix, name.trim_matches('/')), description));
         self.ring.tap(u16::try_from(links.len() - 1).unwrap_or(u16::MAX))
+    }
+
+    /// A handle that registers links under `prefix` (`kmc0`: `kmc0/kmc/serial`), for two
+    /// devices whose links have the same names.
+    pub fn under(&self, prefix: &str) -> RecordLinks {
+        let prefix = format!("{}{}/", self.prefix, prefix.trim_matches('/'));
+        RecordLinks { prefix, ..self.clone() }
     }
 }
 
@@ -263,6 +282,8 @@ struct WriterState {
     /// Added to a tap's monotonic stamp: Unix time, ns.
     unix_offset_ns: i64,
     channels: Channels,
+    /// [`RecorderOptions::wire_only`].
+    wire_only: bool,
     summary: RecordingSummary,
 }
 
@@ -318,11 +339,20 @@ impl WriterState {
         let key = (frame.link, frame.direction, frame.origin.writer);
         let links = &self.links;
         let registered = |link: usize| robowire_rt::lock(links).get(link).cloned();
-        let channel =
-            self.channels.frame_channel(&mut self.writer, key, frame.bytes(), registered).map_err(self.error())?;
-        let Some(channel) = channel else {
-            self.summary.decode_errors += 1;
-            return Ok(None);
+        let placed = self
+            .channels
+            .frame_channel(&mut self.writer, key, frame.bytes(), self.wire_only, registered)
+            .map_err(self.error())?;
+        let channel = match placed {
+            Placed::On(channel) => channel,
+            Placed::UnknownLink => {
+                self.summary.decode_errors += 1;
+                return Ok(None);
+            }
+            Placed::NotWire => {
+                self.summary.not_wire += 1;
+                return Ok(None);
+            }
         };
         let header = self.header(channel.id, frame.monotonic_ns, frame.origin.source_unix_ns);
         self.writer.write_to_known_channel(&header, frame.bytes()).map_err(self.error())?;

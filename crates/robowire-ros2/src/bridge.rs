@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use robowire_dds::{DdsError, Participant, ParticipantOptions};
 use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, OpenOptions};
+use robowire_record::RecordLinks;
 use tokio::sync::watch;
 
 use crate::node::{Node, NodeOptions};
@@ -29,6 +30,12 @@ pub struct BridgeOptions {
     pub deadman: Duration,
     /// Publish at most this often per topic, Hz.
     pub rate_cap_hz: Option<f64>,
+    /// Record every ROS 2 topic the bridge publishes or takes (as `cdr` under its `ros2msg`
+    /// definition, on the ROS topic) with this recorder.
+    pub record: Option<RecordLinks>,
+    /// Record every device's own links with this recorder, under the device's namespace
+    /// (`kmc0/kmc/serial`).
+    pub record_devices: Option<RecordLinks>,
 }
 
 impl BridgeOptions {
@@ -42,6 +49,8 @@ impl BridgeOptions {
             armed: false,
             deadman: Duration::from_millis(500),
             rate_cap_hz: None,
+            record: None,
+            record_devices: None,
         }
     }
 }
@@ -138,11 +147,21 @@ pub async fn run(
         .zip(spaces)
         .map(|(address, namespace)| BridgedDevice { address: address.clone(), namespace, report: Arc::default() })
         .collect();
-    let open_options =
-        OpenOptions { domain: options.domain, sim_interface: options.interface.clone(), ..OpenOptions::default() };
     let mut opened: Vec<AnyDevice> = Vec::new();
     for device in &devices {
         let failed = |source| BridgeError::Device { address: device.address.clone(), source };
+        // A device's own links are recorded under its namespace (`kmc0/kmc/serial`), beside its
+        // ROS topics (`kmc0/odom`).
+        let namespace = device.namespace.trim_matches('/');
+        let open_options = OpenOptions {
+            domain: options.domain,
+            sim_interface: options.interface.clone(),
+            record: options
+                .record_devices
+                .as_ref()
+                .map(|r| if namespace.is_empty() { r.clone() } else { r.under(namespace) }),
+            ..OpenOptions::default()
+        };
         opened.push(robowire_devices::open(&device.address, &open_options).map_err(failed)?);
     }
     started(&devices);
@@ -157,6 +176,7 @@ pub async fn run(
                     armed: options.armed,
                     deadman: options.deadman,
                     rate_cap_hz: options.rate_cap_hz,
+                    record: options.record.clone(),
                 },
             };
             let mut stop = stop.clone();

@@ -5,6 +5,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use robowire_core::cdr::CdrType;
 use robowire_dds::Sample;
+use robowire_record::{RecordLinks, Tap};
 use ros2_proto::geometry::Twist;
 
 use crate::guard::{CmdVelGuard, Verdict};
@@ -23,6 +24,8 @@ pub(crate) struct NodeOptions {
     pub deadman: Duration,
     /// Publish at most this often per topic, Hz (`None`: the device's native rate).
     pub rate_cap_hz: Option<f64>,
+    /// Where the topics' samples are recorded, each topic a link named after it.
+    pub record: Option<RecordLinks>,
 }
 
 /// One device's node: topics in its namespace on the shared participant.
@@ -32,14 +35,28 @@ pub(crate) struct Node<'a> {
 }
 
 impl Node<'_> {
-    /// A writer of the ROS topic `name` in the namespace.
+    /// A writer of the ROS topic `name` in the namespace (recorded if the bridge records).
     pub(crate) fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
-        self.participant.writer(&ros2_proto::topic(&self.options.namespace, name), qos)
+        let mut writer = self.participant.writer(&ros2_proto::topic(&self.options.namespace, name), qos)?;
+        writer.set_tap(self.tap::<T>(name));
+        Ok(writer)
     }
 
-    /// A reader of the ROS topic `name` in the namespace.
+    /// A reader of the ROS topic `name` in the namespace (recorded if the bridge records).
     pub(crate) fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
-        self.participant.reader(&ros2_proto::topic(&self.options.namespace, name), qos)
+        let mut reader = self.participant.reader(&ros2_proto::topic(&self.options.namespace, name), qos)?;
+        reader.set_tap(self.tap::<T>(name));
+        Ok(reader)
+    }
+
+    /// A tap for the ROS topic `name` in the namespace, named as ROS names it (`kmc/odom`), if
+    /// the bridge records and the type is one ROS 2 tools can read from a capture.
+    fn tap<T: CdrType>(&self, name: &str) -> Option<Tap> {
+        let record = self.options.record.as_ref()?;
+        let description = ros2_proto::description::of(T::TYPE_NAME)?;
+        // The DDS topic is the ROS one behind `rt/`.
+        let dds_topic = ros2_proto::topic(&self.options.namespace, name);
+        Some(record.link(dds_topic.strip_prefix("rt/").unwrap_or(&dds_topic), description))
     }
 
     /// The frame id `name` in the namespace: `odom`, or `kmc0/odom`.

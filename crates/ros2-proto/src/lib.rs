@@ -16,6 +16,9 @@ pub mod builtin;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod decode_roundtrip;
+pub mod definitions;
+#[cfg(feature = "json")]
+pub mod description;
 pub mod diagnostic;
 pub mod geometry;
 pub mod nav;

@@ -15,6 +15,7 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
         &zsl_proto::description::DESCRIPTIONS[..],
         &kmc_proto::description::DESCRIPTIONS,
         &lowcmd_proto::description::DESCRIPTIONS,
+        &ros2_proto::description::DESCRIPTIONS,
         &[&robowire_core::json::SKIPPED_BYTES],
     ]
     .concat()
@@ -45,6 +46,39 @@ impl RecordArgs {
     pub(crate) fn start(&self, command: &str) -> anyhow::Result<Option<Recorder>> {
         start_with(self.record.as_deref(), command, self.compression)
     }
+
+    /// As [`start`](Self::start), a capture of ROS 2 topics only: the `ros2` profile, no JSON,
+    /// nothing but frames in a wire encoding, so that ROS 2 tools read all of it.
+    pub(crate) fn start_ros2(&self, command: &str) -> anyhow::Result<Option<Recorder>> {
+        let options = RecorderOptions {
+            compression: self.compression.into(),
+            profile: "ros2",
+            json: false,
+            wire_only: true,
+            ..RecorderOptions::default()
+        };
+        create(self.record.as_deref(), command, options)
+    }
+
+    /// The same arguments for a second file beside the first: `run.mcap` → `run-{suffix}.mcap`.
+    pub(crate) fn beside(&self, suffix: &str) -> Self {
+        let record = self.record.as_ref().map(|path| {
+            let stem = path.file_stem().map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+            let extension = path.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+            path.with_file_name(format!("{stem}-{suffix}{extension}"))
+        });
+        Self { record, ..self.clone() }
+    }
+}
+
+impl From<CompressionArg> for Compression {
+    fn from(arg: CompressionArg) -> Self {
+        match arg {
+            CompressionArg::None => Compression::None,
+            CompressionArg::Zstd => Compression::Zstd,
+            CompressionArg::Lz4 => Compression::Lz4,
+        }
+    }
 }
 
 /// A recorder on `path`, if given.
@@ -58,12 +92,10 @@ pub(crate) fn start_with(
     command: &str,
     compression: CompressionArg,
 ) -> anyhow::Result<Option<Recorder>> {
-    let compression = match compression {
-        CompressionArg::None => Compression::None,
-        CompressionArg::Zstd => Compression::Zstd,
-        CompressionArg::Lz4 => Compression::Lz4,
-    };
-    let options = RecorderOptions { compression, ..RecorderOptions::default() };
+    create(path, command, RecorderOptions { compression: compression.into(), ..RecorderOptions::default() })
+}
+
+fn create(path: Option<&Path>, command: &str, options: RecorderOptions) -> anyhow::Result<Option<Recorder>> {
     path.map(|p| Recorder::create_with(p, command, options).with_context(|| format!("recording to {}", p.display())))
         .transpose()
 }
@@ -74,8 +106,17 @@ pub(crate) fn finish(recorder: Option<Recorder>) -> anyhow::Result<()> {
         let summary = recorder.finish().context("closing the capture")?;
         eprintln!(
             "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable, \
-             {} without JSON (the decoder fell behind)",
-            summary.frames, summary.dropped, summary.oversize, summary.decode_errors, summary.json_skipped
+             {} without JSON (the decoder fell behind){}",
+            summary.frames,
+            summary.dropped,
+            summary.oversize,
+            summary.decode_errors,
+            summary.json_skipped,
+            if summary.not_wire > 0 {
+                format!(", {} not in their wire encoding (left out)", summary.not_wire)
+            } else {
+                String::new()
+            }
         );
     }
     Ok(())

@@ -38,6 +38,11 @@ pub(crate) struct Ros2Args {
     /// At the end, print each device's counters as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Record the ROS 2 topics into FILE.mcap (rosbag2's MCAP: `ros2` profile, `cdr` under
+    /// `ros2msg` definitions, on the ROS topics, nothing else: `ros2 bag play` plays it) and every
+    /// device's own links beside it, into FILE-devices.mcap.
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Serialize)]
@@ -59,6 +64,8 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         Some(s) => anyhow::bail!("--duration must be 0–1e6 s, got {s}"),
         None => None,
     };
+    let recorder = args.record.start_ros2("robowire ros2")?;
+    let devices_recorder = args.record.beside("devices").start("robowire ros2")?;
     let options = BridgeOptions {
         namespace: args.namespace.clone(),
         domain: args.domain,
@@ -66,6 +73,8 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         armed: args.arm,
         deadman: Duration::from_secs_f64(args.deadman),
         rate_cap_hz: args.rate,
+        record: recorder.as_ref().map(robowire_record::Recorder::links),
+        record_devices: devices_recorder.as_ref().map(robowire_record::Recorder::links),
         ..BridgeOptions::new(args.devices.clone())
     };
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
@@ -120,6 +129,9 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
             c.cmd_vel.publishers
         );
     }
+    drop(devices);
+    crate::cmd::record::finish(recorder)?;
+    crate::cmd::record::finish(devices_recorder)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     }
