@@ -36,6 +36,11 @@ pub(crate) fn record_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             target: "–".into(),
             met: None,
         },
+        stream_row(&meta["kmc_stream"], "KMC Driver 0xA5 stream (100 Hz) send lateness, its serial link recorded")?,
+        stream_row(
+            &meta["spline_stream"],
+            "spline daemon simulator (1 kHz) send lateness, its shared memory recorded",
+        )?,
         throughput_row(&meta["unpaced_raw"], "Recorder capacity: 560-byte frames as fast as one thread taps, raw")?,
         throughput_row(
             &meta["unpaced_json"],
@@ -89,5 +94,19 @@ fn paced_row(run: &Value, path: &str) -> anyhow::Result<Row> {
         ratio: "–".into(),
         target: "none dropped".into(),
         met: Some(dropped == 0.0),
+    })
+}
+
+/// A stream recorded and not, alternating: its lateness each way.
+fn stream_row(run: &Value, path: &str) -> anyhow::Result<Row> {
+    let n = |key: &str| run[key].as_f64().with_context(|| format!("record meta {key}"));
+    let (p99, b99) = (n("recorded_p99_us")?, n("plain_p99_us")?);
+    Ok(Row {
+        path: path.into(),
+        figure: format!("p50 {:.0} µs, p99 {p99:.0} µs ({:.0} frames dropped)", n("recorded_p50_us")?, n("dropped")?),
+        baseline: format!("not recorded: p50 {:.0} µs, p99 {b99:.0} µs", n("plain_p50_us")?),
+        ratio: format!("p99 {:+.0} µs", p99 - b99),
+        target: "–".into(),
+        met: None,
     })
 }
