@@ -160,3 +160,50 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
         Device::Go2 => dds::run(offsets, &link, target.dds, pace),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lowcmd_proto::LowCmd;
+
+    fn frame(
+        link: &str,
+        protocol: &'static dyn robowire_record::LinkDescription,
+        direction: Direction,
+        bytes: Vec<u8>,
+    ) -> RecordedFrame {
+        RecordedFrame { link: link.into(), direction, protocol, unix_ns: 0, bytes }
+    }
+
+    fn payload<M: Message>() -> Vec<u8> {
+        let mut payload = vec![0u8; M::cdr_len(CdrEncoding::Xcdr1)];
+        M::default().encode_cdr(CdrEncoding::Xcdr1, &mut payload).unwrap();
+        payload
+    }
+
+    #[test]
+    fn the_device_frames_follow_from_the_recording_end_and_the_direction() {
+        let speed = vec![0xb3, 0, 0, 0, 0];
+        let frames = [
+            // A simulator's capture: the chassis sent, the Go2 sent its LowStates.
+            frame("kmc/chassis", &CHASSIS, Direction::Received, vec![0xb3]),
+            frame("kmc/chassis", &CHASSIS, Direction::Sent, speed.clone()),
+            frame("go2/low_level", &GO2_LOW_LEVEL, Direction::Received, payload::<LowCmd>()),
+            frame("go2/low_level", &GO2_LOW_LEVEL, Direction::Sent, payload::<LowState>()),
+            // A host's capture: it received the chassis' frames.
+            frame("kmc/serial", &HOST, Direction::Sent, vec![0xb3]),
+            frame("kmc/serial", &HOST, Direction::Received, speed.clone()),
+        ];
+        let picked =
+            |link| pick(&frames, link).map(|(l, d, f)| (l, d, f.iter().map(|f| f.direction).collect::<Vec<_>>()));
+        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), Device::KmcChassis, vec![Direction::Sent]));
+        assert_eq!(
+            picked(Some("kmc/serial")).unwrap(),
+            ("kmc/serial".into(), Device::KmcChassis, vec![Direction::Received])
+        );
+        assert_eq!(
+            picked(Some("go2/low_level")).unwrap(),
+            ("go2/low_level".into(), Device::Go2, vec![Direction::Sent])
+        );
+    }
+}
