@@ -31,7 +31,7 @@ pub struct Pty {
     master: OwnedFd,
     slave_path: PathBuf,
     /// Keeps the slave open (and raw) while no client is attached.
-    _slave: OwnedFd,
+    slave: OwnedFd,
 }
 
 impl Pty {
@@ -52,12 +52,18 @@ impl Pty {
         tcsetattr(&slave, OptionalActions::Now, &termios)?;
         let flags = rustix::fs::fcntl_getfl(&master)?;
         rustix::fs::fcntl_setfl(&master, flags | OFlags::NONBLOCK)?;
-        Ok(Self { master, slave_path, _slave: slave })
+        Ok(Self { master, slave_path, slave })
     }
 
     /// The device path a client opens, e.g. `/dev/pts/3`.
     pub fn slave_path(&self) -> &Path {
         &self.slave_path
+    }
+
+    /// Bytes written for the client that it has not read yet (the line's input queue), so that
+    /// a device can wait for the client to catch up before hanging up.
+    pub fn unread(&self) -> io::Result<u64> {
+        Ok(rustix::io::ioctl_fionread(&self.slave)?)
     }
 
     /// Waits up to `timeout` for `flags` on the master; `true` when ready.
@@ -275,5 +281,25 @@ mod tests {
         assert_eq!(back, all);
         // Nothing echoed back to the master.
         assert_eq!(pty.read_timeout(&mut buf, Duration::from_millis(20)).unwrap(), 0);
+    }
+
+    #[test]
+    fn unread_counts_what_the_client_has_not_read_yet() {
+        let pty = Pty::open().unwrap();
+        let mut client = std::fs::OpenOptions::new().read(true).open(pty.slave_path()).unwrap();
+        assert_eq!(pty.unread().unwrap(), 0);
+        pty.write_all(&[1, 2, 3, 4, 5], Duration::from_secs(5)).unwrap();
+        // The kernel moves the bytes to the client's side on its own time: waited for, bounded.
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while pty.unread().unwrap() < 5 {
+            assert!(Instant::now() < deadline, "the bytes never reached the client's side");
+            std::thread::yield_now();
+        }
+        let mut two = [0u8; 2];
+        client.read_exact(&mut two).unwrap();
+        assert_eq!(pty.unread().unwrap(), 3);
+        let mut rest = [0u8; 3];
+        client.read_exact(&mut rest).unwrap();
+        assert_eq!(pty.unread().unwrap(), 0);
     }
 }

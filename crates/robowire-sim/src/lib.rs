@@ -11,7 +11,7 @@ mod handover;
 mod joints;
 #[cfg(feature = "kmc")]
 pub mod kmc;
-#[cfg(feature = "replay")]
+#[cfg(any(feature = "replay", feature = "replay-serial", feature = "replay-dds"))]
 pub mod replay;
 #[cfg(feature = "zsl")]
 pub mod spline;

@@ -8,8 +8,9 @@ use anyhow::Context;
 use clap::Args;
 use robowire_record::{Compression, LinkDescription, Recorder, RecorderOptions};
 
-/// Every link description the CLI knows, one list from each codec: what reading a capture back
-/// (`robowire replay`, `robowire decode --mcap`) understands.
+/// Every link description the CLI knows, one list from each codec, and the bytes a serial link's
+/// decoder skipped: what reading a capture back (`robowire replay`, `robowire decode --mcap`)
+/// understands.
 pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
     [
         &zsl_proto::description::DESCRIPTIONS[..],
@@ -135,16 +136,21 @@ pub(crate) struct ReplayArgs {
     /// One JSON object per frame on stdout.
     #[arg(long)]
     json: bool,
-    /// Play the device's side of the capture to a live client instead (ZSL-1 UDP: the states,
-    /// on the HighLevel or LowLevel port of --bind).
+    /// Play the device's side of the capture to a live client instead, on the transport of the
+    /// link's protocol: ZSL-1 states on UDP (the HighLevel or LowLevel port of --bind), KMC
+    /// chassis frames on a pseudo-terminal (its path the first line), Go2 LowStates on DDS
+    /// rt/lowstate (--interface, --domain).
     #[arg(long)]
     as_device: bool,
-    /// With --as-device: the address to serve on.
+    /// With --as-device on a ZSL-1 link: the address to serve on.
     #[arg(long, default_value = "127.0.0.1", requires = "as_device")]
     bind: std::net::IpAddr,
-    /// With --as-device: the link to play (default: the first with device frames).
+    /// With --as-device: the link to play (default: the link of the first device frame).
     #[arg(long, requires = "as_device")]
     link: Option<String>,
+    /// With --as-device on a Go2 link: where to publish.
+    #[command(flatten)]
+    dds: crate::cmd::go2::DdsArgs,
 }
 
 /// Replays a capture into the decoders, at the recorded pace (or `--speed`, or `--fast`).
@@ -158,8 +164,13 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
     let frames =
         robowire_record::read_frames(&bytes, &descriptions()).with_context(|| format!("{}", args.file.display()))?;
     if args.as_device {
-        let speed = (!args.fast).then_some(args.speed);
-        return crate::cmd::replay_device::run(&frames, args.link.as_deref(), args.bind, speed);
+        let target = crate::cmd::replay_device::Target {
+            link: args.link.as_deref(),
+            bind: args.bind,
+            dds: &args.dds,
+            speed: (!args.fast).then_some(args.speed),
+        };
+        return crate::cmd::replay_device::run(&frames, &target);
     }
     let Some(first) = frames.first().map(|f| f.unix_ns) else {
         eprintln!("{}: no frames", args.file.display());
@@ -247,6 +258,7 @@ mod tests {
             names.contains(&"zsl1.high_level")
                 && names.contains(&"kmc.host")
                 && names.contains(&"unitree_go.low_level")
+                && names.contains(&"stream.skipped")
         );
     }
 }

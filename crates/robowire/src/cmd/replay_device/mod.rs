@@ -1,0 +1,209 @@
+//! `robowire replay --as-device`: the device side of a capture played back to a live client over
+//! the same transport, so that a session seen once on a robot can be replayed on a desk. The
+//! link's protocol (from the capture's metadata) says which device and transport:
+//!
+//! - `zsl1.high_level`, `zsl1.low_level`: the ZSL-1's states on UDP (HighLevel on 43997,
+//!   LowLevel on 43900 of `--bind`), [`udp`].
+//! - `kmc.host` (its received frames) or `kmc.chassis` (its sent frames): the KMC chassis'
+//!   frames on a pseudo-terminal, [`serial`].
+//! - `unitree_go.low_level`: the Go2's `LowState_` payloads (either direction: the client
+//!   received them, a simulator sent them) on DDS `rt/lowstate`, [`dds`].
+//!
+//! This picks the device's frames out of the capture; `robowire_sim::replay` plays them.
+
+mod dds;
+mod serial;
+mod udp;
+
+use std::collections::BTreeMap;
+use std::net::IpAddr;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::bail;
+use kmc_proto::description::{CHASSIS, HOST};
+use lowcmd_proto::description::GO2_LOW_LEVEL;
+use lowcmd_proto::{CdrEncoding, LowState, Message};
+use robowire_record::{Direction, RecordedFrame};
+use robowire_sim::replay::Pace;
+use zsl_proto::udp::AnyDatagram;
+
+/// A device robowire plays the side of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Device {
+    /// A ZSL-1 on UDP.
+    Zsl1,
+    /// A KMC chassis on a serial line.
+    KmcChassis,
+    /// A Go2's low-level link on DDS.
+    Go2,
+}
+
+/// What `--as-device` plays, for the error that finds none.
+const PLAYABLE: &str = "ZSL-1 states (zsl1.high_level, zsl1.low_level), KMC chassis frames (kmc.host received, \
+                        kmc.chassis sent) and Go2 LowStates (unitree_go.low_level)";
+
+impl Device {
+    /// The device whose side a link of `protocol` has.
+    fn of(protocol: &str) -> Option<Self> {
+        if zsl_proto::description::DESCRIPTIONS.iter().any(|d| d.protocol() == protocol) {
+            Some(Self::Zsl1)
+        } else if [HOST.name, CHASSIS.name].contains(&protocol) {
+            Some(Self::KmcChassis)
+        } else if protocol == GO2_LOW_LEVEL.name {
+            Some(Self::Go2)
+        } else {
+            None
+        }
+    }
+
+    /// Whether `frame`, of a link of this device, is one the device sent.
+    fn sent(self, frame: &RecordedFrame) -> bool {
+        match self {
+            Self::Zsl1 => matches!(
+                AnyDatagram::decode(&frame.bytes),
+                Ok(AnyDatagram::HighLevelState(_) | AnyDatagram::LowLevelState(_))
+            ),
+            // The chassis' frames: what the host received, what the chassis sent.
+            Self::KmcChassis => {
+                frame.direction
+                    == if frame.protocol.protocol() == HOST.name { Direction::Received } else { Direction::Sent }
+            }
+            // A LowState_ by its length in the encoding its header names, as the link's
+            // description tells LowCmd_ and LowState_ apart (whatever its CRC).
+            Self::Go2 => frame
+                .bytes
+                .get(..4)
+                .and_then(|h| CdrEncoding::from_header(h.try_into().ok()?))
+                .is_some_and(|encoding| frame.bytes.len() == LowState::cdr_len(encoding)),
+        }
+    }
+}
+
+/// Where and how fast to play.
+#[derive(Debug)]
+pub(crate) struct Target<'a> {
+    /// The link to play (default: the first with device frames).
+    pub(crate) link: Option<&'a str>,
+    /// The ZSL-1's address.
+    pub(crate) bind: IpAddr,
+    /// The Go2's domain and interface.
+    pub(crate) dds: &'a crate::cmd::go2::DdsArgs,
+    /// The recorded pace scaled by this; `None`: as fast as possible.
+    pub(crate) speed: Option<f64>,
+}
+
+/// Each link of the capture in order of its first frame: its protocol and frame count.
+fn links(frames: &[RecordedFrame]) -> Vec<(&str, &'static str, usize)> {
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut order = Vec::new();
+    for frame in frames {
+        let count = counts.entry(&frame.link).or_default();
+        if *count == 0 {
+            order.push((frame.link.as_str(), frame.protocol.protocol()));
+        }
+        *count += 1;
+    }
+    order.into_iter().map(|(link, protocol)| (link, protocol, counts[link])).collect()
+}
+
+/// The links found, for an error.
+fn found(frames: &[RecordedFrame]) -> String {
+    let links = links(frames);
+    if links.is_empty() {
+        return "the capture has no frames".into();
+    }
+    let list: Vec<String> = links.iter().map(|(l, p, n)| format!("{l} ({p}, {n} frames)")).collect();
+    format!("the capture has {}", list.join(", "))
+}
+
+/// The device frames of `link` (or of the first link that has any), with the link and device.
+fn pick<'f>(
+    frames: &'f [RecordedFrame],
+    link: Option<&str>,
+) -> anyhow::Result<(String, Device, Vec<&'f RecordedFrame>)> {
+    let device_frames = |link: &str, device: Device| -> Vec<&RecordedFrame> {
+        frames.iter().filter(|f| f.link == link && device.sent(f)).collect()
+    };
+    let Some(link) = link else {
+        // The link of the first device frame.
+        let first = frames.iter().find_map(|f| Device::of(f.protocol.protocol()).filter(|d| d.sent(f)).map(|d| (f, d)));
+        let Some((first, device)) = first else {
+            bail!("no device frames to play: {}; --as-device plays {PLAYABLE}", found(frames));
+        };
+        return Ok((first.link.clone(), device, device_frames(&first.link, device)));
+    };
+    let Some(protocol) = frames.iter().find(|f| f.link == link).map(|f| f.protocol.protocol()) else {
+        bail!("no link {link:?}: {}", found(frames));
+    };
+    let Some(device) = Device::of(protocol) else {
+        bail!("link {link} is {protocol}, which has no device side to play; --as-device plays {PLAYABLE}");
+    };
+    let picked = device_frames(link, device);
+    if picked.is_empty() {
+        bail!("link {link} ({protocol}) has no device frames: {}", found(frames));
+    }
+    Ok((link.to_string(), device, picked))
+}
+
+/// Plays the device frames of `target.link` (default: the first link that has any) on the
+/// device's transport.
+pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Result<ExitCode> {
+    let (link, device, picked) = pick(frames, target.link)?;
+    let first_ns = picked[0].unix_ns;
+    let offsets: Vec<(Duration, Vec<u8>)> =
+        picked.iter().map(|f| (Duration::from_nanos(f.unix_ns.saturating_sub(first_ns)), f.bytes.clone())).collect();
+    let pace = target.speed.map_or(Pace::Fast, |speed| Pace::Recorded { speed });
+    match device {
+        Device::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
+        Device::KmcChassis => serial::run(offsets, &link, pace),
+        Device::Go2 => dds::run(offsets, &link, target.dds, pace),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lowcmd_proto::LowCmd;
+
+    fn frame(
+        link: &str,
+        protocol: &'static dyn robowire_record::LinkDescription,
+        direction: Direction,
+        bytes: Vec<u8>,
+    ) -> RecordedFrame {
+        RecordedFrame { link: link.into(), direction, protocol, unix_ns: 0, bytes }
+    }
+
+    fn payload<M: Message>() -> Vec<u8> {
+        let mut payload = vec![0u8; M::cdr_len(CdrEncoding::Xcdr1)];
+        M::default().encode_cdr(CdrEncoding::Xcdr1, &mut payload).unwrap();
+        payload
+    }
+
+    #[test]
+    fn the_device_frames_follow_from_the_recording_end_and_the_direction() {
+        let speed = vec![0xb3, 0, 0, 0, 0];
+        let frames = [
+            // A simulator's capture: the chassis sent, the Go2 sent its LowStates.
+            frame("kmc/chassis", &CHASSIS, Direction::Received, vec![0xb3]),
+            frame("kmc/chassis", &CHASSIS, Direction::Sent, speed.clone()),
+            frame("go2/low_level", &GO2_LOW_LEVEL, Direction::Received, payload::<LowCmd>()),
+            frame("go2/low_level", &GO2_LOW_LEVEL, Direction::Sent, payload::<LowState>()),
+            // A host's capture: it received the chassis' frames.
+            frame("kmc/serial", &HOST, Direction::Sent, vec![0xb3]),
+            frame("kmc/serial", &HOST, Direction::Received, speed.clone()),
+        ];
+        let picked =
+            |link| pick(&frames, link).map(|(l, d, f)| (l, d, f.iter().map(|f| f.direction).collect::<Vec<_>>()));
+        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), Device::KmcChassis, vec![Direction::Sent]));
+        assert_eq!(
+            picked(Some("kmc/serial")).unwrap(),
+            ("kmc/serial".into(), Device::KmcChassis, vec![Direction::Received])
+        );
+        assert_eq!(
+            picked(Some("go2/low_level")).unwrap(),
+            ("go2/low_level".into(), Device::Go2, vec![Direction::Sent])
+        );
+    }
+}
