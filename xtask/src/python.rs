@@ -6,8 +6,8 @@
 //!
 //! - 3.10: Unitree's pin of cyclonedds has wheels for it and the vendor's ZSL-1 modules are built
 //!   for it, so this is the environment of the interop tests (`robowire-fixtures`' venv with
-//!   cyclonedds 0.10.2, numpy and Unitree's SDK), where the vendor's module, Unitree's SDK and
-//!   the CLI are required: a missing peer fails the run instead of skipping. Without CPython 3.10
+//!   cyclonedds 0.10.2, numpy, mcap and Unitree's SDK), where the vendor's module, Unitree's SDK,
+//!   the `mcap` reader and the CLI are required: a missing peer fails the run instead of skipping. Without CPython 3.10
 //!   or the peers this run is skipped with a line (failed under `ROBOWIRE_INTEROP=1`);
 //! - 3.12 (or 3.13, else any `python3` ≥ 3.9): a bare venv with pytest only, which proves numpy
 //!   is not needed.
@@ -127,7 +127,7 @@ pub fn test_python() -> anyhow::Result<()> {
             ""
         }
     };
-    let runs = py310.map(|python| (python, "vendor,sdk,cli")).into_iter().chain([(second_venv, "cli")]);
+    let runs = py310.map(|python| (python, "vendor,sdk,mcap,cli")).into_iter().chain([(second_venv, "cli")]);
     for (python, require) in runs {
         install(&python, &wheel)?;
         pip(&python, &["install", "--no-warn-script-location", "pytest"])?;

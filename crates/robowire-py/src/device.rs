@@ -12,6 +12,7 @@ use zsl::udp::{CallError, Refusal};
 use crate::errors::{Kind, chain, error};
 use crate::owned::Owned;
 use crate::pyjson::to_py;
+use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
 use crate::stats::dict;
 
@@ -123,6 +124,7 @@ pub(crate) struct Device {
     device: Owned<Arc<AnyDevice>>,
     address: String,
     kind: &'static str,
+    capture: Capture,
 }
 
 impl Device {
@@ -223,17 +225,19 @@ impl Device {
 #[pymethods]
 impl Device {
     /// Does the device's safe thing (a stop burst, a stop, damping) and closes it, then stops its
-    /// simulator. Idempotent.
+    /// simulator, then finishes the capture of `record=PATH`. Idempotent.
     fn close(&self, py: Python<'_>) -> PyResult<()> {
-        let Some(device) = self.device.take() else { return Ok(()) };
-        match Arc::try_unwrap(device) {
-            Ok(device) => py.detach(move || device.close()).map_err(raise),
+        let closed = match self.device.take().map(Arc::try_unwrap) {
+            None => Ok(()),
+            Some(Ok(device)) => py.detach(move || device.close()).map_err(raise),
             // Another thread is inside a call: the last one out closes it (dropping does the same).
-            Err(shared) => {
+            Some(Err(shared)) => {
                 py.detach(move || drop(shared));
                 Ok(())
             }
-        }
+        };
+        let finished = self.capture.finish(py);
+        closed.and(finished)
     }
 
     fn __enter__(slf: Py<Self>) -> Py<Self> {
@@ -248,16 +252,19 @@ impl Device {
 
 /// Opens the device at `address` (`kmc:/dev/ttyUSB0`, `zsl1:192.168.234.1`, `zsl1w:IP`,
 /// `go2:eth0`, `hg:eth0`, `sim:kmc|zsl1|zsl1w|go2`); `domain` is the DDS domain of `go2:`, `hg:`
-/// and `sim:go2`. A bad address raises `ArgumentError`.
+/// and `sim:go2`. `record`: a path or a `robowire.Recorder` to record the client's links into
+/// (`kmc/serial`, `dog/high_level`, `go2/low_level` and `go2/api`, …). A bad address raises
+/// `ArgumentError`.
 #[pyfunction]
-#[pyo3(signature = (address, *, domain = 0))]
-pub(crate) fn open(py: Python<'_>, address: &str, domain: u16) -> PyResult<Device> {
+#[pyo3(signature = (address, *, domain = 0, record = None))]
+pub(crate) fn open(py: Python<'_>, address: &str, domain: u16, record: Option<&Bound<'_, PyAny>>) -> PyResult<Device> {
     let parsed: DeviceAddress =
         address.parse().map_err(|e: robowire_devices::AddressError| error(Kind::Argument, e))?;
-    let options = OpenOptions { domain, ..OpenOptions::default() };
+    let (record, capture) = record_arg(record, &format!("robowire.open({address:?})"))?;
+    let options = OpenOptions { domain, record, ..OpenOptions::default() };
     let device = py.detach(|| robowire_devices::open(&parsed, &options)).map_err(raise)?;
     let kind = device.kind().name();
-    Ok(Device { device: Owned::new("device", Arc::new(device)), address: parsed.to_string(), kind })
+    Ok(Device { device: Owned::new("device", Arc::new(device)), address: parsed.to_string(), kind, capture })
 }
 
 /// Adds the function and the class to the extension module.

@@ -9,6 +9,7 @@ use pyo3::types::PyDict;
 
 use crate::errors::{Kind, chain, error, service_error};
 use crate::owned::{Owned, closeable};
+use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
 use crate::sim::topic;
 use crate::stats::{dict, lateness};
@@ -84,6 +85,7 @@ fn connection(c: Connection) -> &'static str {
 pub(crate) struct Go2LowLevel {
     client: Owned<Client>,
     robot: &'static str,
+    capture: Capture,
 }
 
 impl Go2LowLevel {
@@ -99,25 +101,38 @@ impl Go2LowLevel {
 impl Go2LowLevel {
     /// Joins DDS domain `domain` on `interface` (the robot's network, 192.168.123.x: `"eth0"`,
     /// `"enp3s0"`; `None` lets the library choose). `robot` `"go2"` or `"hg"` (G1, H1-2).
+    /// `record`: a path or a `robowire.Recorder` to record the client's side of
+    /// `go2/low_level` and `go2/api` (`hg/…` for an HG robot) into.
     #[new]
-    #[pyo3(signature = (*, domain = 0, interface = None, robot = "go2", service_timeout_s = 5.0))]
+    #[pyo3(signature = (*, domain = 0, interface = None, robot = "go2", service_timeout_s = 5.0, record = None))]
     fn new(
         py: Python<'_>,
         domain: u16,
         interface: Option<&str>,
         robot: &str,
         service_timeout_s: f64,
+        record: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let low_level = match robot {
+            "go2" => &lowcmd_proto::description::GO2_LOW_LEVEL,
+            "hg" => &lowcmd_proto::description::HG_LOW_LEVEL,
+            other => return Err(error(Kind::Argument, format!("robot = {other:?}: \"go2\" or \"hg\""))),
+        };
+        let service_timeout = seconds("service_timeout_s", service_timeout_s)?;
+        let (links, capture) = record_arg(record, "robowire.go2.LowLevel")?;
         let options = LowLevelOptions {
-            service_timeout: seconds("service_timeout_s", service_timeout_s)?,
+            service_timeout,
+            low_level_tap: links.as_ref().map(|r| r.link(&format!("{robot}/low_level"), low_level)),
+            services_tap: links
+                .as_ref()
+                .map(|r| r.link(&format!("{robot}/api"), &lowcmd_proto::description::API_CLIENT)),
             ..LowLevelOptions::on(interface, domain)
         };
         let (client, robot) = match robot {
             "go2" => (Client::Go2(Arc::new(py.detach(|| LowLevel::<Go2>::open(options)).map_err(raise)?)), "go2"),
-            "hg" => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(raise)?)), "hg"),
-            other => return Err(error(Kind::Argument, format!("robot = {other:?}: \"go2\" or \"hg\""))),
+            _ => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(raise)?)), "hg"),
         };
-        Ok(Self { client: Owned::new("Go2 client", client), robot })
+        Ok(Self { client: Owned::new("Go2 client", client), robot, capture })
     }
 
     /// `"go2"` or `"hg"`.
@@ -286,7 +301,12 @@ impl Go2LowLevel {
     }
 }
 
-closeable!(Go2LowLevel, client, "Sends damping last, leaves the domain. Idempotent.");
+closeable!(
+    Go2LowLevel,
+    client,
+    capture,
+    "Sends damping last, leaves the domain, then finishes its own capture. Idempotent."
+);
 
 /// Adds the classes to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

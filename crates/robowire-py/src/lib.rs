@@ -9,6 +9,7 @@ mod go2;
 mod kmc;
 mod owned;
 mod pyjson;
+mod record;
 mod runtime;
 mod sim;
 mod spline;
@@ -28,5 +29,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     go2::register(m)?;
     spline::register(m)?;
     device::register(m)?;
+    record::register(m)?;
     Ok(())
 }

@@ -42,15 +42,18 @@ impl<T> Owned<T> {
 }
 
 /// `close()`, `__enter__` and `__exit__` for `$class`, whose field `$field` is an [`Owned`]:
-/// closing drops the value with the GIL released; leaving a `with` block closes.
+/// closing drops the value with the GIL released, then finishes the capture in `$capture` (a
+/// [`crate::record::Capture`]) if given; leaving a `with` block closes.
 macro_rules! closeable {
-    ($class:ty, $field:ident, $doc:literal) => {
+    ($class:ty, $field:ident $(, $capture:ident)?, $doc:literal) => {
         #[pyo3::pymethods]
         impl $class {
             #[doc = $doc]
-            fn close(&self, py: pyo3::Python<'_>) {
+            fn close(&self, py: pyo3::Python<'_>) -> pyo3::PyResult<()> {
                 let value = self.$field.take();
                 py.detach(move || drop(value));
+                $(self.$capture.finish(py)?;)?
+                Ok(())
             }
 
             fn __enter__(slf: pyo3::Py<Self>) -> pyo3::Py<Self> {
@@ -58,8 +61,8 @@ macro_rules! closeable {
             }
 
             #[pyo3(signature = (*_exc))]
-            fn __exit__(&self, py: pyo3::Python<'_>, _exc: &pyo3::Bound<'_, pyo3::types::PyTuple>) {
-                self.close(py);
+            fn __exit__(&self, py: pyo3::Python<'_>, _exc: &pyo3::Bound<'_, pyo3::types::PyTuple>) -> pyo3::PyResult<()> {
+                self.close(py)
             }
         }
     };

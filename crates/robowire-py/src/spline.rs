@@ -7,6 +7,7 @@ use zsl::{ImuReader, JointControl, JointIndex, Leg, SplineClient, SplineCommandB
 
 use crate::errors::{Kind, chain, error};
 use crate::owned::{Owned, closeable};
+use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
 use crate::sim::state_dict;
 use crate::stats::dict;
@@ -61,23 +62,31 @@ fn sixteen(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<[[f32; 4]; 
 #[pyclass(name = "SplineClient", module = "robowire.spline", frozen)]
 pub(crate) struct PySplineClient {
     client: Owned<SplineClient>,
+    capture: Capture,
 }
 
 #[pymethods]
 impl PySplineClient {
     /// Opens the spline object `name`. Raises `NoStateError` if no daemon created it.
     /// `stall_after_s`: how long without fresh state while waiting makes the daemon stalled
-    /// (`None`: the facade's 10 ms, the daemon's period being 1 ms).
+    /// (`None`: the facade's 10 ms, the daemon's period being 1 ms). `record`: a path or a
+    /// `robowire.Recorder` to record the commands written and the states read into
+    /// (`spline/spline`).
     #[new]
-    #[pyo3(signature = (name = "/spline_shm", *, stall_after_s = None))]
-    fn new(name: &str, stall_after_s: Option<f64>) -> PyResult<Self> {
+    #[pyo3(signature = (name = "/spline_shm", *, stall_after_s = None, record = None))]
+    fn new(name: &str, stall_after_s: Option<f64>, record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         let stall_after = runtime::timeout("stall_after_s", stall_after_s)?;
         let client = SplineClient::open(name).map_err(raise)?;
         let client = match stall_after {
             Some(bound) => client.with_stall_after(bound),
             None => client,
         };
-        Ok(Self { client: Owned::new("spline client", client) })
+        let (links, capture) = record_arg(record, "robowire.spline.SplineClient")?;
+        let client = match links {
+            Some(r) => client.with_tap(r.link(robowire_devices::SPLINE_LINK, &zsl_proto::description::SPLINE_CLIENT)),
+            None => client,
+        };
+        Ok(Self { client: Owned::new("spline client", client), capture })
     }
 
     /// Writes every joint's target and raises the control flag. Each argument is one number
@@ -147,22 +156,29 @@ impl PySplineClient {
     }
 }
 
-closeable!(PySplineClient, client, "Unmaps the object. Idempotent.");
+closeable!(PySplineClient, client, capture, "Unmaps the object, then finishes its own capture. Idempotent.");
 
 /// The IMU samples the daemon publishes on `/imu_shm`.
 #[pyclass(name = "ImuReader", module = "robowire.spline", frozen)]
 pub(crate) struct PyImuReader {
     reader: Owned<ImuReader>,
+    capture: Capture,
 }
 
 #[pymethods]
 impl PyImuReader {
-    /// Opens the IMU object `name`.
+    /// Opens the IMU object `name`. `record`: a path or a `robowire.Recorder` to record each
+    /// sample read into (`spline/imu`).
     #[new]
-    #[pyo3(signature = (name = "/imu_shm"))]
-    fn new(name: &str) -> PyResult<Self> {
+    #[pyo3(signature = (name = "/imu_shm", *, record = None))]
+    fn new(name: &str, record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         let reader = ImuReader::open(name).map_err(|e| error(Kind::NoState, chain(&e)))?;
-        Ok(Self { reader: Owned::new("IMU reader", reader) })
+        let (links, capture) = record_arg(record, "robowire.spline.ImuReader")?;
+        let reader = match links {
+            Some(r) => reader.with_tap(r.link(robowire_devices::SPLINE_IMU_LINK, &zsl_proto::description::IMU)),
+            None => reader,
+        };
+        Ok(Self { reader: Owned::new("IMU reader", reader), capture })
     }
 
     /// The latest consistent sample: `timestamp_ns`, `acc_mps2`, `gyro_radps`,
@@ -178,7 +194,7 @@ impl PyImuReader {
     }
 }
 
-closeable!(PyImuReader, reader, "Unmaps the object. Idempotent.");
+closeable!(PyImuReader, reader, capture, "Unmaps the object, then finishes its own capture. Idempotent.");
 
 /// Adds the classes to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

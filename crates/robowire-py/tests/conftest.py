@@ -3,8 +3,8 @@
 Everything runs on loopback (each dog test on its own 127.0.0.x) or, for DDS, in a private
 network namespace entered here before any robowire thread starts (as root, or as the root of a
 user namespace: ``cargo xtask test`` runs pytest under ``unshare --user --map-root-user --net``). Tests that need something
-this machine may lack (the vendor's CPython 3.10 module, Unitree's SDK, DDS multicast) skip,
-unless ``ROBOWIRE_REQUIRE`` names it (``vendor``, ``sdk``, ``dds``; ``cargo xtask test`` sets
+this machine may lack (the vendor's CPython 3.10 module, Unitree's SDK, the mcap package, DDS multicast) skip,
+unless ``ROBOWIRE_REQUIRE`` names it (``vendor``, ``sdk``, ``mcap``, ``dds``, ``cli``; ``cargo xtask test`` sets
 it): then a missing peer fails the run instead of hiding it.
 """
 
@@ -33,6 +33,16 @@ def missing(what: str, reason: str) -> None:
     if what in REQUIRED:
         pytest.fail(f"{reason} (required here: ROBOWIRE_REQUIRE={','.join(sorted(REQUIRED))})")
     pytest.skip(reason)
+
+
+def cli() -> str:
+    """The robowire CLI: ``$ROBOWIRE_CLI``, else the workspace's build (skips without one)."""
+    path = os.environ.get("ROBOWIRE_CLI") or next(
+        (str(p) for p in (REPO / "target/debug/robowire", REPO / "target/release/robowire") if p.exists()), None
+    )
+    if not path:
+        missing("cli", "the robowire CLI is not built (cargo build -p robowire, or set ROBOWIRE_CLI)")
+    return path
 
 
 DDS_READY = False

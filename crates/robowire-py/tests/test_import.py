@@ -20,7 +20,7 @@ def test_importing_every_module_starts_no_thread_and_opens_nothing():
         def fds(): return len(os.listdir("/proc/self/fd"))
         before = (tasks(), fds())
         import robowire, robowire.zsl1, robowire.zsl1w, robowire.kmc, robowire.unitree
-        import robowire.go2, robowire.sim, robowire.spline, robowire.errors, robowire.device
+        import robowire.go2, robowire.sim, robowire.spline, robowire.errors, robowire.device, robowire.record
         after = (tasks(), fds())
         print(before, after)
         assert before == after, (before, after)
@@ -61,7 +61,9 @@ def test_crc_error_carries_both_crcs():
     assert isinstance(e, robowire.DecodeError)
 
 
-@pytest.mark.parametrize("module", ["robowire.zsl1", "robowire.kmc", "robowire.unitree", "robowire.device"])
+@pytest.mark.parametrize(
+    "module", ["robowire.zsl1", "robowire.kmc", "robowire.unitree", "robowire.device", "robowire.record"]
+)
 def test_the_examples_in_the_module_docs_run(module):
     result = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0

@@ -1,4 +1,5 @@
-"""The README's Python examples run as written, each in a fresh interpreter."""
+"""The READMEs' Python examples run as written, each in a fresh interpreter: the repository's
+Python section, and the recording example of the package's own README."""
 
 import re
 import subprocess
@@ -31,3 +32,12 @@ def test_a_readme_example_runs(block, request):
     result = subprocess.run([sys.executable, "-c", block], capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip(), "every example prints what it did"
+
+
+def test_the_recording_example_of_the_package_readme_runs():
+    readme = (REPO / "crates/robowire-py/README.md").read_text()
+    section = readme.split("\n## Recording\n", 1)[1].split("\n## ", 1)[0]
+    (block,) = re.findall(r"```python\n(.*?)```", section, flags=re.S)
+    result = subprocess.run([sys.executable, "-c", block], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "host.mcap: {'frames'" in result.stdout and "chassis.mcap" in result.stdout, result.stdout

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import robowire
-from conftest import REPO, missing
+from conftest import REPO, cli, missing
 from robowire.unitree import ArrayView, HgLowCmd, HgLowState, LowCmd, LowState, StructView
 
 FIXTURES = Path(os.environ.get("ROBOWIRE_FIXTURES", REPO / "fixtures"))  # the golden vectors, in the repo
@@ -158,15 +158,6 @@ def test_numeric_arrays_convert_to_numpy():
     state.foot_force = [1, 2, 3, 4]
     assert numpy.asarray(state.foot_force).dtype == numpy.int16
     assert numpy.asarray(state.imu_state.quaternion).dtype == numpy.float32
-
-
-def cli():
-    path = os.environ.get("ROBOWIRE_CLI") or next(
-        (str(p) for p in (REPO / "target/debug/robowire", REPO / "target/release/robowire") if p.exists()), None
-    )
-    if not path:
-        missing("cli", "the robowire CLI is not built (cargo build -p robowire, or set ROBOWIRE_CLI)")
-    return path
 
 
 @pytest.mark.parametrize("kind", ["lowcmd", "lowstate"])

@@ -8,12 +8,14 @@
 - :mod:`robowire.sim`: every simulator, in-process, as a context manager.
 - :func:`robowire.open`: any device by its address (``kmc:/dev/ttyUSB0``, ``zsl1:IP``,
   ``go2:eth0``, ``sim:zsl1``, …) as a :class:`robowire.Device` of one shape.
+- :class:`robowire.Recorder`: an MCAP capture of the links of every device given ``record=``.
 
 Importing robowire starts no thread and opens nothing.
 """
 
 from ._native import __version__
 from .device import Device, open
+from .record import Recorder
 from .errors import (
     ArgumentError,
     BindError,
@@ -31,6 +33,7 @@ __all__ = [
     "__version__",
     "open",
     "Device",
+    "Recorder",
     "Error",
     "ArgumentError",
     "ClosedError",

@@ -1,13 +1,17 @@
 """Type stubs of robowire.device (see device.py)."""
 
-from typing import Any, Dict, List, Optional
+from os import PathLike
+from typing import Any, Dict, List, Optional, Union
 
 from typing_extensions import Self
 
+from .record import Recorder
+
 __all__ = ["Device", "open"]
 
-def open(address: str, *, domain: int = 0) -> Device:
-    """kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:kmc|zsl1|zsl1w|go2; a bad address raises ArgumentError."""
+def open(address: str, *, domain: int = 0, record: Union[str, PathLike[str], Recorder, None] = None) -> Device:
+    """kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:kmc|zsl1|zsl1w|go2; a bad address raises ArgumentError.
+    record: a path (a capture of its own, finished by close()) or a Recorder."""
 
 class Device:
     """A device opened by robowire.open(address)."""

@@ -1,9 +1,11 @@
 """Type stubs of robowire.go2 (see go2.py)."""
 
+from os import PathLike
 from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
 
 from typing_extensions import Self
 
+from .record import Recorder
 from .unitree import HgLowCmd, HgLowState, LowCmd, LowState
 
 __all__ = ["LowLevel", "STAND_POSE_RAD"]
@@ -21,7 +23,9 @@ class LowLevel:
         interface: Optional[str] = None,
         robot: Literal["go2", "hg"] = "go2",
         service_timeout_s: float = 5.0,
-    ) -> None: ...
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record: go2/low_level and go2/api (hg/… for robot="hg") into a path or a Recorder."""
     @property
     def robot(self) -> str: ...
     def release_sport_mode(self) -> int:

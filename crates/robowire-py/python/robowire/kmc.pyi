@@ -1,9 +1,12 @@
 """Type stubs of robowire.kmc (see kmc.py)."""
 
 from dataclasses import dataclass
+from os import PathLike
 from typing import Any, Dict, Iterator, Optional, Tuple, Union
 
 from typing_extensions import Self
+
+from .record import Recorder
 
 __all__ = [
     "Driver",
@@ -85,7 +88,9 @@ class Driver:
         max_speed_mps: float = 20.0,
         reopen: bool = True,
         baud_rate: int = 115200,
-    ) -> None: ...
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record (robowire's): kmc/serial and kmc/serial_skipped into a path (finished by close()) or a Recorder."""
     @property
     def port(self) -> str: ...
     def start(self) -> None:

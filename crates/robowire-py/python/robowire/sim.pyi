@@ -1,14 +1,17 @@
 """Type stubs of robowire.sim (see sim.py)."""
 
-from typing import Any, Dict, List, Literal, Optional, Tuple
+from os import PathLike
+from typing import Any, Dict, List, Literal, Optional, Tuple, Union
 
 from typing_extensions import Self
+
+from .record import Recorder
 
 __all__ = ["Dog", "Chassis", "Spline", "Go2", "loopback_has_multicast", "enter_loopback_namespace"]
 
 class _Simulator:
     def close(self) -> None:
-        """Stops the simulator; idempotent."""
+        """Stops the simulator, then finishes the capture of record=PATH; idempotent."""
     def __enter__(self) -> Self: ...
     def __exit__(self, *exc: Any) -> None: ...
 
@@ -22,7 +25,9 @@ class Dog(_Simulator):
         high_level_port: int = 43997,
         low_level_port: int = 43900,
         state_period_s: float = 0.002,
-    ) -> None: ...
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record: dog/high_level and dog/low_level, the robot's side."""
     @property
     def ip(self) -> str: ...
     @property
@@ -48,7 +53,9 @@ class Chassis(_Simulator):
         command_watchdog_s: Optional[float] = 1.0,
         link: Optional[str] = None,
         seed: int = 0x5EEDCAFE,
-    ) -> None: ...
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record: kmc/serial and kmc/serial_skipped, the chassis's side."""
     @property
     def path(self) -> str: ...
     @property
@@ -64,8 +71,14 @@ class Chassis(_Simulator):
 class Spline(_Simulator):
     """The ZSL-1 spline daemon on POSIX shared memory (private object names by default)."""
     def __init__(
-        self, *, spline_name: Optional[str] = None, imu_name: Optional[str] = None, period_s: float = 0.001
-    ) -> None: ...
+        self,
+        *,
+        spline_name: Optional[str] = None,
+        imu_name: Optional[str] = None,
+        period_s: float = 0.001,
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record: spline/spline (the daemon's side) and spline/imu."""
     @property
     def spline_name(self) -> str: ...
     @property
@@ -77,7 +90,15 @@ class Spline(_Simulator):
 
 class Go2(_Simulator):
     """A Unitree Go2 on DDS."""
-    def __init__(self, *, domain: int = 0, interface: Optional[str] = None, state_period_s: float = 0.002) -> None: ...
+    def __init__(
+        self,
+        *,
+        domain: int = 0,
+        interface: Optional[str] = None,
+        state_period_s: float = 0.002,
+        record: Union[str, PathLike[str], Recorder, None] = None,
+    ) -> None:
+        """record: go2/low_level and go2/api, the robot's side."""
     @property
     def domain(self) -> int: ...
     def inject_silence(self) -> None: ...

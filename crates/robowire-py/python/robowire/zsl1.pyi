@@ -1,8 +1,11 @@
 """Type stubs of robowire.zsl1, the drop-in for mc_sdk_zsl_1_py (see zsl1.py)."""
 
+from os import PathLike
 from typing import Any, Dict, Iterable, Iterator, List, Optional, Tuple, Union, overload
 
 from typing_extensions import Self
+
+from .record import Recorder
 
 __all__ = ["HighLevel", "LowLevel", "MotorCommand", "MotorState", "JointArray"]
 
@@ -167,13 +170,14 @@ class _Session:
         """Waits up to timeout_s for state (GIL released, Ctrl-C interrupts)."""
     def stats(self) -> Dict[str, Any]: ...
     def close(self) -> None:
-        """Stops streaming and frees the port; idempotent."""
+        """Stops streaming and frees the port, and finishes the capture of record=PATH; idempotent."""
     def __enter__(self) -> Self: ...
     def __exit__(self, *exc: Any) -> None: ...
 
 class HighLevel(_Session):
     """The ZSL-1 HighLevel client (mc_sdk_zsl_1_py.HighLevel): the vendor's calls and codes."""
-    def __init__(self) -> None: ...
+    def __init__(self, *, record: Union[str, PathLike[str], Recorder, None] = None) -> None:
+        """record (robowire's): dog/high_level into a path or a Recorder."""
     def initRobot(self, local_ip: str, local_port: int, dog_ip: str = "192.168.234.1") -> None:
         """Binds local_ip:local_port, streams to dog_ip:43997 every 2 ms; raises BindError."""
     def checkConnect(self) -> bool: ...
@@ -224,7 +228,8 @@ class HighLevel(_Session):
 
 class LowLevel(_Session):
     """The ZSL-1 LowLevel client (mc_sdk_zsl_1_py.LowLevel)."""
-    def __init__(self) -> None: ...
+    def __init__(self, *, record: Union[str, PathLike[str], Recorder, None] = None) -> None:
+        """record (robowire's): dog/low_level into a path or a Recorder."""
     def initRobot(self, local_ip: str, local_port: int, dog_ip: str = "192.168.234.1") -> None:
         """Binds local_ip:local_port, streams to dog_ip:43900 every 2 ms; raises BindError."""
     def checkConnect(self) -> bool: ...

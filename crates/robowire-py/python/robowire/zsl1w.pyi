@@ -1,14 +1,17 @@
 """Type stubs of robowire.zsl1w, the drop-in for mc_sdk_zsl_1w_py (see zsl1w.py)."""
 
-from typing import List
+from os import PathLike
+from typing import List, Union
 
+from .record import Recorder
 from .zsl1 import _Session
 
 __all__ = ["HighLevel"]
 
 class HighLevel(_Session):
     """The ZSL-1W HighLevel client (mc_sdk_zsl_1w_py.HighLevel)."""
-    def __init__(self) -> None: ...
+    def __init__(self, *, record: Union[str, PathLike[str], Recorder, None] = None) -> None:
+        """record (robowire's): dog/high_level into a path or a Recorder."""
     def initRobot(self, local_ip: str, local_port: int, dog_ip: str = "192.168.234.1") -> None: ...
     def checkConnect(self) -> bool: ...
     def standUp(self) -> int: ...

@@ -13,6 +13,7 @@ use robowire_rt::lock;
 
 use super::{frame_to_py, raise, state_to_py};
 use crate::errors::{Kind, chain, error};
+use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
 use crate::stats::{dict, lateness};
 
@@ -55,6 +56,8 @@ pub(crate) struct Driver {
     /// The options `start()` opens with (`set_command_timeout` changes them).
     options: Mutex<DriverOptions>,
     port: String,
+    /// Finished by `close()`: every run between records into it.
+    capture: Capture,
 }
 
 impl Driver {
@@ -123,9 +126,12 @@ impl Driver {
 impl Driver {
     /// A stopped driver for the chassis at `port`; `start()` (or `with`) opens it. Options
     /// are the vendor's, with its defaults; -1 keeps `realtime_priority` (`SCHED_FIFO` 1..99)
-    /// and `cpu_affinity` off. Raises `ArgumentError` for an option out of range.
+    /// and `cpu_affinity` off. Raises `ArgumentError` for an option out of range. `record` (not
+    /// the vendor's): a path or a `robowire.Recorder` to record the line into (`kmc/serial`,
+    /// and `kmc/serial_skipped`: the bytes the decoder skipped), from every `start()` to
+    /// `stop()`; a path's capture is finished by `close()`.
     #[new]
-    #[pyo3(signature = (port, *, control_rate_hz = 100.0, vehicle_speed_rate_hz = 50.0, poll_battery = false, poll_allstate = false, command_timeout_ms = 300, stop_burst_count = 3, realtime_priority = -1, cpu_affinity = -1, max_queue = 1024, lock_memory = false, max_speed_mps = 20.0, reopen = true, baud_rate = 115_200))]
+    #[pyo3(signature = (port, *, control_rate_hz = 100.0, vehicle_speed_rate_hz = 50.0, poll_battery = false, poll_allstate = false, command_timeout_ms = 300, stop_burst_count = 3, realtime_priority = -1, cpu_affinity = -1, max_queue = 1024, lock_memory = false, max_speed_mps = 20.0, reopen = true, baud_rate = 115_200, record = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         port: String,
@@ -142,6 +148,7 @@ impl Driver {
         max_speed_mps: f32,
         reopen: bool,
         baud_rate: u32,
+        record: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let placement = Placement {
             realtime_priority: optional("realtime_priority", realtime_priority, "1..=99")?,
@@ -170,7 +177,12 @@ impl Driver {
             ..defaults
         };
         options.validate().map_err(raise)?;
-        Ok(Self { run: RwLock::new(Run::Stopped(Mutex::default())), options: Mutex::new(options), port })
+        let (links, capture) = record_arg(record, "robowire.kmc.Driver")?;
+        let options = DriverOptions {
+            taps: links.map(|r| robowire_devices::kmc_taps(&r, &kmc_proto::description::HOST)).unwrap_or_default(),
+            ..options
+        };
+        Ok(Self { run: RwLock::new(Run::Stopped(Mutex::default())), options: Mutex::new(options), port, capture })
     }
 
     /// The port path.
@@ -363,13 +375,16 @@ impl Driver {
         }))
     }
 
-    /// Stops (stop burst) and releases the port for good.
+    /// Stops (stop burst) and releases the port for good, then finishes the capture of
+    /// `record=PATH`.
     fn close(&self, py: Python<'_>) -> PyResult<()> {
         let run = py.detach(|| std::mem::replace(&mut *self.write(), Run::Closed));
-        match run {
+        let closed = match run {
             Run::Running(driver) => py.detach(move || driver.close()).map_err(raise),
             Run::Stopped(_) | Run::Closed => Ok(()),
-        }
+        };
+        let finished = self.capture.finish(py);
+        closed.and(finished)
     }
 
     /// Starts the driver unless it runs already.

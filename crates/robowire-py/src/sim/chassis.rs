@@ -10,6 +10,7 @@ use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 use crate::errors::{Kind, error};
 use crate::owned::{Owned, closeable};
 use crate::pyjson;
+use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
 use crate::stats::dict;
 
@@ -25,6 +26,7 @@ use crate::stats::dict;
 #[pyclass(module = "robowire.sim", frozen)]
 pub(crate) struct Chassis {
     sim: Owned<ChassisSim>,
+    capture: Capture,
 }
 
 fn text(path: PathBuf) -> String {
@@ -35,9 +37,11 @@ fn text(path: PathBuf) -> String {
 impl Chassis {
     /// Opens a pty and starts the chassis at rest. `link`: a symlink kept pointing at the
     /// current pty (across `replug()`); `command_watchdog_s=None` disables the chassis's own
-    /// watchdog.
+    /// watchdog. `record`: a path or a `robowire.Recorder` to record the chassis's side of the
+    /// line into (`kmc/serial`, and `kmc/serial_skipped`: the bytes it skipped).
     #[new]
-    #[pyo3(signature = (*, speed_time_constant_s = 0.2, battery_initial_volts = 25.2, battery_drain_volts_per_s = 0.0005, command_watchdog_s = Some(1.0), link = None, seed = 0x5eed_cafe))]
+    #[pyo3(signature = (*, speed_time_constant_s = 0.2, battery_initial_volts = 25.2, battery_drain_volts_per_s = 0.0005, command_watchdog_s = Some(1.0), link = None, seed = 0x5eed_cafe, record = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         speed_time_constant_s: f64,
@@ -46,6 +50,7 @@ impl Chassis {
         command_watchdog_s: Option<f64>,
         link: Option<PathBuf>,
         seed: u64,
+        record: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         for (name, v) in
             [("battery_initial_volts", battery_initial_volts), ("battery_drain_volts_per_s", battery_drain_volts_per_s)]
@@ -54,6 +59,7 @@ impl Chassis {
                 return Err(error(Kind::Argument, format!("{name} = {v} must be finite and not negative")));
             }
         }
+        let (links, capture) = record_arg(record, "robowire.sim.Chassis")?;
         let config = ChassisSimConfig {
             speed_time_constant: seconds("speed_time_constant_s", speed_time_constant_s)?,
             battery_initial_volts,
@@ -61,7 +67,7 @@ impl Chassis {
             command_watchdog: command_watchdog_s.map(|s| seconds("command_watchdog_s", s)).transpose()?,
             link,
             seed,
-            ..ChassisSimConfig::default()
+            taps: links.map(|r| robowire_devices::kmc_taps(&r, &kmc_proto::description::CHASSIS)).unwrap_or_default(),
         };
         if config.speed_time_constant.is_zero() || config.command_watchdog.is_some_and(|w| w < Duration::from_millis(1))
         {
@@ -70,7 +76,7 @@ impl Chassis {
         let sim = py
             .detach(|| ChassisSim::spawn(config))
             .map_err(|e| error(Kind::Port, format!("chassis simulator: {e}")))?;
-        Ok(Self { sim: Owned::new("chassis simulator", sim) })
+        Ok(Self { sim: Owned::new("chassis simulator", sim), capture })
     }
 
     /// The path to open: the symlink if one was asked for, else the pty.
@@ -150,4 +156,9 @@ impl Chassis {
     }
 }
 
-closeable!(Chassis, sim, "Stops the simulator; the pty (and its symlink) go away. Idempotent.");
+closeable!(
+    Chassis,
+    sim,
+    capture,
+    "Stops the simulator; the pty (and its symlink) go away; then finishes its own capture. Idempotent."
+);

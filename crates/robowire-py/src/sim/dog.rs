@@ -9,6 +9,7 @@ use zsl_proto::udp::{Model, ReturnCode};
 
 use crate::errors::{Kind, error};
 use crate::owned::{Owned, closeable};
+use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
 use crate::stats::{dict, lateness};
 
@@ -28,6 +29,7 @@ pub(crate) struct Dog {
     ip: String,
     high_level: SocketAddr,
     low_level: SocketAddr,
+    capture: Capture,
 }
 
 fn model(name: &str) -> PyResult<Model> {
@@ -71,9 +73,11 @@ fn port<'py>(py: Python<'py>, p: &PortStats) -> PyResult<Bound<'py, PyDict>> {
 #[pymethods]
 impl Dog {
     /// Binds both ports on `ip` and starts the robot lying down. `model` `"zsl1"` or `"zsl1w"`;
-    /// port 0 picks a free one. Raises `BindError` if a port is taken.
+    /// port 0 picks a free one. Raises `BindError` if a port is taken. `record`: a path or a
+    /// `robowire.Recorder` to record both ports' datagrams into (`dog/high_level`,
+    /// `dog/low_level`).
     #[new]
-    #[pyo3(signature = (model = "zsl1", *, ip = "127.0.0.1", high_level_port = 43997, low_level_port = 43900, state_period_s = 0.002))]
+    #[pyo3(signature = (model = "zsl1", *, ip = "127.0.0.1", high_level_port = 43997, low_level_port = 43900, state_period_s = 0.002, record = None))]
     fn new(
         py: Python<'_>,
         model: &str,
@@ -81,6 +85,7 @@ impl Dog {
         high_level_port: u16,
         low_level_port: u16,
         state_period_s: f64,
+        record: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let bind: IpAddr =
             ip.parse().map_err(|_| error(Kind::Argument, format!("ip = {ip:?} is not an IP address")))?;
@@ -88,17 +93,21 @@ impl Dog {
         if state_period.is_zero() {
             return Err(error(Kind::Argument, "state_period_s must be above 0"));
         }
+        let model = self::model(model)?;
+        let (links, capture) = record_arg(record, "robowire.sim.Dog")?;
         let config = DogSimConfig {
             bind,
             high_level_port,
             low_level_port,
-            model: self::model(model)?,
+            model,
             state_period,
+            high_level_tap: links.as_ref().map(|r| r.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
+            low_level_tap: links.as_ref().map(|r| r.link("dog/low_level", &zsl_proto::description::LOW_LEVEL)),
             ..DogSimConfig::default()
         };
         let sim = py.detach(|| DogSim::spawn(config)).map_err(|e| error(Kind::Bind, e))?;
         let (high_level, low_level) = (sim.high_level_addr(), sim.low_level_addr());
-        Ok(Self { sim: Owned::new("dog simulator", sim), ip: bind.to_string(), high_level, low_level })
+        Ok(Self { sim: Owned::new("dog simulator", sim), ip: bind.to_string(), high_level, low_level, capture })
     }
 
     /// The IP both ports are bound on (the `dog_ip` of `initRobot`).
@@ -192,4 +201,4 @@ impl Dog {
     }
 }
 
-closeable!(Dog, sim, "Stops the simulator and frees its ports. Idempotent.");
+closeable!(Dog, sim, capture, "Stops the simulator and frees its ports, then finishes its own capture. Idempotent.");

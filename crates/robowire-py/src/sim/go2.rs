@@ -7,6 +7,7 @@ use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 
 use crate::errors::{Kind, chain, error};
 use crate::owned::{Owned, closeable};
+use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
 use crate::stats::{dict, lateness};
 
@@ -19,6 +20,7 @@ use crate::stats::{dict, lateness};
 pub(crate) struct Go2 {
     sim: Owned<Go2Sim>,
     domain: u16,
+    capture: Capture,
 }
 
 pub(crate) fn topic<'py>(py: Python<'py>, t: &TopicStats) -> PyResult<Bound<'py, PyDict>> {
@@ -33,21 +35,31 @@ pub(crate) fn topic<'py>(py: Python<'py>, t: &TopicStats) -> PyResult<Bound<'py,
 #[pymethods]
 impl Go2 {
     /// Joins DDS domain `domain` on `interface` (`None`: the library's choice) and boots lying
-    /// down with its sport mode owning the motors.
+    /// down with its sport mode owning the motors. `record`: a path or a `robowire.Recorder`
+    /// to record the robot's side of `go2/low_level` and `go2/api` into.
     #[new]
-    #[pyo3(signature = (*, domain = 0, interface = None, state_period_s = 0.002))]
-    fn new(py: Python<'_>, domain: u16, interface: Option<&str>, state_period_s: f64) -> PyResult<Self> {
+    #[pyo3(signature = (*, domain = 0, interface = None, state_period_s = 0.002, record = None))]
+    fn new(
+        py: Python<'_>,
+        domain: u16,
+        interface: Option<&str>,
+        state_period_s: f64,
+        record: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let state_period = seconds("state_period_s", state_period_s)?;
         if state_period.as_micros() < 100 {
             return Err(error(Kind::Argument, "state_period_s must be at least 0.0001"));
         }
+        let (links, capture) = record_arg(record, "robowire.sim.Go2")?;
         let config = Go2SimConfig {
             participant: ParticipantOptions::new(domain, interface),
             state_period,
+            low_level_tap: links.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
+            services_tap: links.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
             ..Go2SimConfig::default()
         };
         let sim = py.detach(|| Go2Sim::spawn(config)).map_err(|e| error(Kind::Error, chain(&e)))?;
-        Ok(Self { sim: Owned::new("Go2 simulator", sim), domain })
+        Ok(Self { sim: Owned::new("Go2 simulator", sim), domain, capture })
     }
 
     /// The DDS domain.
@@ -115,7 +127,7 @@ impl Go2 {
     }
 }
 
-closeable!(Go2, sim, "Leaves the domain and stops the robot. Idempotent.");
+closeable!(Go2, sim, capture, "Leaves the domain and stops the robot, then finishes its own capture. Idempotent.");
 
 /// Whether loopback carries multicast here (DDS discovery on one machine needs it).
 #[pyfunction]

@@ -7,6 +7,7 @@ use zsl_proto::shm::{JointIndex, Leg, SplineStateBlock};
 
 use crate::errors::{Kind, error};
 use crate::owned::{Owned, closeable};
+use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
 use crate::stats::{dict, lateness};
 
@@ -19,6 +20,7 @@ pub(crate) struct Spline {
     sim: Owned<SplineSim>,
     spline_name: String,
     imu_name: String,
+    capture: Capture,
 }
 
 /// `[leg][joint]` (legs FR, FL, RR, RL; joints abad, hip, knee, foot) of one quantity.
@@ -42,24 +44,35 @@ pub(crate) fn state_dict<'py>(py: Python<'py>, state: &SplineStateBlock) -> PyRe
 
 #[pymethods]
 impl Spline {
-    /// Creates both objects and starts the loop (`period_s`, default 1 ms).
+    /// Creates both objects and starts the loop (`period_s`, default 1 ms). `record`: a path or
+    /// a `robowire.Recorder` to record the daemon's side of `spline/spline` and the IMU records
+    /// it publishes (`spline/imu`) into.
     #[new]
-    #[pyo3(signature = (*, spline_name = None, imu_name = None, period_s = 0.001))]
-    fn new(py: Python<'_>, spline_name: Option<String>, imu_name: Option<String>, period_s: f64) -> PyResult<Self> {
+    #[pyo3(signature = (*, spline_name = None, imu_name = None, period_s = 0.001, record = None))]
+    fn new(
+        py: Python<'_>,
+        spline_name: Option<String>,
+        imu_name: Option<String>,
+        period_s: f64,
+        record: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let private = SplineSimConfig::private("py");
         let period = seconds("period_s", period_s)?;
         if period.is_zero() {
             return Err(error(Kind::Argument, "period_s must be above 0"));
         }
+        let (links, capture) = record_arg(record, "robowire.sim.Spline")?;
         let config = SplineSimConfig {
             spline_name: spline_name.unwrap_or(private.spline_name),
             imu_name: imu_name.unwrap_or(private.imu_name),
             period,
+            tap: links.as_ref().map(|r| r.link(robowire_devices::SPLINE_LINK, &zsl_proto::description::SPLINE_DAEMON)),
+            imu_tap: links.as_ref().map(|r| r.link(robowire_devices::SPLINE_IMU_LINK, &zsl_proto::description::IMU)),
             ..SplineSimConfig::default()
         };
         let (spline_name, imu_name) = (config.spline_name.clone(), config.imu_name.clone());
         let sim = py.detach(|| SplineSim::spawn(config)).map_err(|e| error(Kind::Error, crate::errors::chain(&e)))?;
-        Ok(Self { sim: Owned::new("spline simulator", sim), spline_name, imu_name })
+        Ok(Self { sim: Owned::new("spline simulator", sim), spline_name, imu_name, capture })
     }
 
     /// Name of the spline object (open it with `robowire.spline.SplineClient`).
@@ -118,4 +131,9 @@ impl Spline {
     }
 }
 
-closeable!(Spline, sim, "Stops the daemon and removes its objects. Idempotent.");
+closeable!(
+    Spline,
+    sim,
+    capture,
+    "Stops the daemon and removes its objects, then finishes its own capture. Idempotent."
+);

@@ -28,10 +28,12 @@ macro_rules! high_level_class {
         #[allow(non_snake_case)]
         #[pymethods]
         impl $class {
-            /// Not connected until `initRobot`.
+            /// Not connected until `initRobot`. `record` (not the vendor's): a path or a
+            /// `robowire.Recorder` to record every datagram both ways into (`dog/high_level`).
             #[new]
-            fn new() -> Self {
-                Self { session: Session::new($model) }
+            #[pyo3(signature = (*, record = None))]
+            fn new(record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+                Ok(Self { session: Session::new($model, record)? })
             }
 
             /// Binds `local_ip:local_port` (where the robot sends its state; its

@@ -24,10 +24,12 @@ pub(crate) struct Zsl1LowLevel {
 #[allow(non_snake_case)]
 #[pymethods]
 impl Zsl1LowLevel {
-    /// Not connected until `initRobot`.
+    /// Not connected until `initRobot`. `record` (not the vendor's): a path or a
+    /// `robowire.Recorder` to record every datagram both ways into (`dog/low_level`).
     #[new]
-    fn new() -> Self {
-        Self { session: Session::new(Model::Zsl1) }
+    #[pyo3(signature = (*, record = None))]
+    fn new(record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        Ok(Self { session: Session::new(Model::Zsl1, record)? })
     }
 
     /// Binds `local_ip:local_port` and starts streaming to `dog_ip:43900`. Raises `BindError`

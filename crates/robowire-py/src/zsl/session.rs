@@ -8,11 +8,13 @@ use std::time::Duration;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use robowire_core::json::LinkProtocol;
 use zsl::udp::{
     self as facade, CallError, ClientOptions, ClientStats, ConnectError, Connection, Device, Latched, Model, ReturnCode,
 };
 
 use crate::errors::{Kind, chain, error};
+use crate::record::{Capture, record_arg};
 use crate::runtime;
 use crate::stats::{dict, lateness};
 
@@ -22,6 +24,8 @@ pub(crate) trait Facade:
 {
     /// The vendor's name, for messages.
     const NAME: &'static str;
+    /// The link it is recorded as, and its description.
+    fn link() -> (&'static str, &'static LinkProtocol);
     /// Options for `initRobot(local_ip, local_port, dog_ip)`.
     fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions;
     /// Binds and starts streaming.
@@ -33,9 +37,12 @@ pub(crate) trait Facade:
 }
 
 macro_rules! facade {
-    ($t:ty, $name:literal, $options:path) => {
+    ($t:ty, $name:literal, $options:path, $link:literal, $description:path) => {
         impl Facade for $t {
             const NAME: &'static str = $name;
+            fn link() -> (&'static str, &'static LinkProtocol) {
+                ($link, &$description)
+            }
             fn options(local: IpAddr, port: u16, dog: IpAddr) -> ClientOptions {
                 $options(local, port, dog)
             }
@@ -52,8 +59,14 @@ macro_rules! facade {
     };
 }
 
-facade!(facade::HighLevel, "HighLevel", ClientOptions::high_level);
-facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level);
+facade!(
+    facade::HighLevel,
+    "HighLevel",
+    ClientOptions::high_level,
+    "dog/high_level",
+    zsl_proto::description::HIGH_LEVEL
+);
+facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level, "dog/low_level", zsl_proto::description::LOW_LEVEL);
 
 /// A `ConnectError` as the exception a Python user expects; `what` says who failed.
 pub(crate) fn connect_error(what: &str, e: &ConnectError) -> PyErr {
@@ -81,6 +94,9 @@ pub(crate) struct Session<T> {
     model: Model,
     running: RwLock<Option<Running<T>>>,
     last_error: Mutex<Option<String>>,
+    /// Every client `initRobot` opens records its datagrams here.
+    tap: Option<robowire_tap::Tap>,
+    capture: Capture,
 }
 
 fn parse_ip(name: &str, text: &str) -> PyResult<IpAddr> {
@@ -88,8 +104,13 @@ fn parse_ip(name: &str, text: &str) -> PyResult<IpAddr> {
 }
 
 impl<T: Facade> Session<T> {
-    pub(crate) fn new(model: Model) -> Self {
-        Self { model, running: RwLock::new(None), last_error: Mutex::new(None) }
+    /// Not connected; `record` (`None`, a path or a `robowire.Recorder`) records every
+    /// client's datagrams.
+    pub(crate) fn new(model: Model, record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let (links, capture) = record_arg(record, &format!("robowire.zsl1.{}", T::NAME))?;
+        let (link, description) = T::link();
+        let tap = links.map(|r| r.link(link, description));
+        Ok(Self { model, running: RwLock::new(None), last_error: Mutex::new(None), tap, capture })
     }
 
     /// `initRobot`: binds `local_ip:local_port`, streams to `dog_ip`. A second call replaces
@@ -99,8 +120,15 @@ impl<T: Facade> Session<T> {
         let dog = parse_ip("dog_ip", dog_ip)?;
         let port = u16::try_from(local_port)
             .map_err(|_| error(Kind::Argument, format!("local_port = {local_port} is outside 0..=65535")))?;
-        self.close(py)?;
-        let options = T::options(local, port, dog).with_model(self.model);
+        self.close_client(py);
+        if self.capture.is_finished() {
+            return Err(error(
+                Kind::Closed,
+                format!("this {}'s capture was finished by close(): record into a new object", T::NAME),
+            ));
+        }
+        let mut options = T::options(local, port, dog).with_model(self.model);
+        options.tap = self.tap.clone();
         let dog = options.dog;
         let client =
             py.detach(|| T::open(options)).map_err(|e| connect_error(&format!("{}.initRobot", T::NAME), &e))?;
@@ -109,8 +137,14 @@ impl<T: Facade> Session<T> {
     }
 
     /// Stops streaming and frees the port (bound again at once if no other thread is inside a
-    /// call on this client). Idempotent.
+    /// call on this client), then finishes the capture of `record=PATH`. Idempotent.
     pub(crate) fn close(&self, py: Python<'_>) -> PyResult<()> {
+        self.close_client(py);
+        self.capture.finish(py)
+    }
+
+    /// Stops streaming and frees the port.
+    fn close_client(&self, py: Python<'_>) {
         let old = robowire_rt::sync::write(&self.running).take();
         if let Some(Running { client, .. }) = old {
             match Arc::try_unwrap(client) {
@@ -118,7 +152,6 @@ impl<T: Facade> Session<T> {
                 Err(shared) => py.detach(move || drop(shared)),
             }
         }
-        Ok(())
     }
 
     /// The running client, or `ClosedError`.
@@ -277,7 +310,8 @@ macro_rules! session_methods {
             }
 
             /// robowire: stops streaming and frees the port (the robot stops a walk on its own
-            /// command timeout). Idempotent; `initRobot` connects again.
+            /// command timeout), and finishes the capture of `record=PATH`. Idempotent;
+            /// `initRobot` connects again (unless it recorded into a path of its own).
             fn close(&self, py: pyo3::Python<'_>) -> pyo3::PyResult<()> {
                 self.session.close(py)
             }
