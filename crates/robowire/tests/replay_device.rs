@@ -1,7 +1,8 @@
-//! `robowire replay --as-device` on the demo's KMC and Go2 captures: a live client (the `kmc`
-//! driver on the replay's pseudo-terminal, the `go2` low-level client on DDS in a private
-//! network) goes through the recorded states, in order, as many as were recorded; and what it
-//! cannot play is a clear error (exit code 1), never a panic.
+//! `robowire replay --as-device` on the demo's KMC, Go2 and spline captures: a live client (the
+//! `kmc` driver on the replay's pseudo-terminal, the `go2` low-level client on DDS in a private
+//! network, a spline client and IMU reader on the replay's shared memory) goes through the
+//! recorded states, in order; and what it cannot play is a clear error (exit code 1), never a
+//! panic.
 
 mod support;
 
@@ -34,6 +35,7 @@ fn record_demo(device: &str, capture: &Path) -> Vec<RecordedFrame> {
     let descriptions = [
         &kmc_proto::description::DESCRIPTIONS[..],
         &lowcmd_proto::description::DESCRIPTIONS,
+        &zsl_proto::description::DESCRIPTIONS,
         &[&robowire_core::json::SKIPPED_BYTES],
     ]
     .concat();
@@ -92,6 +94,61 @@ fn a_live_kmc_driver_goes_through_the_recorded_chassis_frames() {
     assert_eq!(received, recorded.len() as u64, "the driver counted as many frames as were recorded");
     let n = recorded.len();
     assert!(out.stderr.contains(&format!("wrote {n} of {n} chassis frames")), "{}", out.stderr);
+    let _ = std::fs::remove_file(capture);
+}
+
+#[test]
+fn a_live_spline_client_takes_the_recorded_daemon_states() {
+    use zsl::spline::{ImuReader, SplineClient};
+    use zsl_proto::shm::SplineCommandBlock;
+    use zsl_proto::zerocopy::IntoBytes;
+    let capture = temp("spline.mcap");
+    let frames = record_demo("spline", &capture);
+    // Recorded at the motion controller: the states it took, the IMU samples it read.
+    let recorded: Vec<&[u8]> = frames
+        .iter()
+        .filter(|f| f.link == "spline/spline" && f.direction == Direction::Received)
+        .map(|f| f.bytes.as_slice())
+        .collect();
+    let last_imu = frames.iter().rev().find(|f| f.link == "spline/imu").map(|f| f.bytes.clone()).unwrap();
+    assert!(recorded.len() > 500, "{} states", recorded.len());
+
+    let pid = std::process::id();
+    let (spline, imu) = (format!("/robowire-replay-{pid}-spline"), format!("/robowire-replay-{pid}-imu"));
+    let replay = Running::spawn(
+        robowire()
+            .args(["replay", "--as-device", "--speed", "0.5", "--spline-name", &spline, "--imu-name", &imu])
+            .arg(&capture)
+            .stderr(Stdio::piped()),
+    );
+    assert_eq!(replay.first_line, format!("{spline} {imu}"));
+    let mut client = SplineClient::open(&spline).unwrap();
+    // Mapped now: the objects go when the player ends.
+    let mut imu_reader = ImuReader::open(&imu).unwrap();
+    client.write_command(&SplineCommandBlock::default()).unwrap();
+    // Every state taken until the last recorded one comes (the handshake keeps the newest: a
+    // client that looks late skips states, as it would on the robot).
+    let began = std::time::Instant::now();
+    let mut seen: Vec<Vec<u8>> = Vec::new();
+    while seen.last().map(Vec::as_slice) != recorded.last().copied() {
+        assert!(began.elapsed() < WAIT, "after {} states, not the last recorded one", seen.len());
+        if let Some(state) = client.try_read_state().unwrap() {
+            seen.push(state.legs.as_bytes().to_vec());
+            client.write_command(&SplineCommandBlock::default()).unwrap();
+        }
+        std::hint::spin_loop();
+    }
+    let out = replay.wait();
+    assert!(out.status.success(), "{}", out.stderr);
+    // In the recorded order: each state seen is a recorded one, after the one seen before.
+    let mut at = 0;
+    for state in &seen {
+        at += recorded[at..].iter().position(|r| *r == state.as_slice()).expect("a recorded state, in order") + 1;
+    }
+    assert!(seen.len() * 2 > recorded.len(), "most states taken: {} of {}", seen.len(), recorded.len());
+    let sample = imu_reader.read().unwrap();
+    assert_eq!(sample.timestamp_ns.to_le_bytes(), last_imu[..8], "the last IMU record, as recorded");
+    assert!(out.stderr.contains("published") && out.stderr.contains("commands"), "{}", out.stderr);
     let _ = std::fs::remove_file(capture);
 }
 

@@ -9,6 +9,8 @@
 //!   stream decoder, from the host's first frame on (the KMC chassis).
 //! - [`DdsReplay`] (feature `replay-dds`): on a DDS topic, as raw payloads, from the first
 //!   matched reader on (the Go2's `rt/lowstate`).
+//! - [`SplineReplay`] (feature `zsl`): on shared memory as the ZSL-1's motor daemon (spline
+//!   states and IMU records), from the motion controller's first command on.
 //!
 //! Each sends every frame on robowire's runner at its due time: the recorded offset divided by
 //! a speed, or at once ([`Pace`]); what the client sends meanwhile is counted.
@@ -19,6 +21,8 @@ mod datagram;
 mod dds;
 #[cfg(feature = "replay-serial")]
 mod serial;
+#[cfg(feature = "zsl")]
+mod shm;
 
 use std::time::Duration;
 
@@ -31,6 +35,8 @@ pub use self::datagram::DatagramReplay;
 pub use self::dds::{DdsReplay, DdsTopic};
 #[cfg(feature = "replay-serial")]
 pub use self::serial::SerialReplay;
+#[cfg(feature = "zsl")]
+pub use self::shm::SplineReplay;
 
 /// How fast to play.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,6 +87,18 @@ pub enum ReplayError {
     #[cfg(feature = "replay-dds")]
     #[error("DDS")]
     Dds(#[from] robowire_dds::DdsError),
+    /// A recorded frame of the wrong length for what it is played as.
+    #[error("frame {index}: a {what} is {expected} bytes, found {found}")]
+    Length {
+        /// The frame's index among those of its kind.
+        index: usize,
+        /// What it is played as (`spline state`).
+        what: &'static str,
+        /// Its length.
+        expected: usize,
+        /// The frame's.
+        found: usize,
+    },
     /// A recorded DDS payload that a raw writer cannot send as recorded: its encapsulation
     /// header is not the one the writer puts before every body.
     #[error(

@@ -139,7 +139,8 @@ pub(crate) struct ReplayArgs {
     /// Play the device's side of the capture to a live client instead, on the transport of the
     /// link's protocol: ZSL-1 states on UDP (the HighLevel or LowLevel port of --bind), KMC
     /// chassis frames on a pseudo-terminal (its path the first line), Go2 LowStates on DDS
-    /// rt/lowstate (--interface, --domain).
+    /// rt/lowstate (--interface, --domain), the spline daemon's states and IMU records on shared
+    /// memory (--spline-name, --imu-name).
     #[arg(long)]
     as_device: bool,
     /// With --as-device on a ZSL-1 link: the address to serve on.
@@ -151,6 +152,12 @@ pub(crate) struct ReplayArgs {
     /// With --as-device on a Go2 link: where to publish.
     #[command(flatten)]
     dds: crate::cmd::go2::DdsArgs,
+    /// With --as-device on a spline link: the spline object to create (the robot's name).
+    #[arg(long, default_value = "/spline_shm", requires = "as_device")]
+    spline_name: String,
+    /// With --as-device on a spline link: the IMU object to create (the robot's name).
+    #[arg(long, default_value = "/imu_shm", requires = "as_device")]
+    imu_name: String,
 }
 
 /// Replays a capture into the decoders, at the recorded pace (or `--speed`, or `--fast`).
@@ -168,6 +175,7 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
             link: args.link.as_deref(),
             bind: args.bind,
             dds: &args.dds,
+            shm: (&args.spline_name, &args.imu_name),
             speed: (!args.fast).then_some(args.speed),
         };
         return crate::cmd::replay_device::run(&frames, &target);

@@ -8,11 +8,15 @@
 //!   frames on a pseudo-terminal, [`serial`].
 //! - `unitree_go.low_level`: the Go2's `LowState_` payloads (either direction: the client
 //!   received them, a simulator sent them) on DDS `rt/lowstate`, [`dds`].
+//! - `zsl1.spline.client` (its received frames) or `zsl1.spline.daemon` (its sent frames): the
+//!   spline daemon's states on shared memory, with the IMU records of the device's `zsl1.imu`
+//!   link, [`shm`].
 //!
 //! This picks the device's frames out of the capture; `robowire_sim::replay` plays them.
 
 mod dds;
 mod serial;
+mod shm;
 mod udp;
 
 use std::collections::BTreeMap;
@@ -26,6 +30,7 @@ use lowcmd_proto::description::GO2_LOW_LEVEL;
 use lowcmd_proto::{CdrEncoding, LowState, Message};
 use robowire_record::{Direction, RecordedFrame};
 use robowire_sim::replay::Pace;
+use zsl_proto::description::{HIGH_LEVEL, IMU, LOW_LEVEL, SPLINE_CLIENT, SPLINE_DAEMON};
 use zsl_proto::udp::AnyDatagram;
 
 /// A device robowire plays the side of.
@@ -37,17 +42,22 @@ enum Device {
     KmcChassis,
     /// A Go2's low-level link on DDS.
     Go2,
+    /// The ZSL-1's spline daemon on shared memory.
+    Spline,
 }
 
 /// What `--as-device` plays, for the error that finds none.
 const PLAYABLE: &str = "ZSL-1 states (zsl1.high_level, zsl1.low_level), KMC chassis frames (kmc.host received, \
-                        kmc.chassis sent) and Go2 LowStates (unitree_go.low_level)";
+                        kmc.chassis sent), Go2 LowStates (unitree_go.low_level) and spline daemon states \
+                        (zsl1.spline.client received, zsl1.spline.daemon sent)";
 
 impl Device {
     /// The device whose side a link of `protocol` has.
     fn of(protocol: &str) -> Option<Self> {
-        if zsl_proto::description::DESCRIPTIONS.iter().any(|d| d.protocol() == protocol) {
+        if [HIGH_LEVEL.name, LOW_LEVEL.name].contains(&protocol) {
             Some(Self::Zsl1)
+        } else if [SPLINE_CLIENT.name, SPLINE_DAEMON.name].contains(&protocol) {
+            Some(Self::Spline)
         } else if [HOST.name, CHASSIS.name].contains(&protocol) {
             Some(Self::KmcChassis)
         } else if protocol == GO2_LOW_LEVEL.name {
@@ -64,6 +74,15 @@ impl Device {
                 AnyDatagram::decode(&frame.bytes),
                 Ok(AnyDatagram::HighLevelState(_) | AnyDatagram::LowLevelState(_))
             ),
+            // The daemon's states: what the controller received, what the daemon sent.
+            Self::Spline => {
+                frame.direction
+                    == if frame.protocol.protocol() == SPLINE_CLIENT.name {
+                        Direction::Received
+                    } else {
+                        Direction::Sent
+                    }
+            }
             // The chassis' frames: what the host received, what the chassis sent.
             Self::KmcChassis => {
                 frame.direction
@@ -89,6 +108,8 @@ pub(crate) struct Target<'a> {
     pub(crate) bind: IpAddr,
     /// The Go2's domain and interface.
     pub(crate) dds: &'a crate::cmd::go2::DdsArgs,
+    /// The spline daemon's objects: spline, IMU.
+    pub(crate) shm: (&'a str, &'a str),
     /// The recorded pace scaled by this; `None`: as fast as possible.
     pub(crate) speed: Option<f64>,
 }
@@ -151,13 +172,24 @@ fn pick<'f>(
 pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Result<ExitCode> {
     let (link, device, picked) = pick(frames, target.link)?;
     let first_ns = picked[0].unix_ns;
-    let offsets: Vec<(Duration, Vec<u8>)> =
-        picked.iter().map(|f| (Duration::from_nanos(f.unix_ns.saturating_sub(first_ns)), f.bytes.clone())).collect();
+    let offset = |f: &RecordedFrame| (Duration::from_nanos(f.unix_ns.saturating_sub(first_ns)), f.bytes.clone());
+    let offsets: Vec<(Duration, Vec<u8>)> = picked.iter().map(|f| offset(f)).collect();
     let pace = target.speed.map_or(Pace::Fast, |speed| Pace::Recorded { speed });
     match device {
         Device::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
         Device::KmcChassis => serial::run(offsets, &link, pace),
         Device::Go2 => dds::run(offsets, &link, target.dds, pace),
+        Device::Spline => {
+            // The device's IMU records (its `zsl1.imu` link beside), from the states' first on.
+            let device = link.split('/').next().unwrap_or_default();
+            let imu: Vec<(Duration, Vec<u8>)> = frames
+                .iter()
+                .filter(|f| f.protocol.protocol() == IMU.name && f.link.split('/').next() == Some(device))
+                .filter(|f| f.unix_ns >= first_ns)
+                .map(offset)
+                .collect();
+            shm::run(offsets, imu, &link, target.shm, pace)
+        }
     }
 }
 
