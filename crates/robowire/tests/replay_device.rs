@@ -21,10 +21,17 @@ fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("robowire-replay-device-{}-{name}", std::process::id()))
 }
 
+/// One demo at a time: this file's tests run in parallel, and three demos at once on a 2-core
+/// machine starve the spline daemon's 1 kHz loop (the demo's PD loop then stops at its stall
+/// bound).
+static DEMO: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// `robowire demo --only DEVICE --duration 1 --record CAPTURE`, and the capture's frames.
 fn record_demo(device: &str, capture: &Path) -> Vec<RecordedFrame> {
+    let one_at_a_time = DEMO.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let demo =
         robowire().args(["demo", "--only", device, "--duration", "1", "--record"]).arg(capture).output().unwrap();
+    drop(one_at_a_time);
     // Only the capture matters here: a demo check that fails on a busy machine (a lateness
     // bound) still leaves a whole capture, which is what is replayed.
     let stderr = String::from_utf8_lossy(&demo.stderr);

@@ -46,13 +46,22 @@ macro_rules! header_deps {
     };
 }
 
+macro_rules! vector3_dep {
+    () => {
+        dependency!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n")
+    };
+}
+
+macro_rules! quaternion_dep {
+    () => {
+        dependency!("geometry_msgs/Quaternion", "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n")
+    };
+}
+
 /// `geometry_msgs/msg/Twist`.
 pub const TWIST: MessageDefinition = MessageDefinition {
     name: "geometry_msgs/msg/Twist",
-    text: concat!(
-        "Vector3 linear\nVector3 angular\n",
-        dependency!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
-    ),
+    text: concat!("Vector3 linear\nVector3 angular\n", vector3_dep!(),),
 };
 
 /// `nav_msgs/msg/Odometry`.
@@ -65,10 +74,10 @@ pub const ODOMETRY: MessageDefinition = MessageDefinition {
         dependency!("geometry_msgs/PoseWithCovariance", "Pose pose\nfloat64[36] covariance\n"),
         dependency!("geometry_msgs/Pose", "Point position\nQuaternion orientation\n"),
         dependency!("geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n"),
-        dependency!("geometry_msgs/Quaternion", "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n"),
+        quaternion_dep!(),
         dependency!("geometry_msgs/TwistWithCovariance", "Twist twist\nfloat64[36] covariance\n"),
         dependency!("geometry_msgs/Twist", "Vector3 linear\nVector3 angular\n"),
-        dependency!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
+        vector3_dep!(),
     ),
 };
 
@@ -80,8 +89,8 @@ pub const IMU: MessageDefinition = MessageDefinition {
         "geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n",
         "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance\n",
         header_deps!(),
-        dependency!("geometry_msgs/Quaternion", "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n"),
-        dependency!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
+        quaternion_dep!(),
+        vector3_dep!(),
     ),
 };
 
@@ -120,8 +129,8 @@ pub const TF_MESSAGE: MessageDefinition = MessageDefinition {
         ),
         header_deps!(),
         dependency!("geometry_msgs/Transform", "Vector3 translation\nQuaternion rotation\n"),
-        dependency!("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
-        dependency!("geometry_msgs/Quaternion", "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n"),
+        vector3_dep!(),
+        quaternion_dep!(),
     ),
 };
 
