@@ -464,6 +464,16 @@ fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         target: format!("max ≤ {} ms", STALLED_MAX_US / 1000),
         met: Some(hmax <= STALLED_MAX_US),
     }];
+    let (r50, r99, rmax, rdropped, rrun, _) = case("healthy_recorded")?;
+    let frames_dropped = meta["healthy_recorded"]["recorded"]["dropped"].as_u64().unwrap_or(0);
+    rows.push(Row {
+        path: format!("Go2 LowCmd stream (500 Hz) send lateness, its link recorded to MCAP ({rrun:.0} s)"),
+        figure: format!("{}; {frames_dropped} frames dropped by the recorder", figure(r50, r99, rmax, rdropped)),
+        baseline: format!("not recorded: {}", figure(h50, h99, hmax, hdropped)),
+        ratio: format!("p99 {:+} µs", r99 as i64 - h99 as i64),
+        target: "–".into(),
+        met: None,
+    });
     for (key, what) in [
         ("stops_taking", "stops taking samples (its participant still acknowledges)"),
         ("stopped", "is stopped (SIGSTOP: neither reads nor acknowledges)"),

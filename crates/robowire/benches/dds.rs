@@ -308,8 +308,19 @@ fn summary(s: &robowire_core::timing::LatenessSummary) -> Value {
 /// for `stall_for`, then `after`. The client's send lateness (over its ring: the last 4096
 /// ticks, 8.2 s; max since the start), its counters, and the samples the reader took.
 fn lowcmd_stream(stall: Stall, before: Duration, stall_for: Duration, after: Duration) -> Value {
+    lowcmd_stream_recorded(stall, before, stall_for, after, false)
+}
+
+/// As [`lowcmd_stream`], the client's low-level link recorded to MCAP if `record`.
+fn lowcmd_stream_recorded(stall: Stall, before: Duration, stall_for: Duration, after: Duration, record: bool) -> Value {
+    let capture = std::env::temp_dir().join(format!("robowire-bench-dds-{}.mcap", std::process::id()));
+    let recorder = record.then(|| robowire_record::Recorder::create(&capture, "bench").expect("a recorder"));
     let mut reader = ReaderProcess::spawn();
-    let client = LowLevel::<go2::Go2>::open(LowLevelOptions::on(Some("lo"), 0)).expect("Go2 client");
+    let options = LowLevelOptions {
+        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
+        ..LowLevelOptions::on(Some("lo"), 0)
+    };
+    let client = LowLevel::<go2::Go2>::open(options).expect("Go2 client");
     client.set_joints(&[JointCommand::hold(0.0, 0.0, 1.0); 12]).expect("a command");
     reader.line("receiving", Duration::from_secs(30));
     std::thread::sleep(before);
@@ -320,6 +331,8 @@ fn lowcmd_stream(stall: Stall, before: Duration, stall_for: Duration, after: Dur
     let stats = client.stats();
     drop(client);
     let taken = reader.finish();
+    let recorded = recorder.map(|r| r.finish().expect("the capture"));
+    let _ = std::fs::remove_file(&capture);
     let lateness = stats.send_lateness;
     println!(
         "LowCmd stream, reader {stall:?} for {stall_for:?}: lateness p50 {} p99 {} max {} µs; sent {}, dropped {}, write drops {}; reader took {taken}",
@@ -335,6 +348,7 @@ fn lowcmd_stream(stall: Stall, before: Duration, stall_for: Duration, after: Dur
         "dropped": stats.lowcmd.dropped,
         "write_errors": stats.lowcmd.write_errors,
         "reader_took": taken,
+        "recorded": recorded.map(|r| json!({"frames": r.frames, "dropped": r.dropped})),
     })
 }
 
@@ -344,6 +358,7 @@ fn stalled_reader(seconds: u32) -> Value {
     let stall = Duration::from_secs(1);
     let side = (Duration::from_secs(u64::from(seconds)).saturating_sub(stall) / 2).max(Duration::from_secs(1));
     let healthy = lowcmd_stream(Stall::None, side, stall, side);
+    let recorded = lowcmd_stream_recorded(Stall::None, side, stall, side, true);
     let stop_taking = lowcmd_stream(Stall::StopTaking, side, stall, side);
     let stopped = lowcmd_stream(Stall::StopProcess, side, stall, side);
     let to_fill = LOWCMD_PERIOD * RUSTDDS_WINDOW_SAMPLES + Duration::from_secs(1);
@@ -351,6 +366,7 @@ fn stalled_reader(seconds: u32) -> Value {
     json!({
         "window_samples": RUSTDDS_WINDOW_SAMPLES,
         "healthy": healthy,
+        "healthy_recorded": recorded,
         "stops_taking": stop_taking,
         "stopped": stopped,
         "window_full": window_full,
