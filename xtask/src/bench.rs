@@ -542,19 +542,22 @@ mod tests {
         let meta = serde_json::json!({
             "window_samples": 8192,
             "healthy": case(40, 900, 0),
+            "healthy_recorded": case(30, 800, 0),
             "stops_taking": case(60, 1000, 0),
             "stopped": case(61, 500, 0),
             "window_full": case(50, 1001, 700),
         });
         let rows = stalled_reader_rows(&meta).unwrap();
-        assert_eq!(rows.len(), 4);
+        assert_eq!(rows.len(), 5);
         assert_eq!((rows[0].target.as_str(), rows[0].met), ("max ≤ 1 ms", Some(true)));
-        assert_eq!(rows[1].figure, "p50 0 µs, p99 60 µs, max 1000 µs; 0 dropped");
-        assert_eq!(rows[1].baseline, "healthy reader: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
-        assert_eq!((rows[1].ratio.as_str(), rows[1].met), ("1.50× (p99); max 1.00 ms", Some(true)));
-        assert_eq!(rows[2].met, Some(false), "p99 above 1.5× healthy");
-        assert_eq!(rows[3].met, Some(false), "a send later than 1 ms");
-        assert!(rows[3].path.contains("8192 samples") && rows[3].figure.ends_with("700 dropped"));
+        assert_eq!(rows[1].baseline, "not recorded: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
+        assert_eq!((rows[1].ratio.as_str(), rows[1].met), ("p99 -10 µs", None));
+        assert_eq!(rows[2].figure, "p50 0 µs, p99 60 µs, max 1000 µs; 0 dropped");
+        assert_eq!(rows[2].baseline, "healthy reader: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
+        assert_eq!((rows[2].ratio.as_str(), rows[2].met), ("1.50× (p99); max 1.00 ms", Some(true)));
+        assert_eq!(rows[3].met, Some(false), "p99 above 1.5× healthy");
+        assert_eq!(rows[4].met, Some(false), "a send later than 1 ms");
+        assert!(rows[4].path.contains("8192 samples") && rows[4].figure.ends_with("700 dropped"));
         assert!(stalled_reader_rows(&serde_json::json!({})).is_err(), "missing keys are errors");
     }
 }
