@@ -1,6 +1,6 @@
 //! The robot's services (spec `unitree-dds.md`): `unitree_api::msg::dds_::Request_` and
 //! `Response_` on `rt/api/<service>/request` and `/response`, and the API ids of the services
-//! robowire speaks (`motion_switcher`, `sport`).
+//! robowire speaks (`motion_switcher`, the Go2's `sport`, the G1's `sport` and `arm`).
 //!
 //! ```text
 //! Request_  { header { identity { int64 id; int64 api_id; }  lease { int64 id; }
@@ -94,6 +94,104 @@ pub mod sport {
     pub const STAND_UP: i64 = 1004;
     /// StandDown (lie down before the sport mode is released).
     pub const STAND_DOWN: i64 = 1005;
+}
+
+/// The G1's locomotion service (Unitree's `LocoClient`): service `sport` like the Go2's, but
+/// its own API (version "1.0.0.0") and ids. Parameters and data are JSON, `{"data": …}` unless
+/// said otherwise.
+pub mod g1_loco {
+    /// Service name (the same topics as the Go2's `sport`).
+    pub const SERVICE: &str = "sport";
+    /// API version.
+    pub const API_VERSION: &str = "1.0.0.0";
+    /// GetFsmId: data `{"data": id}`.
+    pub const GET_FSM_ID: i64 = 7001;
+    /// GetFsmMode: data `{"data": mode}`.
+    pub const GET_FSM_MODE: i64 = 7002;
+    /// GetBalanceMode: data `{"data": mode}`.
+    pub const GET_BALANCE_MODE: i64 = 7003;
+    /// GetSwingHeight: data `{"data": m}`.
+    pub const GET_SWING_HEIGHT: i64 = 7004;
+    /// GetStandHeight: data `{"data": m}`.
+    pub const GET_STAND_HEIGHT: i64 = 7005;
+    /// GetPhase (deprecated by Unitree).
+    pub const GET_PHASE: i64 = 7006;
+    /// SetFsmId: parameter `{"data": id}` (see [`fsm`]).
+    pub const SET_FSM_ID: i64 = 7101;
+    /// SetBalanceMode: `{"data": 0}` balance stand, `1` continuous gait.
+    pub const SET_BALANCE_MODE: i64 = 7102;
+    /// SetSwingHeight: `{"data": m}`.
+    pub const SET_SWING_HEIGHT: i64 = 7103;
+    /// SetStandHeight: `{"data": m}`.
+    pub const SET_STAND_HEIGHT: i64 = 7104;
+    /// SetVelocity: `{"velocity": [vx m/s, vy m/s, yaw rad/s], "duration": s}`.
+    pub const SET_VELOCITY: i64 = 7105;
+    /// SetArmTask: `{"data": task}` (wave hand 0, turning wave 1, shake hand 2 and 3).
+    pub const SET_ARM_TASK: i64 = 7106;
+    /// SetSpeedMode: `{"data": mode}`.
+    pub const SET_SPEED_MODE: i64 = 7107;
+    /// SwitchToUserCtrl: `{"data": bool}`.
+    pub const SWITCH_TO_USER_CTRL: i64 = 7110;
+    /// SwitchToInternalCtrl: `{"data": 0}` last, `1` passive, `2` walk/run.
+    pub const SWITCH_TO_INTERNAL_CTRL: i64 = 7111;
+
+    /// Error codes of the service.
+    pub mod error {
+        /// The locomotion state is not available (no mode selected: after ReleaseMode).
+        pub const LOCO_STATE_UNAVAILABLE: i32 = 7301;
+        /// An FSM id the controller does not have.
+        pub const INVALID_FSM_ID: i32 = 7302;
+        /// A task id the controller does not have.
+        pub const INVALID_TASK_ID: i32 = 7303;
+    }
+
+    /// FSM ids of `SetFsmId` (Unitree's C++ `LocoClient`).
+    pub mod fsm {
+        /// Zero torque.
+        pub const ZERO_TORQUE: i64 = 0;
+        /// Damping.
+        pub const DAMP: i64 = 1;
+        /// Squat.
+        pub const SQUAT: i64 = 2;
+        /// Sit.
+        pub const SIT: i64 = 3;
+        /// Stand up (locked standing).
+        pub const STAND_UP: i64 = 4;
+        /// The walking controller ("Start"); `rt/arm_sdk` is blended in 500, 501 and 801.
+        pub const START: i64 = 500;
+    }
+}
+
+/// The G1's arm action service (Unitree's `G1ArmActionClient`): service `arm`, API version
+/// "1.0.0.14".
+pub mod g1_arm {
+    /// Service name.
+    pub const SERVICE: &str = "arm";
+    /// API version.
+    pub const API_VERSION: &str = "1.0.0.14";
+    /// ExecuteAction: `{"data": action}` (Unitree's Python SDK; its C++ SDK names the key
+    /// `action_id`: the robot is sent both).
+    pub const EXECUTE_ACTION: i64 = 7106;
+    /// GetActionList: data the action list.
+    pub const GET_ACTION_LIST: i64 = 7107;
+    /// ExecuteCustomAction: `{"action_name": name}`.
+    pub const EXECUTE_CUSTOM_ACTION: i64 = 7108;
+    /// StopCustomAction.
+    pub const STOP_CUSTOM_ACTION: i64 = 7113;
+    /// The action that releases the arms (ends a holding action).
+    pub const RELEASE_ARM: i64 = 99;
+
+    /// Error codes of the service.
+    pub mod error {
+        /// `rt/arm_sdk` is in use: no action runs meanwhile.
+        pub const ARM_SDK_OCCUPIED: i32 = 7400;
+        /// The arms hold an action: release them (action 99) first.
+        pub const HOLDING: i32 = 7401;
+        /// No such action.
+        pub const INVALID_ACTION_ID: i32 = 7402;
+        /// Actions run only in FSM 500, 501 and 801 (the walking controllers).
+        pub const INVALID_FSM_ID: i32 = 7404;
+    }
 }
 
 /// The internal API every service answers: its API version.

@@ -30,6 +30,28 @@ idl_struct! {
     }
 }
 
+impl Default for HgMotorCmd {
+    /// Disabled, every field zero.
+    fn default() -> Self {
+        Self::new_zeroed()
+    }
+}
+
+impl HgMotorCmd {
+    /// Enabled (mode 1) with the given targets: `q` rad, `dq` rad/s, gains `kp`, `kd`, torque
+    /// `tau` N·m.
+    pub fn servo(q: f32, dq: f32, kp: f32, kd: f32, tau: f32) -> Self {
+        let mut cmd = Self::new_zeroed();
+        cmd.mode = 1;
+        cmd.q = q.into();
+        cmd.dq = dq.into();
+        cmd.kp = kp.into();
+        cmd.kd = kd.into();
+        cmd.tau = tau.into();
+        cmd
+    }
+}
+
 idl_struct! {
     /// HG low-level command, `unitree_hg::msg::dds_::LowCmd_`, 1004 bytes.
     pub struct HgLowCmd as "LowCmd_" in HG_LOW_CMD_LAYOUT {

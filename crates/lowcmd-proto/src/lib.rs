@@ -12,6 +12,7 @@ pub mod decode_roundtrip;
 pub mod description;
 mod error;
 pub mod field;
+pub mod g1;
 pub mod go2;
 pub mod hg;
 pub mod idl;

@@ -126,6 +126,37 @@ pub enum CommandError {
         /// Motor slot.
         motor: usize,
     },
+    /// No state has told the robot's `mode_machine` yet (HG): a command without it is ignored by
+    /// the robot.
+    #[error("no LowState seen yet: the robot's mode_machine is unknown, and it ignores a LowCmd without it")]
+    NoModeMachine,
+    /// The command's `mode_machine` is not the one the robot reports (HG): the robot ignores it.
+    #[error("mode_machine {found} is not the robot's ({expected}, from its LowState): the robot ignores this LowCmd")]
+    ModeMachine {
+        /// The robot's, from its LowState.
+        expected: u8,
+        /// The command's.
+        found: u8,
+    },
+    /// `mode_pr` is neither 0 (PR) nor 1 (AB), or not what the topic takes (HG).
+    #[error("mode_pr {found} is not accepted here (0: pitch/roll, 1: A/B)")]
+    ModePr {
+        /// The command's.
+        found: u8,
+    },
+    /// A motor with `mode` 0 (disabled) and a target, gain or torque set (HG): the robot accepts
+    /// the frame and the motor does nothing.
+    #[error("motor {motor} has mode 0 (disabled) but a target, gain or torque: set mode 1 to command it")]
+    DisabledMotor {
+        /// Motor slot.
+        motor: usize,
+    },
+    /// The `rt/arm_sdk` weight (slot 29's `q`) outside 0..=1 or not finite.
+    #[error("the arm_sdk weight {value} is outside 0..=1")]
+    ArmSdkWeight {
+        /// The weight.
+        value: f32,
+    },
     /// A header the robot drops (Go2: `head` FE EF, `level_flag` 0xFF).
     #[error("the command's header is {found:02x?}, the robot expects {expected:02x?}")]
     Header {
@@ -165,21 +196,22 @@ pub trait Robot: Send + Sync + 'static {
 pub struct Go2;
 
 /// The HG family (G1, H1-2; `unitree_hg`): its 35 slots are checked for finiteness, gains and
-/// sentinels; there is no joint-limit table for it (yet).
+/// sentinels. The G1's own rules (`mode_machine`, disabled motors, joint limits) need the robot's
+/// LowState and are [`crate::g1::check_low_cmd`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Hg;
 
-fn finite(motor: usize, field: MotorField, value: F32) -> Result<f32, CommandError> {
+pub(crate) fn finite(motor: usize, field: MotorField, value: F32) -> Result<f32, CommandError> {
     let value = value.get();
     if value.is_finite() { Ok(value) } else { Err(CommandError::NonFinite { motor, field, value }) }
 }
 
-fn within(motor: usize, field: MotorField, value: f32, min: f32, max: f32) -> Result<(), CommandError> {
+pub(crate) fn within(motor: usize, field: MotorField, value: f32, min: f32, max: f32) -> Result<(), CommandError> {
     if (min..=max).contains(&value) { Ok(()) } else { Err(CommandError::OutOfRange { motor, field, value, min, max }) }
 }
 
 /// The checks every family shares: finite fields, gains in range, sentinels only with gain 0.
-fn check_motor(motor: usize, q: F32, dq: F32, tau: F32, kp: F32, kd: F32) -> Result<[f32; 5], CommandError> {
+pub(crate) fn check_motor(motor: usize, q: F32, dq: F32, tau: F32, kp: F32, kd: F32) -> Result<[f32; 5], CommandError> {
     let [q, dq, tau, kp, kd] = [
         finite(motor, MotorField::Q, q)?,
         finite(motor, MotorField::Dq, dq)?,
@@ -266,14 +298,19 @@ impl Robot for Hg {
         Ok(())
     }
 
-    /// `mode_pr` and `mode_machine` kept from the last command; every motor enabled, kp 0, `kd`.
+    /// `mode_pr` and `mode_machine` kept from the last command (the robot ignores a LowCmd
+    /// without its `mode_machine`); the motors the last command enabled (every motor if it
+    /// enabled none) enabled with kp 0, `kd`, no targets or torque.
     fn damping(last: &HgLowCmd, kd: f32) -> HgLowCmd {
         let mut cmd = HgLowCmd::default();
         cmd.mode_pr = last.mode_pr;
         cmd.mode_machine = last.mode_machine;
-        for m in &mut cmd.motor_cmd {
-            m.mode = 1;
-            m.kd = kd.into();
+        let any_enabled = last.motor_cmd.iter().any(|m| m.mode != 0);
+        for (m, was) in cmd.motor_cmd.iter_mut().zip(&last.motor_cmd) {
+            if was.mode != 0 || !any_enabled {
+                m.mode = 1;
+                m.kd = kd.into();
+            }
         }
         cmd
     }

@@ -1,10 +1,10 @@
-//! The Go2 low-level command stream on a fake clock: the rate, the command timeout to damping,
+//! The Go2 and G1 low-level command streams on a fake clock: the rate, the command timeout to damping,
 //! refused commands, damping on demand, the missed-tick policy.
 
 use core::time::Duration;
 
 use lowcmd_proto::go2::MotorCmd;
-use lowcmd_proto::robot::{CommandError, Go2, MotorField};
+use lowcmd_proto::robot::{CommandError, Go2, MotorField, Robot};
 use lowcmd_proto::stream::{CommandStream, StreamConfig, Transmit};
 use lowcmd_proto::{F32, LowCmd};
 use robowire_core::schedule::Time;
@@ -21,7 +21,7 @@ fn stand() -> LowCmd {
 }
 
 /// Every command a perfect runner sends from `from` until `end`.
-fn run(stream: &mut CommandStream<Go2>, from: Time, end: Time) -> Vec<(Time, Transmit<LowCmd>)> {
+fn run<R: Robot>(stream: &mut CommandStream<R>, from: Time, end: Time) -> Vec<(Time, Transmit<R::Cmd>)> {
     let mut sent = Vec::new();
     let mut now = from;
     while let Some(deadline) = stream.poll_timeout() {
@@ -97,4 +97,34 @@ fn a_late_tick_is_sent_once_and_counted() {
     assert!(stream.poll_transmit(T0 + 11 * MS).is_none(), "no catch-up burst");
     assert_eq!(stream.counters().missed_ticks, 4);
     assert_eq!(stream.poll_timeout(), Some(T0 + 12 * MS));
+}
+
+#[test]
+fn the_g1_stream_damps_a_stale_command_keeping_the_robots_mode_machine() {
+    use lowcmd_proto::g1::{self, G1Variant};
+    use lowcmd_proto::robot::Hg;
+
+    let variant = G1Variant::Dof23;
+    let zero = g1::hold(&[0.0; g1::JOINTS], 4, variant);
+    assert_eq!(g1::check_low_cmd(&zero, Some(4), variant), Ok(()));
+    let mut stream = CommandStream::<Hg>::new(T0, StreamConfig::default());
+    stream.handle_command(T0, zero).unwrap();
+    let sent = run(&mut stream, T0, T0 + 200 * MS);
+    assert_eq!(sent.len(), 100, "500 Hz for 200 ms");
+    let (fresh, damping): (Vec<_>, Vec<_>) = sent.iter().partition(|(_, t)| t.fresh);
+    assert_eq!(fresh.len(), 51, "fresh for the 100 ms command timeout (both ends)");
+    for (_, t) in &damping {
+        let c = &t.command;
+        assert_eq!(c.mode_machine, 4, "the robot ignores a LowCmd without its mode_machine");
+        // The damping enables what the command enabled (the 23 joints), with kp 0 and kd.
+        assert_eq!(g1::check_low_cmd(c, Some(4), variant), Ok(()));
+        assert!(
+            c.motor_cmd
+                .iter()
+                .enumerate()
+                .all(|(slot, m)| (m.mode == 1) == variant.drives(slot) && m.kp.get() == 0.0 && m.q.get() == 0.0)
+        );
+        assert_eq!(c.motor_cmd[3].kd.get(), lowcmd_proto::robot::DAMPING_KD);
+    }
+    assert_eq!(stream.counters().command_timeouts, 1);
 }
