@@ -269,6 +269,46 @@ fn lowcmd_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
             met: Some(ns <= 2.0 * base),
         });
     }
+    rows.extend(hg_rows(criterion)?);
+    Ok(rows)
+}
+
+/// The HG (G1) messages beside the Go2 rows: image paths against a memcpy of the image, XCDR1
+/// paths against the image paths.
+fn hg_rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
+    let group = "hg_codec";
+    let mut rows = Vec::new();
+    for (name, label, bytes) in [("hg_lowcmd", "HG LowCmd", 1004), ("hg_lowstate", "HG LowState", 2092)] {
+        let ns = |bench: &str| mean_ns(criterion, group, &format!("{name}_{bench}"));
+        let copy = ns("memcpy")?;
+        for (bench, what) in
+            [("encode_image", "encode (zero padding, CRC)"), ("decode_verify_image", "decode + verify")]
+        {
+            let t = ns(bench)?;
+            rows.push(Row {
+                path: format!("{label} {what}"),
+                figure: format!("{t:.0} ns"),
+                baseline: format!("memcpy {bytes} B: {copy:.0} ns"),
+                ratio: format!("{:.1}×", t / copy),
+                target: "–".into(),
+                met: None,
+            });
+        }
+        for (bench, image, what) in [
+            ("encode_xcdr1", "encode_image", "encode XCDR1 (copy plan)"),
+            ("decode_verify_xcdr1", "decode_verify_image", "decode XCDR1 + verify"),
+        ] {
+            let (t, base) = (ns(bench)?, ns(image)?);
+            rows.push(Row {
+                path: format!("{label} {what}"),
+                figure: format!("{t:.0} ns"),
+                baseline: format!("struct image: {base:.0} ns"),
+                ratio: format!("{:.2}×", t / base),
+                target: "≤ 2× the struct image".into(),
+                met: Some(t <= 2.0 * base),
+            });
+        }
+    }
     Ok(rows)
 }
 

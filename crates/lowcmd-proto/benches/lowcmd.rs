@@ -1,6 +1,6 @@
-//! CRC, encode and decode+verify of the Go2 messages, each beside its baseline from the same run:
-//! the CRC beside Unitree's bitwise routine (and the portable table backend), encode/decode
-//! beside a memcpy of the same image.
+//! CRC, encode and decode+verify of the Go2 and HG (G1) messages, each beside its baseline from
+//! the same run: the CRC beside Unitree's bitwise routine (and the portable table backend),
+//! encode/decode beside a memcpy of the same image.
 
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]
@@ -11,7 +11,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use lowcmd_proto::crc::{crc32_words, crc32_words_table};
-use lowcmd_proto::{CdrEncoding, LowCmd, LowState, Message, MotorCmd};
+use lowcmd_proto::g1::{self, G1Variant};
+use lowcmd_proto::{CdrEncoding, HgLowState, LowCmd, LowState, Message, MotorCmd};
 
 fn stand_command() -> LowCmd {
     let mut cmd = LowCmd::default();
@@ -85,6 +86,46 @@ fn benches(c: &mut Criterion) {
         })
     });
     codec.finish();
+
+    // The G1's messages: a 29-joint hold and a LowState, image and XCDR1, beside a memcpy.
+    let mut hg = c.benchmark_group("hg_codec");
+    let hold = g1::hold(&[0.1; g1::JOINTS], 5, G1Variant::Dof29);
+    let mut state = HgLowState::default();
+    state.mode_machine = 5;
+    state.tick = 12345.into();
+    let mut out = [0u8; 2200];
+    image_and_xcdr1(&mut hg, "hg_lowcmd", &hold, &mut out);
+    image_and_xcdr1(&mut hg, "hg_lowstate", &state, &mut out);
+    hg.finish();
+}
+
+/// `{name}_encode_image`, `_decode_verify_image`, `_encode_xcdr1`, `_decode_verify_xcdr1` and
+/// `{name}_memcpy` (the image's length) of `message`.
+fn image_and_xcdr1<M: Message>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    message: &M,
+    out: &mut [u8],
+) {
+    let mut image = vec![0u8; M::IMAGE_LEN];
+    message.encode_image(&mut image).unwrap();
+    let mut cdr = vec![0u8; out.len()];
+    let n = message.encode_cdr(CdrEncoding::Xcdr1, &mut cdr).unwrap();
+    cdr.truncate(n);
+    group.bench_function(format!("{name}_encode_image"), |b| b.iter(|| black_box(message).encode_image(out)));
+    group.bench_function(format!("{name}_decode_verify_image"), |b| {
+        b.iter(|| M::decode_image(black_box(&image)).is_ok())
+    });
+    group.bench_function(format!("{name}_encode_xcdr1"), |b| {
+        b.iter(|| black_box(message).encode_cdr(CdrEncoding::Xcdr1, out))
+    });
+    group.bench_function(format!("{name}_decode_verify_xcdr1"), |b| b.iter(|| M::decode_cdr(black_box(&cdr)).is_ok()));
+    group.bench_function(format!("{name}_memcpy"), |b| {
+        b.iter(|| {
+            out[..image.len()].copy_from_slice(black_box(&image));
+            black_box(&out);
+        })
+    });
 }
 
 criterion_group!(lowcmd, benches);

@@ -74,10 +74,13 @@ pub static API_SERVER: LinkProtocol = LinkProtocol {
     wire_schema: Some(|direction, f| call_wire(direction == Direction::Received, f)),
 };
 
-/// What `robowire plot` draws of a Go2's low-level link recorded at the client: each leg's joint
-/// angles against the commanded targets (a target outside ±20 rad, Unitree's "no position"
-/// marker, is not drawn), the body's attitude.
-pub static PLOTS: [LinkPlots; 1] = [LinkPlots {
+/// What `robowire plot` draws of a Unitree low-level link recorded at the client. Go2: each leg's
+/// joint angles against the commanded targets (a target outside ±20 rad, Unitree's "no position"
+/// marker, is not drawn), the body's attitude. HG (G1): the legs' pitch joints and ankles, the
+/// waist, the arms, each against its target, and the pelvis attitude.
+pub static PLOTS: [LinkPlots; 2] = [GO2_PLOTS, HG_PLOTS];
+
+const GO2_PLOTS: LinkPlots = LinkPlots {
     protocol: "unitree_go.low_level",
     panels: &[
         PanelSpec {
@@ -138,30 +141,111 @@ pub static PLOTS: [LinkPlots; 1] = [LinkPlots {
             ],
         },
     ],
-}];
+};
 
-/// A commanded joint target (`LowCmd_`, sent): held until the next command.
-const fn target(name: &'static str, pointer: &'static str) -> SeriesSpec {
-    SeriesSpec {
-        name,
-        direction: Direction::Sent,
-        schema: LowCmd::DDS_TYPE_NAME,
-        pointer,
-        held: true,
-        range: (-20.0, 20.0),
-    }
+const HG_PLOTS: LinkPlots = LinkPlots {
+    protocol: "unitree_hg.low_level",
+    panels: &[
+        PanelSpec {
+            title: "left leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                hg_target("hip pitch target", "/motor_cmd/0/q"),
+                hg_joint("hip pitch", "/motor_state/0/q"),
+                hg_target("knee target", "/motor_cmd/3/q"),
+                hg_joint("knee", "/motor_state/3/q"),
+                hg_target("ankle pitch (B) target", "/motor_cmd/4/q"),
+                hg_joint("ankle pitch (B)", "/motor_state/4/q"),
+                hg_target("ankle roll (A) target", "/motor_cmd/5/q"),
+                hg_joint("ankle roll (A)", "/motor_state/5/q"),
+            ],
+        },
+        PanelSpec {
+            title: "right leg: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                hg_target("hip pitch target", "/motor_cmd/6/q"),
+                hg_joint("hip pitch", "/motor_state/6/q"),
+                hg_target("knee target", "/motor_cmd/9/q"),
+                hg_joint("knee", "/motor_state/9/q"),
+                hg_target("ankle pitch (B) target", "/motor_cmd/10/q"),
+                hg_joint("ankle pitch (B)", "/motor_state/10/q"),
+                hg_target("ankle roll (A) target", "/motor_cmd/11/q"),
+                hg_joint("ankle roll (A)", "/motor_state/11/q"),
+            ],
+        },
+        PanelSpec {
+            title: "waist: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                hg_target("yaw target", "/motor_cmd/12/q"),
+                hg_joint("yaw", "/motor_state/12/q"),
+                hg_target("roll (A) target", "/motor_cmd/13/q"),
+                hg_joint("roll (A)", "/motor_state/13/q"),
+                hg_target("pitch (B) target", "/motor_cmd/14/q"),
+                hg_joint("pitch (B)", "/motor_state/14/q"),
+            ],
+        },
+        PanelSpec {
+            title: "left arm: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                hg_target("shoulder pitch target", "/motor_cmd/15/q"),
+                hg_joint("shoulder pitch", "/motor_state/15/q"),
+                hg_target("shoulder roll target", "/motor_cmd/16/q"),
+                hg_joint("shoulder roll", "/motor_state/16/q"),
+                hg_target("elbow target", "/motor_cmd/18/q"),
+                hg_joint("elbow", "/motor_state/18/q"),
+            ],
+        },
+        PanelSpec {
+            title: "right arm: joint angles and their targets",
+            y_label: "angle (rad)",
+            series: &[
+                hg_target("shoulder pitch target", "/motor_cmd/22/q"),
+                hg_joint("shoulder pitch", "/motor_state/22/q"),
+                hg_target("shoulder roll target", "/motor_cmd/23/q"),
+                hg_joint("shoulder roll", "/motor_state/23/q"),
+                hg_target("elbow target", "/motor_cmd/25/q"),
+                hg_joint("elbow", "/motor_state/25/q"),
+            ],
+        },
+        PanelSpec {
+            title: "pelvis attitude (IMU)",
+            y_label: "angle (rad)",
+            series: &[
+                hg_joint("roll", "/imu_state/rpy/0"),
+                hg_joint("pitch", "/imu_state/rpy/1"),
+                hg_joint("yaw", "/imu_state/rpy/2"),
+            ],
+        },
+    ],
+};
+
+/// A commanded joint target (a `LowCmd_` of type `schema`, sent): held until the next command.
+const fn commanded(schema: &'static str, name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec { name, direction: Direction::Sent, schema, pointer, held: true, range: (-20.0, 20.0) }
 }
 
-/// A reported value (`LowState_`, received).
+/// A reported value (a `LowState_` of type `schema`, received).
+const fn reported(schema: &'static str, name: &'static str, pointer: &'static str) -> SeriesSpec {
+    SeriesSpec { name, direction: Direction::Received, schema, pointer, held: false, range: ANY_VALUE }
+}
+
+const fn target(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    commanded(LowCmd::DDS_TYPE_NAME, name, pointer)
+}
+
 const fn joint(name: &'static str, pointer: &'static str) -> SeriesSpec {
-    SeriesSpec {
-        name,
-        direction: Direction::Received,
-        schema: LowState::DDS_TYPE_NAME,
-        pointer,
-        held: false,
-        range: ANY_VALUE,
-    }
+    reported(LowState::DDS_TYPE_NAME, name, pointer)
+}
+
+const fn hg_target(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    commanded(HgLowCmd::DDS_TYPE_NAME, name, pointer)
+}
+
+const fn hg_joint(name: &'static str, pointer: &'static str) -> SeriesSpec {
+    reported(HgLowState::DDS_TYPE_NAME, name, pointer)
 }
 
 /// Every Unitree DDS link.

@@ -130,3 +130,37 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn every_plotted_series_names_a_number_of_its_message() {
+    use lowcmd_proto::description::PLOTS;
+    fn xcdr1<M: Message>(message: M) -> Vec<u8> {
+        let mut out = vec![0u8; 2200];
+        let n = message.encode_cdr(CdrEncoding::Xcdr1, &mut out).unwrap();
+        out[..n].to_vec()
+    }
+    let frames: Vec<_> = [
+        (&GO2_LOW_LEVEL, Direction::Sent, xcdr1(LowCmd::default())),
+        (&GO2_LOW_LEVEL, Direction::Received, xcdr1(LowState::default())),
+        (&HG_LOW_LEVEL, Direction::Sent, xcdr1(HgLowCmd::default())),
+        (&HG_LOW_LEVEL, Direction::Received, xcdr1(HgLowState::default())),
+    ]
+    .into_iter()
+    .map(|(link, direction, payload)| (link.name, direction, link.decode(direction, &payload).unwrap()))
+    .collect();
+    for plots in &PLOTS {
+        let mut checked = 0;
+        for series in plots.panels.iter().flat_map(|p| p.series) {
+            let (_, _, frame) = frames
+                .iter()
+                .find(|(link, direction, frame)| {
+                    *link == plots.protocol && *direction == series.direction && frame.schema == series.schema
+                })
+                .unwrap_or_else(|| panic!("{}: no {} frame", plots.protocol, series.schema));
+            let value = frame.value.pointer(series.pointer);
+            assert!(value.is_some_and(Value::is_number), "{} {}: {:?}", plots.protocol, series.pointer, value);
+            checked += 1;
+        }
+        assert!(checked > 10, "{}", plots.protocol);
+    }
+}
