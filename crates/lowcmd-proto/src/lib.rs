@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 
 pub mod api;
+pub mod bms;
 mod cdr;
 pub mod crc;
 #[cfg(feature = "fuzzing")]
