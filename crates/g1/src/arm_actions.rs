@@ -7,8 +7,9 @@ use lowcmd_proto::api::g1_arm::{self, error};
 
 use crate::G1Error;
 
-/// The arm action service; see the [module](self). Every call: any executor, the low-level
-/// options' service timeout.
+/// The G1's arm action service (service `arm`, Unitree's `G1ArmActionClient`,
+/// `lowcmd_proto::api::g1_arm`), its documented refusals typed. Every call: any executor, the
+/// low-level options' service timeout.
 #[derive(Debug, Clone)]
 pub struct ArmActions {
     service: ServiceHandle,

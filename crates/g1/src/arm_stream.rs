@@ -1,5 +1,5 @@
 //! The `rt/arm_sdk` stream, sans-IO: the latched arm command sent every
-//! [`ARM_SDK_PERIOD`](lowcmd_proto::g1::ARM_SDK_PERIOD) (20 ms) on absolute deadlines, its weight
+//! [`ARM_SDK_PERIOD`] (20 ms) on absolute deadlines, its weight
 //! (slot 29's `q`) moved toward the command's target by at most `weight_rate_per_s` × period per
 //! frame ([`WeightRamp`]): blended in and out, never switched.
 //!

@@ -101,7 +101,7 @@ impl G1 {
         let arm_sdk = writer.stats_handle();
         let arm_shared = Arc::new(ArmShared::default());
         let job = ArmSdkJob::new(ArmSdkStream::new(options.arm_sdk), writer, arm_shared.clone());
-        let arm_stream = Runner::spawn(RunnerOptions::placed("g1-arm-sdk", options.arm_sdk_placement), job)?;
+        let arm_stream = Runner::spawn(RunnerOptions::placed("g1-arm-sdk", options.low_level.placement), job)?;
         let arm_waker = arm_stream.waker();
         let loco = Loco::new(low.service(g1_loco::SERVICE)?);
         let arm = ArmActions::new(low.service(g1_arm::SERVICE)?);

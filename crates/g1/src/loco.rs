@@ -67,8 +67,11 @@ impl Velocity {
     }
 }
 
-/// The locomotion service; see the [module](self). Every call: any executor, the low-level
-/// options' service timeout.
+/// The G1's locomotion service (service `sport`, Unitree's `LocoClient`,
+/// `lowcmd_proto::api::g1_loco`) as typed calls. Arguments are checked before anything is sent;
+/// the service's documented refusals are typed ([`G1Error::LocoStateUnavailable`],
+/// [`G1Error::InvalidFsmId`], [`G1Error::InvalidTaskId`]). Every call: any executor, the
+/// low-level options' service timeout.
 #[derive(Debug, Clone)]
 pub struct Loco {
     service: ServiceHandle,

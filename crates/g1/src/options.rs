@@ -4,7 +4,6 @@ use std::time::Duration;
 
 use go2::{Go2Error, LowLevelOptions};
 use lowcmd_proto::g1::G1Variant;
-use robowire_rt::Placement;
 
 use crate::G1Error;
 use crate::arm_stream::{ARM_SDK_WEIGHT_RATE_MAX_PER_S, ArmSdkConfig};
@@ -13,15 +12,14 @@ use crate::arm_stream::{ARM_SDK_WEIGHT_RATE_MAX_PER_S, ArmSdkConfig};
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct G1Options {
     /// Domain, interface, the 500 Hz `rt/lowcmd` stream, the state watchdog, service timeout,
-    /// placement of the LowCmd thread, taps: as for any Unitree robot.
+    /// taps: as for any Unitree robot. Its placement places both stream threads (`rt/lowcmd` and
+    /// `rt/arm_sdk`).
     pub low_level: LowLevelOptions,
     /// Which G1 this is, whatever its LowState's `mode_machine` says (`None`: from
     /// `mode_machine`, see [`G1::variant`](crate::G1::variant)).
     pub variant: Option<G1Variant>,
     /// The `rt/arm_sdk` stream: 20 ms period, 500 ms command timeout, weight rate 0.5/s.
     pub arm_sdk: ArmSdkConfig,
-    /// Where the `rt/arm_sdk` stream thread runs (priority, CPU, memory lock).
-    pub arm_sdk_placement: Placement,
 }
 
 impl G1Options {
@@ -32,7 +30,7 @@ impl G1Options {
     }
 
     /// The `rt/arm_sdk` options: period 1 ms..=1 s, command timeout at least a period, weight
-    /// rate finite in (0, 5] per second; the placement valid. (The low-level options are checked
+    /// rate finite in (0, 5] per second. (The low-level options, placement included, are checked
     /// by [`go2::LowLevel::open`].)
     pub(crate) fn validate(&self) -> Result<(), G1Error> {
         let bad = |name: &'static str, reason: String| Err(G1Error::LowLevel(Go2Error::Option { name, reason }));
@@ -47,7 +45,6 @@ impl G1Options {
         if !(rate.is_finite() && rate > 0.0 && rate <= ARM_SDK_WEIGHT_RATE_MAX_PER_S) {
             return bad("arm_sdk.weight_rate_per_s", format!("{rate} is outside (0, {ARM_SDK_WEIGHT_RATE_MAX_PER_S}]"));
         }
-        self.arm_sdk_placement.validate().map_err(Go2Error::Thread)?;
         Ok(())
     }
 }

@@ -20,8 +20,8 @@ use robowire_dds::qos::Qos;
 use robowire_dds::rpc::RpcServer;
 use robowire_dds::{Participant, ParticipantOptions};
 
-/// Generous: a condition not reached within this is a failure, not slowness.
-const WAIT: Duration = Duration::from_secs(20);
+mod common;
+use common::{WAIT, pattern};
 
 /// One robot at a time (two cores).
 fn one_at_a_time() -> MutexGuard<'static, ()> {
@@ -256,17 +256,6 @@ async fn until(what: &str, mut done: impl FnMut() -> bool) {
     }
 }
 
-/// A pattern for the 29 joints, each within its range, speed and torque.
-fn pattern() -> [JointCommand; JOINTS] {
-    std::array::from_fn(|i| JointCommand {
-        q_rad: 0.01 * (i + 1) as f32,
-        dq_radps: 0.001 * i as f32,
-        kp: 40.0 + i as f32,
-        kd: 1.0 + 0.05 * i as f32,
-        tau_nm: 0.1 * (i % 3) as f32,
-    })
-}
-
 fn refused(result: Result<(), G1Error>) -> CommandError {
     match result {
         Err(G1Error::Command(e)) => e,
@@ -335,6 +324,20 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
         assert_eq!(stale.mode_machine, 5);
         assert!(stale.motor_cmd[..JOINTS].iter().all(|m| m.mode == 1 && m.kd.get() == 1.0));
         assert_eq!(g1.stats().low_level.command_timeouts, 1);
+
+        // The variant option wins over mode_machine: a 23-dof G1 has no waist roll (slot 13).
+        let dof23 = G1::open(G1Options { variant: Some(G1Variant::Dof23), ..G1Options::on(Some("lo"), 0) }).unwrap();
+        assert!(dof23.wait_state(WAIT, |_| true).await.is_some());
+        assert_eq!((dof23.mode_machine(), dof23.variant()), (Some(5), Some(G1Variant::Dof23)));
+        assert_eq!(refused(dof23.set_joints(&pattern())), CommandError::UndrivenMotor { motor: 13 });
+        let mut joints = pattern();
+        for (slot, j) in joints.iter_mut().enumerate() {
+            if !G1Variant::Dof23.drives(slot) {
+                *j = JointCommand::default();
+            }
+        }
+        dof23.set_joints(&joints).unwrap();
+        dof23.close();
     });
 }
 
