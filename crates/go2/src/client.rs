@@ -19,7 +19,7 @@ use robowire_rt::device::{Device, Receive, Received, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 use robowire_rt::stats::Counter;
 
-use crate::services::Services;
+use crate::services::{ServiceHandle, Services};
 use crate::stream::{StreamJob, StreamShared};
 use crate::{Go2Error, LowLevelOptions};
 
@@ -147,7 +147,7 @@ pub struct LowLevel<R: Robot = Go2> {
     lowcmd: StatsHandle,
     lowstate: StatsHandle,
     services: Arc<Services>,
-    _participant: Arc<Participant>,
+    participant: Arc<Participant>,
     /// Dropped last: the receive thread ends after the stream's damping went out.
     receiving: Receiving<R::State>,
 }
@@ -211,7 +211,7 @@ where
             lowcmd,
             lowstate,
             services,
-            _participant: participant,
+            participant,
             receiving,
         })
     }
@@ -223,12 +223,8 @@ where
         T: Send + 'static,
         F: Future<Output = Result<T, Go2Error>> + Send + 'static,
     {
-        let (tx, rx) = tokio::sync::oneshot::channel();
         let services = self.services.clone();
-        self.receiving.runtime().spawn(async move {
-            let _ = tx.send(call(services).await);
-        });
-        rx.await.map_err(|_| Go2Error::Closed)?
+        crate::services::on_runtime(self.receiving.runtime(), async move { call(services).await }).await
     }
 
     /// Releases the sport mode the way Unitree's low-level example does: CheckMode; while a
@@ -236,7 +232,42 @@ where
     /// Returns the ReleaseMode calls it took (0 if nothing owned the motors). A service that does
     /// not answer within the service timeout, or answers an error, is an error. Any executor.
     pub async fn release_sport_mode(&self) -> Result<u32, Go2Error> {
-        self.on_device(|services| async move { services.release_sport_mode().await }).await
+        self.on_device(|services| async move { services.release(true).await }).await
+    }
+
+    /// Releases the mode owning the motors the way Unitree's G1 and H1 low-level examples do,
+    /// through `motion_switcher` alone: CheckMode; while a mode owns the motors, ReleaseMode,
+    /// CheckMode again (at most [`RELEASE_ATTEMPTS`](crate::services::RELEASE_ATTEMPTS)
+    /// ReleaseModes, then [`Go2Error::NotReleased`]). Returns the ReleaseMode calls it took (0 if
+    /// nothing owned the motors). Errors as [`release_sport_mode`](Self::release_sport_mode). Any
+    /// executor.
+    pub async fn release_mode(&self) -> Result<u32, Go2Error> {
+        self.on_device(|services| async move { services.release(false).await }).await
+    }
+
+    /// motion_switcher SelectMode `name`: the robot's controller of that name (a name CheckMode
+    /// reported before the release) owns the motors again and ignores LowCmds. Any executor.
+    pub async fn select_mode(&self, name: &str) -> Result<(), Go2Error> {
+        let name = name.to_owned();
+        self.on_device(|services| async move { services.select_mode(&name).await }).await
+    }
+
+    /// A client of the robot's service `service` on this client's participant, called from any
+    /// executor (its calls run on the receive thread), with the service timeout and the services
+    /// tap of the options.
+    pub fn service(&self, service: &'static str) -> Result<ServiceHandle, Go2Error> {
+        let (runtime, timeout) = (self.receiving.runtime(), self.options.service_timeout);
+        Ok(ServiceHandle::new(&self.participant, service, runtime, timeout, self.options.services_tap.clone())?)
+    }
+
+    /// The client's DDS participant, for writers and readers of the robot's other topics.
+    pub fn participant(&self) -> &Arc<Participant> {
+        &self.participant
+    }
+
+    /// The latest command latched by [`set_command`](Self::set_command) (`None` before the first).
+    pub fn latched(&self) -> Option<R::Cmd> {
+        self.shared.commands.read().map(|(_, command)| command)
     }
 
     /// The sport mode owning the motors (empty: none), as CheckMode reports it. Any executor.

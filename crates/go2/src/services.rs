@@ -1,8 +1,9 @@
 //! Unitree's services over `rt/api/<service>/request` and `/response` (spec `unitree-dds.md`):
 //! the request/answer protocol as a [`Service`] of `robowire-dds`, request ids as Unitree's SDKs
-//! make them, and the calls robowire makes (`motion_switcher` CheckMode and ReleaseMode, `sport`
-//! StandDown).
+//! make them, the calls robowire makes (`motion_switcher` CheckMode, ReleaseMode and SelectMode,
+//! the Go2's `sport` StandDown), and [`ServiceHandle`]: a service called from any executor.
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, Ordering};
 use std::time::Duration;
 
@@ -12,6 +13,23 @@ use robowire_dds::{DdsError, Participant};
 use robowire_tap::Tap;
 
 use crate::Go2Error;
+
+/// ReleaseMode calls a release makes at most before it gives up ([`Go2Error::NotReleased`]).
+pub const RELEASE_ATTEMPTS: u32 = 10;
+
+/// `text` with JSON's string escapes (quote, backslash, control characters).
+fn json_escaped(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if u32::from(c) < 0x20 => out.push_str(&format!("\\u{:04x}", u32::from(c))),
+            c => out.push(c),
+        }
+    }
+    out
+}
 
 /// Unitree's request/answer protocol: `unitree_api` `Request_`/`Response_`, paired by
 /// `identity.id`.
@@ -85,6 +103,58 @@ impl ServiceClient {
     }
 }
 
+/// Runs `task` on `runtime` (a device's receive thread, where its services' answers arrive) and
+/// waits for its outcome, on any executor. [`Go2Error::Closed`] if the runtime has shut down.
+pub(crate) async fn on_runtime<T, F>(runtime: &tokio::runtime::Handle, task: F) -> Result<T, Go2Error>
+where
+    T: Send + 'static,
+    F: Future<Output = Result<T, Go2Error>> + Send + 'static,
+{
+    let (tx, rx) = tokio::sync::oneshot::channel();
+    runtime.spawn(async move {
+        let _ = tx.send(task.await);
+    });
+    rx.await.map_err(|_| Go2Error::Closed)?
+}
+
+/// One of the robot's services as a device calls it: a [`ServiceClient`] made on the device's
+/// receive thread (its answers are read there), called from any executor, with the device's
+/// service timeout. Made by [`LowLevel::service`](crate::LowLevel::service); cheap to clone.
+#[derive(Debug, Clone)]
+pub struct ServiceHandle {
+    client: Arc<ServiceClient>,
+    runtime: tokio::runtime::Handle,
+    timeout: Duration,
+}
+
+impl ServiceHandle {
+    /// A client of `service` on `participant`, its answers read by a task of `runtime`.
+    pub(crate) fn new(
+        participant: &Participant,
+        service: &'static str,
+        runtime: &tokio::runtime::Handle,
+        timeout: Duration,
+        tap: Option<Tap>,
+    ) -> Result<Self, DdsError> {
+        // The client's answer task is spawned on the current runtime: the device's.
+        let _on_device = runtime.enter();
+        let client = Arc::new(ServiceClient::tapped(participant, service, tap)?);
+        Ok(Self { client, runtime: runtime.clone(), timeout })
+    }
+
+    /// The service's name.
+    pub fn service(&self) -> &'static str {
+        self.client.service
+    }
+
+    /// Calls `api_id` with `parameter` (JSON by convention) and waits up to the service timeout
+    /// for its answer, as [`ServiceClient::call`] does. Any executor.
+    pub async fn call(&self, api_id: i64, parameter: impl Into<String>) -> Result<ApiResponse, Go2Error> {
+        let (client, parameter, timeout) = (self.client.clone(), parameter.into(), self.timeout);
+        on_runtime(&self.runtime, async move { client.call(api_id, &parameter, timeout).await }).await
+    }
+}
+
 /// The robot's `motion_switcher` and `sport` services, as the low-level client uses them.
 #[derive(Debug)]
 pub(crate) struct Services {
@@ -110,23 +180,30 @@ impl Services {
             .ok_or(Go2Error::Unexpected { service: api::motion_switcher::SERVICE, data: answer.data })
     }
 
-    /// Releases the sport mode the way Unitree's low-level example does: CheckMode; while a mode
-    /// owns the motors, sport StandDown, motion_switcher ReleaseMode, CheckMode again. Returns the
-    /// ReleaseMode calls it took.
-    pub(crate) async fn release_sport_mode(&self) -> Result<u32, Go2Error> {
-        const MAX_ATTEMPTS: u32 = 10;
+    /// Releases the mode owning the motors: CheckMode; while a mode owns them, (with
+    /// `stand_down`: the Go2's sport StandDown,) motion_switcher ReleaseMode, CheckMode again, at
+    /// most [`RELEASE_ATTEMPTS`] ReleaseModes. Returns the ReleaseMode calls it took.
+    pub(crate) async fn release(&self, stand_down: bool) -> Result<u32, Go2Error> {
         let mut attempts = 0;
         loop {
             let mode = self.sport_mode().await?;
             if mode.is_empty() {
                 return Ok(attempts);
             }
-            if attempts == MAX_ATTEMPTS {
+            if attempts == RELEASE_ATTEMPTS {
                 return Err(Go2Error::NotReleased { mode, attempts });
             }
-            self.sport.call(api::sport::STAND_DOWN, "{}", self.timeout).await?;
+            if stand_down {
+                self.sport.call(api::sport::STAND_DOWN, "{}", self.timeout).await?;
+            }
             self.switcher.call(api::motion_switcher::RELEASE_MODE, "{}", self.timeout).await?;
             attempts += 1;
         }
+    }
+
+    /// motion_switcher SelectMode `name`: the robot's controller `name` takes the motors again.
+    pub(crate) async fn select_mode(&self, name: &str) -> Result<(), Go2Error> {
+        let parameter = format!(r#"{{"name":"{}"}}"#, json_escaped(name));
+        self.switcher.call(api::motion_switcher::SELECT_MODE, &parameter, self.timeout).await.map(drop)
     }
 }

@@ -1,0 +1,50 @@
+//! [`G1Options`]: the low-level client's options, the variant, the `rt/arm_sdk` stream.
+
+use std::time::Duration;
+
+use go2::{Go2Error, LowLevelOptions};
+use lowcmd_proto::g1::G1Variant;
+
+use crate::G1Error;
+use crate::arm_stream::{ARM_SDK_WEIGHT_RATE_MAX_PER_S, ArmSdkConfig};
+
+/// How a [`G1`](crate::G1) client is set up.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct G1Options {
+    /// Domain, interface, the 500 Hz `rt/lowcmd` stream, the state watchdog, service timeout,
+    /// taps: as for any Unitree robot. Its placement places both stream threads (`rt/lowcmd` and
+    /// `rt/arm_sdk`).
+    pub low_level: LowLevelOptions,
+    /// Which G1 this is, whatever its LowState's `mode_machine` says (`None`: from
+    /// `mode_machine`, see [`G1::variant`](crate::G1::variant)).
+    pub variant: Option<G1Variant>,
+    /// The `rt/arm_sdk` stream: 20 ms period, 500 ms command timeout, weight rate 0.5/s.
+    pub arm_sdk: ArmSdkConfig,
+}
+
+impl G1Options {
+    /// Domain `domain` on interface `interface` (`None`: the library chooses); everything else
+    /// the defaults.
+    pub fn on(interface: Option<&str>, domain: u16) -> Self {
+        Self { low_level: LowLevelOptions::on(interface, domain), ..Self::default() }
+    }
+
+    /// The `rt/arm_sdk` options: period 1 ms..=1 s, command timeout at least a period, weight
+    /// rate finite in (0, 5] per second. (The low-level options, placement included, are checked
+    /// by [`go2::LowLevel::open`].)
+    pub(crate) fn validate(&self) -> Result<(), G1Error> {
+        let bad = |name: &'static str, reason: String| Err(G1Error::LowLevel(Go2Error::Option { name, reason }));
+        let a = &self.arm_sdk;
+        if a.period < Duration::from_millis(1) || a.period > Duration::from_secs(1) {
+            return bad("arm_sdk.period", format!("{:?} is outside 1 ms..=1 s", a.period));
+        }
+        if a.command_timeout < a.period {
+            return bad("arm_sdk.command_timeout", format!("{:?} is shorter than the period", a.command_timeout));
+        }
+        let rate = a.weight_rate_per_s;
+        if !(rate.is_finite() && rate > 0.0 && rate <= ARM_SDK_WEIGHT_RATE_MAX_PER_S) {
+            return bad("arm_sdk.weight_rate_per_s", format!("{rate} is outside (0, {ARM_SDK_WEIGHT_RATE_MAX_PER_S}]"));
+        }
+        Ok(())
+    }
+}
