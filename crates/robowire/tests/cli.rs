@@ -153,6 +153,24 @@ fn demo_lowcmd_loop_and_json_output() {
 }
 
 #[test]
+fn demo_g1_refuses_what_the_robot_ignores_and_the_robot_counts_it() {
+    let Some(()) = robowire_fixtures::interop::require(robowire_dds::netns::available()) else { return };
+    let out = demo(&["--only", "g1", "--duration", "1", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");
+    assert_eq!(report["passed"], true, "{report}");
+    let checks = report["checks"].as_array().unwrap();
+    let kind = |k: &str| checks.iter().filter(|c| c["kind"] == k).count();
+    assert_eq!((kind("functional"), kind("timing")), (7, 3), "{report}");
+    let device = &report["devices"][0];
+    assert_eq!(device["device"], "g1", "{report}");
+    let counter = |name: &str| device["counters"][name].as_u64().unwrap();
+    assert!(counter("bad mode_machine") >= 1 && counter("disabled motors") >= 1, "{report}");
+    assert!(counter("LowCmd ignored") >= 1 && counter("arm_sdk frames") > 0, "{report}");
+    assert_eq!(counter("CRC errors"), 0, "{report}");
+}
+
+#[test]
 fn error_messages_say_each_cause_once_and_what_was_expected() {
     let missing = robowire().args(["kmc", "--port", "/dev/robowire-nonexistent", "speed"]).output().unwrap();
     let err = String::from_utf8_lossy(&missing.stderr);

@@ -23,12 +23,7 @@ const FLIP_EVERY: u32 = 25;
 
 pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
     out.line(format_args!("== Unitree Go2 over DDS (rt/lowcmd, rt/lowstate, motion_switcher; simulated Go2) =="));
-    if robowire_dds::netns::loopback_has_multicast() {
-        return scenario(duration_s, out, record);
-    }
-    out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace (root)");
-    robowire_dds::netns::in_loopback_namespace(|| scenario(duration_s, out, record))
-        .context("DDS on one machine needs multicast on lo")?
+    super::on_dds_loopback(out, || scenario(duration_s, out, record))
 }
 
 /// A command for the 12 joints at `pose`, tagged with `tag` (the simulator echoes it).

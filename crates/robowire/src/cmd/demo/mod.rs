@@ -2,6 +2,7 @@
 //! what was commanded was observed.
 
 mod dog;
+mod g1;
 mod kmc;
 mod lowcmd;
 mod progress;
@@ -20,6 +21,16 @@ use robowire_dds::netns::Loopback;
 use robowire_record::RecordLinks;
 
 use crate::output::Output;
+
+/// Runs a DDS scenario where loopback carries multicast: here if it does, else (root) on a thread
+/// in a private network namespace.
+fn on_dds_loopback<T: Send>(out: &Output, scenario: impl FnOnce() -> anyhow::Result<T> + Send) -> anyhow::Result<T> {
+    if robowire_dds::netns::loopback_has_multicast() {
+        return scenario();
+    }
+    out.line("loopback has no multicast (DDS discovery needs it): running in a private network namespace (root)");
+    robowire_dds::netns::in_loopback_namespace(scenario).context("DDS on one machine needs multicast on lo")?
+}
 
 /// The simulated device at `sim:KIND`, opened by address as any app opens a device: its client
 /// and, still reachable for faults and snapshots, its simulator.
@@ -55,7 +66,7 @@ pub(crate) struct DemoArgs {
 
 /// One PNG per device of the run's capture into `dir`.
 fn draw(dir: &std::path::Path, capture: &std::path::Path, out: &Output) -> anyhow::Result<()> {
-    for device in ["kmc", "dog", "spline", "go2"] {
+    for device in ["kmc", "dog", "spline", "go2", "g1"] {
         let image = dir.join(format!("{device}.png"));
         let selection = crate::cmd::plot::Selection { device: Some(device.into()), ..Default::default() };
         // A device whose scenario did not run (--only) has nothing to draw.
@@ -77,12 +88,21 @@ enum Device {
     /// A Unitree Go2 on DDS (simulated): sport mode release, stand-up, CRC faults on the wire.
     #[value(alias = "go2")]
     Lowcmd,
+    /// A Unitree G1 humanoid on DDS (simulated): rt/arm_sdk, release, zero posture, ankle swing
+    /// in PR and AB mode, frames the robot ignores refused and counted.
+    G1,
 }
 
 impl DemoArgs {
-    /// Whether the Go2 scenario is among those to run (it needs multicast on loopback).
+    /// Whether a DDS scenario (Go2, G1) is among those to run (they need multicast on loopback).
     pub(crate) fn runs_go2(&self) -> bool {
-        self.only.is_none_or(|d| d == Device::Lowcmd)
+        self.only.is_none_or(|d| d.uses_dds())
+    }
+}
+
+impl Device {
+    fn uses_dds(self) -> bool {
+        matches!(self, Self::Lowcmd | Self::G1)
     }
 }
 
@@ -90,7 +110,7 @@ impl DemoArgs {
 /// device's links recorded with the recorder, if any.
 type Scenario = fn(f64, &Output, Option<&RecordLinks>) -> anyhow::Result<DeviceReport>;
 
-/// Runs the demo; `loopback`: where the Go2 scenario's DDS runs (`None`: it is not run).
+/// Runs the demo; `loopback`: where the DDS scenarios run (`None`: they are not run).
 pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
         args.duration.is_finite() && (0.3..=600.0).contains(&args.duration),
@@ -99,23 +119,24 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
     );
     // With `--json`, the human-readable report goes to stderr and stdout carries only the JSON.
     let out = Output::new(args.json);
-    let mut go2 = true;
+    let mut dds = true;
     match loopback {
         Some(Loopback::UserNamespace) => out.line(
             "loopback has no multicast (DDS discovery needs it): the demo runs in a user + network namespace of its own",
         ),
         Some(Loopback::Unavailable(e)) if args.only.is_none() => {
-            out.line(format_args!("skipped the Go2 scenario: DDS on one machine needs multicast on lo: {e}"));
-            go2 = false;
+            out.line(format_args!("skipped the Go2 and G1 scenarios: DDS on one machine needs multicast on lo: {e}"));
+            dds = false;
         }
-        Some(Loopback::Unavailable(e)) => anyhow::bail!("the Go2 scenario needs multicast on lo: {e}"),
+        Some(Loopback::Unavailable(e)) => anyhow::bail!("the DDS scenarios need multicast on lo: {e}"),
         _ => {}
     }
-    let scenarios: [(Device, Scenario); 4] = [
+    let scenarios: [(Device, Scenario); 5] = [
         (Device::Kmc, kmc::run),
         (Device::Dog, dog::run),
         (Device::Spline, spline::run),
         (Device::Lowcmd, lowcmd::run),
+        (Device::G1, g1::run),
     ];
     let capture = match (&args.record.record, &args.plot) {
         (Some(file), _) => Some(file.clone()),
@@ -129,7 +150,7 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
     let record = recorder.as_ref().map(robowire_record::Recorder::links);
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
-        if args.only.is_none_or(|d| d == device) && (go2 || device != Device::Lowcmd) {
+        if args.only.is_none_or(|d| d == device) && (dds || !device.uses_dds()) {
             if !reports.is_empty() {
                 out.line("");
             }
