@@ -21,7 +21,7 @@ struct Cli {
 enum Command {
     /// Drive every simulated device through its client API and report what was seen.
     Demo(cmd::demo::DemoArgs),
-    /// Print one state of any device, by address (kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:KIND).
+    /// Print one state of any device, by address (kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, g1:IFACE, sim:KIND).
     Status(cmd::device::StatusArgs),
     /// Print the state of any device live, by address, until Ctrl-C.
     Watch(cmd::device::DeviceArgs),
