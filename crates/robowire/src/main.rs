@@ -34,6 +34,8 @@ enum Command {
     Dog(cmd::dog::DogArgs),
     /// Drive a Unitree Go2's low-level interface over DDS (status, watch, release, stand, damp).
     Go2(cmd::go2::Go2Args),
+    /// Drive a Unitree G1 humanoid's low-level interface over DDS (status, watch, release, damp, zero).
+    G1(cmd::g1::G1Args),
     /// Inspect DDS: the topics on the network, the samples of one.
     Dds(cmd::dds::DdsCommandArgs),
     /// Every device as a ROS 2 node on the wire (cmd_vel, odom, tf, imu, joint_states, …), no ROS install needed.
@@ -74,6 +76,7 @@ fn main() -> ExitCode {
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),
         Command::Go2(args) => cmd::go2::run(args),
+        Command::G1(args) => cmd::g1::run(args),
         Command::Dds(args) => cmd::dds::run(args),
         Command::Ros2(args) => cmd::ros2::run(args),
         Command::Shm(command) => cmd::shm::run(&command),
