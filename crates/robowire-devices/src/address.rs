@@ -22,7 +22,7 @@ pub enum DeviceAddress {
     G1(String),
     /// `spline:/spline_shm`: a ZSL-1's spline daemon on shared memory, watched.
     Spline(String),
-    /// `sim:kmc|zsl1|zsl1w|go2|spline`: an in-process simulator and a client of it.
+    /// `sim:kmc|zsl1|zsl1w|go2|g1|spline`: an in-process simulator and a client of it.
     Sim(SimKind),
 }
 
@@ -37,6 +37,8 @@ pub enum SimKind {
     Zsl1w,
     /// A Go2 on DDS.
     Go2,
+    /// A 29-joint G1 on DDS.
+    G1,
     /// The spline daemon on private shared memory.
     Spline,
 }
@@ -76,7 +78,7 @@ impl DeviceKind {
 }
 
 /// The addresses every error message shows as examples.
-pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|spline";
+pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|g1|spline";
 
 /// Why an address was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -121,8 +123,9 @@ impl FromStr for DeviceAddress {
                 "zsl1" => SimKind::Zsl1,
                 "zsl1w" => SimKind::Zsl1w,
                 "go2" => SimKind::Go2,
+                "g1" => SimKind::G1,
                 "spline" => SimKind::Spline,
-                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, spline)")),
+                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)")),
             })),
             _ => Err(refuse("unknown kind")),
         }
@@ -152,6 +155,7 @@ impl SimKind {
             Self::Zsl1 => DeviceKind::Zsl1,
             Self::Zsl1w => DeviceKind::Zsl1w,
             Self::Go2 => DeviceKind::Go2,
+            Self::G1 => DeviceKind::G1,
             Self::Spline => DeviceKind::Spline,
         }
     }
@@ -199,6 +203,7 @@ mod tests {
             "spline:/spline_shm",
             "sim:zsl1",
             "sim:spline",
+            "sim:g1",
         ] {
             let address: DeviceAddress = text.parse().unwrap();
             assert_eq!(address.to_string(), text);
@@ -207,6 +212,8 @@ mod tests {
         assert!("sim:go2".parse::<DeviceAddress>().unwrap().uses_dds());
         let g1: DeviceAddress = "g1:enp3s0".parse().unwrap();
         assert_eq!((g1.kind(), g1.kind().name(), g1.uses_dds()), (DeviceKind::G1, "g1", true));
+        let sim: DeviceAddress = "sim:g1".parse().unwrap();
+        assert_eq!((sim.kind(), sim.is_simulated(), sim.uses_dds()), (DeviceKind::G1, true, true));
         assert_eq!("hg:eth0".parse::<DeviceAddress>().unwrap().kind(), DeviceKind::Hg, "hg: stays the generic client");
         for (bad, reason) in [
             ("kmc", "no kind: write KIND:WHERE"),
@@ -215,7 +222,7 @@ mod tests {
             ("go2:a/b", "not a network interface name"),
             ("g1:a-very-long-interface-name", "not a network interface name"),
             ("g1:", "nothing after the kind"),
-            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2, spline)"),
+            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)"),
             ("spline:spline_shm", "not a shared-memory object name (/spline_shm)"),
             ("tank:1", "unknown kind"),
         ] {

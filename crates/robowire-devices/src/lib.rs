@@ -32,9 +32,9 @@ use tokio::sync::watch;
 /// How [`open`] reaches a device, beyond its address.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OpenOptions {
-    /// DDS domain of `go2:`, `hg:`, `g1:` and `sim:go2` (Unitree's robots: 0).
+    /// DDS domain of `go2:`, `hg:`, `g1:`, `sim:go2` and `sim:g1` (Unitree's robots: 0).
     pub domain: u16,
-    /// Network interface of `sim:go2`'s simulator and client (`None`: `lo`).
+    /// Network interface of `sim:go2`'s and `sim:g1`'s simulator and client (`None`: `lo`).
     pub sim_interface: Option<String>,
     /// Local address of `zsl1:`/`zsl1w:` clients: where the robot sends its state (its
     /// `target_ip`/`target_port`, port 43988 by default).
