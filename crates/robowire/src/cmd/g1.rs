@@ -58,6 +58,7 @@ pub(crate) fn run(args: G1Args) -> anyhow::Result<ExitCode> {
                 if json {
                     println!("{}", serde_json::to_string(&crate::cmd::decode::json_value(&state)?)?);
                 } else {
+                    wait_battery(&robot).await;
                     println!("{}", robot.status_text().context("no state")?);
                 }
                 ExitCode::SUCCESS
@@ -90,6 +91,18 @@ pub(crate) fn run(args: G1Args) -> anyhow::Result<ExitCode> {
         robot.close();
         Ok(code)
     })
+}
+
+/// How long `status` waits for `rt/lf/bmsstate` after the first LowState (the robot sends it
+/// less often).
+const BATTERY_WAIT: Duration = Duration::from_millis(1500);
+
+/// Waits up to [`BATTERY_WAIT`] for the first battery state (looking every 10 ms).
+async fn wait_battery(robot: &G1) {
+    let deadline = tokio::time::Instant::now() + BATTERY_WAIT;
+    while robot.battery().is_none() && tokio::time::Instant::now() < deadline {
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
 }
 
 async fn release(robot: &G1) -> anyhow::Result<()> {
