@@ -13,6 +13,8 @@ Scenarios:
   stand before it walks).
 - sense_chassis: rt/NS/battery_state and rt/NS/diagnostics of a KMC chassis.
 - sense_go2: rt/NS/joint_states and rt/NS/imu of a Go2, and rt/NS/lowstate with Unitree's class.
+- sense_g1: rt/NS/joint_states and rt/NS/battery_state of a G1, and rt/NS/lowstate with Unitree's
+  HG class.
 """
 
 import json
@@ -147,6 +149,26 @@ def sense_go2(dp, ns):
     }
 
 
+def sense_g1(dp, ns):
+    """joint_states and battery_state from the G1's LowState and BmsState, and the LowState itself
+    passed through as unitree_hg/msg/LowState (read with Unitree's own HG IDL class, its CRC
+    checked by Unitree's code)."""
+    from unitree_sdk2py.idl.unitree_hg.msg.dds_ import LowState_
+    from unitree_sdk2py.utils.crc import CRC
+
+    joints = take_one(DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR))
+    battery = take_one(DataReader(dp, Topic(dp, topic(ns, "battery_state"), BatteryState), qos=SENSOR))
+    low = take_one(DataReader(dp, Topic(dp, topic(ns, "lowstate"), LowState_), qos=SENSOR))
+    return {
+        "names": joints.name,
+        "position": joints.position,
+        "lowstate_q": [m.q for m in low.motor_state[:29]],
+        "mode_machine": low.mode_machine,
+        "crc_ok": CRC().Crc(low) == low.crc,
+        "battery": asdict(battery),
+    }
+
+
 def stand_up(dp, ns):
     requests = DataWriter(dp, Topic(dp, f"rq{ns}/stand_upRequest", TriggerRequest), qos=RELIABLE)
     replies = DataReader(dp, Topic(dp, f"rr{ns}/stand_upReply", TriggerResponse), qos=RELIABLE)
@@ -183,6 +205,7 @@ def main():
         "stand_and_drive": stand_and_drive,
         "sense": sense,
         "sense_go2": sense_go2,
+        "sense_g1": sense_g1,
         "sense_chassis": sense_chassis,
         "stand_up": stand_up,
     }
