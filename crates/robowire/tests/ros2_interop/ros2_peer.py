@@ -130,15 +130,18 @@ def sense(dp, ns):
     return out
 
 
+def sensed(dp, ns, name, message_type):
+    """One sample of rt/NS/NAME, read with the sensor-data QoS."""
+    return take_one(DataReader(dp, Topic(dp, topic(ns, name), message_type), qos=SENSOR))
+
+
 def sense_go2(dp, ns):
     """joint_states and imu from the Go2's LowState, and the LowState itself passed through as
     unitree_go/msg/LowState (read with Unitree's own IDL class, its CRC checked by Unitree's code)."""
     from unitree_sdk2py.idl.unitree_go.msg.dds_ import LowState_
     from unitree_sdk2py.utils.crc import CRC
 
-    joints = take_one(DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR))
-    imu = take_one(DataReader(dp, Topic(dp, topic(ns, "imu"), Imu), qos=SENSOR))
-    low = take_one(DataReader(dp, Topic(dp, topic(ns, "lowstate"), LowState_), qos=SENSOR))
+    joints, imu, low = (sensed(dp, ns, name, t) for name, t in [("joint_states", JointState), ("imu", Imu), ("lowstate", LowState_)])
     return {
         "names": joints.name,
         "position": joints.position,
@@ -156,9 +159,9 @@ def sense_g1(dp, ns):
     from unitree_sdk2py.idl.unitree_hg.msg.dds_ import LowState_
     from unitree_sdk2py.utils.crc import CRC
 
-    joints = take_one(DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR))
-    battery = take_one(DataReader(dp, Topic(dp, topic(ns, "battery_state"), BatteryState), qos=SENSOR))
-    low = take_one(DataReader(dp, Topic(dp, topic(ns, "lowstate"), LowState_), qos=SENSOR))
+    joints, battery, low = (
+        sensed(dp, ns, name, t) for name, t in [("joint_states", JointState), ("battery_state", BatteryState), ("lowstate", LowState_)]
+    )
     return {
         "names": joints.name,
         "position": joints.position,
