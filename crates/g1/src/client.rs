@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use go2::{Device, Go2Stats, Hg, JointCommand, LowLevel};
 use lowcmd_proto::api::{g1_arm, g1_loco};
+use lowcmd_proto::bms::HgBmsState;
 use lowcmd_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, JOINTS, ModePr, slot};
 use lowcmd_proto::hg::HgMotorCmd;
 use lowcmd_proto::robot::{CommandError, Robot};
@@ -20,7 +21,8 @@ use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 
 use crate::arm_job::{ArmSdkJob, ArmShared};
 use crate::arm_stream::ArmSdkStream;
-use crate::{ArmActions, G1Error, G1Options, Loco};
+use crate::battery::BatteryReader;
+use crate::{ArmActions, Battery, G1Error, G1Options, Loco};
 
 /// The joints of `rt/arm_sdk`, in [`ARM_SDK_JOINTS`] order: both arms (slots 15..29), then the
 /// waist (12, 13, 14).
@@ -45,12 +47,8 @@ pub struct G1Stats {
     pub arm_sdk_weight: f32,
     /// Send lateness of the arm stream, µs.
     pub arm_sdk_send_lateness: LatenessSummary,
-}
-
-/// The variant a LowState's `mode_machine` names; [`G1Variant::Dof29`] for a value not in
-/// Unitree's table (0, a simulator's, included).
-fn variant_of(mode_machine: u8) -> G1Variant {
-    G1Variant::of_mode_machine(mode_machine).unwrap_or(G1Variant::Dof29)
+    /// `rt/lf/bmsstate` samples (decode errors counted apart).
+    pub bmsstate: TopicStats,
 }
 
 /// A Unitree G1 over DDS, on robowire's one device shape ([`Device`]: the latest
@@ -80,6 +78,7 @@ pub struct G1 {
     arm_targets: Mutex<Option<HgLowCmd>>,
     loco: Loco,
     arm: ArmActions,
+    battery: BatteryReader,
     /// Dropped after the arm stream ended.
     low: LowLevel<Hg>,
 }
@@ -105,6 +104,7 @@ impl G1 {
         let arm_waker = arm_stream.waker();
         let loco = Loco::new(low.service(g1_loco::SERVICE)?);
         let arm = ArmActions::new(low.service(g1_arm::SERVICE)?);
+        let battery = BatteryReader::spawn(low.participant(), low.receiving().runtime())?;
         Ok(Self {
             options,
             arm_stream: Some(arm_stream),
@@ -114,6 +114,7 @@ impl G1 {
             arm_targets: Mutex::new(None),
             loco,
             arm,
+            battery,
             low,
         })
     }
@@ -150,13 +151,13 @@ impl G1 {
     /// table (0 from a simulator included: its commands are checked as for a 29-dof G1). `None`
     /// without the option before the first LowState.
     pub fn variant(&self) -> Option<G1Variant> {
-        self.options.variant.or_else(|| self.mode_machine().map(variant_of))
+        self.mode_machine().map(|m| self.options.variant_of(m)).or(self.options.variant)
     }
 
     /// The robot's `mode_machine` and variant, or [`CommandError::NoModeMachine`].
     fn machine(&self) -> Result<(u8, G1Variant), CommandError> {
         let mode_machine = self.mode_machine().ok_or(CommandError::NoModeMachine)?;
-        Ok((mode_machine, self.options.variant.unwrap_or_else(|| variant_of(mode_machine))))
+        Ok((mode_machine, self.options.variant_of(mode_machine)))
     }
 
     /// Latches `command` for `rt/lowcmd` if [`lowcmd_proto::g1::check_low_cmd`] allows it for
@@ -278,6 +279,16 @@ impl G1 {
         f32::from_bits(self.arm_shared.weight.load(Ordering::Relaxed))
     }
 
+    /// The robot's latest battery state (`rt/lf/bmsstate`; `None` before the first).
+    pub fn battery(&self) -> Option<HgBmsState> {
+        self.battery.battery.latest()
+    }
+
+    /// A handle on the latest battery state, for readers that outlive a borrow of the client.
+    pub fn battery_handle(&self) -> Battery {
+        self.battery.battery.clone()
+    }
+
     /// The locomotion service (`sport`).
     pub fn loco(&self) -> &Loco {
         &self.loco
@@ -325,6 +336,7 @@ impl Device for G1 {
             arm_sdk_write_drops: a.write_drops.get(),
             arm_sdk_weight: self.arm_weight(),
             arm_sdk_send_lateness: a.lateness.summary(),
+            bmsstate: self.battery.stats.get(),
         }
     }
 
@@ -336,6 +348,7 @@ impl Device for G1 {
 
 impl Drop for G1 {
     fn drop(&mut self) {
+        self.battery.task.abort();
         if let Some(arm_stream) = self.arm_stream.take() {
             // The arm stream ramps its weight to 0 (bounded: see `arm_stream`) and ends by itself.
             self.arm_shared.closing.store(true, Ordering::Release);

@@ -29,6 +29,13 @@ impl G1Options {
         Self { low_level: LowLevelOptions::on(interface, domain), ..Self::default() }
     }
 
+    /// The variant of a robot whose LowState says `mode_machine`: the option if set; otherwise
+    /// what `mode_machine` names ([`G1Variant::of_mode_machine`]), and [`G1Variant::Dof29`] for a
+    /// value not in Unitree's table (0, a simulator's, included).
+    pub fn variant_of(&self, mode_machine: u8) -> G1Variant {
+        self.variant.or(G1Variant::of_mode_machine(mode_machine)).unwrap_or(G1Variant::Dof29)
+    }
+
     /// The `rt/arm_sdk` options: period 1 ms..=1 s, command timeout at least a period, weight
     /// rate finite in (0, 5] per second. (The low-level options, placement included, are checked
     /// by [`go2::LowLevel::open`].)

@@ -9,11 +9,12 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use g1::{
-    ARM_JOINTS, ArmActions, CommandError, Device, G1, G1Error, G1Options, G1Variant, HgLowCmd, HgLowState,
+    ARM_JOINTS, ArmActions, CommandError, Device, G1, G1Error, G1Options, G1Variant, HgBmsState, HgLowCmd, HgLowState,
     JOINT_LIMITS, JOINTS, JointCommand, Loco,
 };
 use lowcmd_proto::Message;
 use lowcmd_proto::api::{self, ApiRequest, ApiResponse, Response, g1_arm, g1_loco, motion_switcher};
+use lowcmd_proto::bms::BMS_TOPIC;
 use lowcmd_proto::g1::{ARM_SDK_TOPIC, slot};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
@@ -92,6 +93,21 @@ impl Robot {
                 if flag.load(Ordering::Relaxed) {
                     state.tick = (state.tick.get() + 2).into();
                     let _ = states.try_write(state);
+                }
+            }
+        });
+        // The battery beside it (no CRC), as the robot publishes it.
+        let bms = participant.writer::<HgBmsState>(BMS_TOPIC, Qos::STREAM_WRITER).unwrap();
+        let flag = publishing.clone();
+        tokio::spawn(async move {
+            let mut state = HgBmsState::default();
+            (state.soc, state.current) = (87, (-3200).into());
+            state.cell_vol[..13].fill(4012.into());
+            let mut every = tokio::time::interval(Duration::from_millis(20));
+            loop {
+                every.tick().await;
+                if flag.load(Ordering::Relaxed) {
+                    let _ = bms.try_write(state);
                 }
             }
         });
@@ -273,11 +289,19 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
         assert_eq!(refused(g1.set_arm_joints(&[JointCommand::default(); ARM_JOINTS])), CommandError::NoModeMachine);
         assert_eq!((g1.mode_machine(), g1.variant()), (None, None));
         assert_eq!(g1.stats().low_level.commands_sent, 0);
+        assert_eq!(g1.battery(), None);
 
         robot.publish();
         assert!(g1.wait_state(WAIT, |_| true).await.is_some(), "rt/lowstate");
         assert_eq!((g1.mode_machine(), g1.variant()), (Some(5), Some(G1Variant::Dof29)));
         assert!((g1.joint_positions().unwrap()[3] - 0.03).abs() < 1e-6);
+        // rt/lf/bmsstate beside it: the latest, and its topic's counters.
+        until("rt/lf/bmsstate", || g1.battery().is_some()).await;
+        let battery = g1.battery_handle().latest().unwrap();
+        assert_eq!((battery.soc, battery.current.get(), battery.cell_vol[12].get()), (87, -3200, 4012));
+        assert_eq!(battery.cell_vol[13].get(), 0);
+        let bmsstate = g1.stats().bmsstate;
+        assert!(bmsstate.samples > 0 && bmsstate.decode_errors == 0, "{bmsstate:?}");
 
         // Damping before any command: the robot's mode_machine, its 29 joints.
         g1.damp().unwrap();

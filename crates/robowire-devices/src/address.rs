@@ -18,9 +18,11 @@ pub enum DeviceAddress {
     Go2(String),
     /// `hg:eth0`: a Unitree HG robot's (G1, H1-2) low-level interface on that interface.
     Hg(String),
+    /// `g1:eth0`: a Unitree G1 humanoid on that interface, through the `g1` facade.
+    G1(String),
     /// `spline:/spline_shm`: a ZSL-1's spline daemon on shared memory, watched.
     Spline(String),
-    /// `sim:kmc|zsl1|zsl1w|go2|spline`: an in-process simulator and a client of it.
+    /// `sim:kmc|zsl1|zsl1w|go2|g1|spline`: an in-process simulator and a client of it.
     Sim(SimKind),
 }
 
@@ -35,6 +37,8 @@ pub enum SimKind {
     Zsl1w,
     /// A Go2 on DDS.
     Go2,
+    /// A 29-joint G1 on DDS.
+    G1,
     /// The spline daemon on private shared memory.
     Spline,
 }
@@ -52,12 +56,14 @@ pub enum DeviceKind {
     Go2,
     /// A Unitree HG robot (G1, H1-2).
     Hg,
+    /// A Unitree G1 humanoid.
+    G1,
     /// A ZSL-1's spline daemon.
     Spline,
 }
 
 impl DeviceKind {
-    /// Its name in addresses: `kmc`, `zsl1`, `zsl1w`, `go2`, `hg`.
+    /// Its name in addresses: `kmc`, `zsl1`, `zsl1w`, `go2`, `hg`, `g1`, `spline`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Kmc => "kmc",
@@ -65,13 +71,14 @@ impl DeviceKind {
             Self::Zsl1w => "zsl1w",
             Self::Go2 => "go2",
             Self::Hg => "hg",
+            Self::G1 => "g1",
             Self::Spline => "spline",
         }
     }
 }
 
 /// The addresses every error message shows as examples.
-pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|spline";
+pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|g1|spline";
 
 /// Why an address was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -106,6 +113,7 @@ impl FromStr for DeviceAddress {
             "zsl1w" => Ok(Self::Zsl1w(ip()?)),
             "go2" => Ok(Self::Go2(interface()?)),
             "hg" => Ok(Self::Hg(interface()?)),
+            "g1" => Ok(Self::G1(interface()?)),
             "spline" if rest.starts_with('/') && rest.len() > 1 && !rest[1..].contains('/') => {
                 Ok(Self::Spline(rest.into()))
             }
@@ -115,8 +123,9 @@ impl FromStr for DeviceAddress {
                 "zsl1" => SimKind::Zsl1,
                 "zsl1w" => SimKind::Zsl1w,
                 "go2" => SimKind::Go2,
+                "g1" => SimKind::G1,
                 "spline" => SimKind::Spline,
-                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, spline)")),
+                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)")),
             })),
             _ => Err(refuse("unknown kind")),
         }
@@ -131,6 +140,7 @@ impl fmt::Display for DeviceAddress {
             Self::Zsl1w(ip) => write!(f, "zsl1w:{ip}"),
             Self::Go2(interface) => write!(f, "go2:{interface}"),
             Self::Hg(interface) => write!(f, "hg:{interface}"),
+            Self::G1(interface) => write!(f, "g1:{interface}"),
             Self::Spline(name) => write!(f, "spline:{name}"),
             Self::Sim(kind) => write!(f, "sim:{}", kind.device().name()),
         }
@@ -145,6 +155,7 @@ impl SimKind {
             Self::Zsl1 => DeviceKind::Zsl1,
             Self::Zsl1w => DeviceKind::Zsl1w,
             Self::Go2 => DeviceKind::Go2,
+            Self::G1 => DeviceKind::G1,
             Self::Spline => DeviceKind::Spline,
         }
     }
@@ -159,6 +170,7 @@ impl DeviceAddress {
             Self::Zsl1w(_) => DeviceKind::Zsl1w,
             Self::Go2(_) => DeviceKind::Go2,
             Self::Hg(_) => DeviceKind::Hg,
+            Self::G1(_) => DeviceKind::G1,
             Self::Spline(_) => DeviceKind::Spline,
             Self::Sim(sim) => sim.device(),
         }
@@ -171,7 +183,7 @@ impl DeviceAddress {
 
     /// Whether its link is DDS (on one machine, DDS discovery needs multicast on loopback).
     pub fn uses_dds(&self) -> bool {
-        matches!(self.kind(), DeviceKind::Go2 | DeviceKind::Hg)
+        matches!(self.kind(), DeviceKind::Go2 | DeviceKind::Hg | DeviceKind::G1)
     }
 }
 
@@ -187,21 +199,30 @@ mod tests {
             "zsl1w:10.0.0.2",
             "go2:eth0",
             "hg:enp3s0",
+            "g1:eth0",
             "spline:/spline_shm",
             "sim:zsl1",
             "sim:spline",
+            "sim:g1",
         ] {
             let address: DeviceAddress = text.parse().unwrap();
             assert_eq!(address.to_string(), text);
         }
         assert_eq!("zsl1w:192.168.234.1".parse::<DeviceAddress>().unwrap().kind(), DeviceKind::Zsl1w);
         assert!("sim:go2".parse::<DeviceAddress>().unwrap().uses_dds());
+        let g1: DeviceAddress = "g1:enp3s0".parse().unwrap();
+        assert_eq!((g1.kind(), g1.kind().name(), g1.uses_dds()), (DeviceKind::G1, "g1", true));
+        let sim: DeviceAddress = "sim:g1".parse().unwrap();
+        assert_eq!((sim.kind(), sim.is_simulated(), sim.uses_dds()), (DeviceKind::G1, true, true));
+        assert_eq!("hg:eth0".parse::<DeviceAddress>().unwrap().kind(), DeviceKind::Hg, "hg: stays the generic client");
         for (bad, reason) in [
             ("kmc", "no kind: write KIND:WHERE"),
             ("kmc:", "nothing after the kind"),
             ("zsl1:robot", "not an IP address"),
             ("go2:a/b", "not a network interface name"),
-            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2, spline)"),
+            ("g1:a-very-long-interface-name", "not a network interface name"),
+            ("g1:", "nothing after the kind"),
+            ("sim:tank", "no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)"),
             ("spline:spline_shm", "not a shared-memory object name (/spline_shm)"),
             ("tank:1", "unknown kind"),
         ] {

@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 mod address;
+mod g1;
 mod kmc;
 mod link;
 mod observation;
@@ -31,22 +32,23 @@ use tokio::sync::watch;
 /// How [`open`] reaches a device, beyond its address.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OpenOptions {
-    /// DDS domain of `go2:`, `hg:` and `sim:go2` (Unitree's robots: 0).
+    /// DDS domain of `go2:`, `hg:`, `g1:`, `sim:go2` and `sim:g1` (Unitree's robots: 0).
     pub domain: u16,
-    /// Network interface of `sim:go2`'s simulator and client (`None`: `lo`).
+    /// Network interface of `sim:go2`'s and `sim:g1`'s simulator and client (`None`: `lo`).
     pub sim_interface: Option<String>,
     /// Local address of `zsl1:`/`zsl1w:` clients: where the robot sends its state (its
     /// `target_ip`/`target_port`, port 43988 by default).
     pub zsl_local: SocketAddr,
     /// `kmc:` polls the battery (1 Hz) and the motors' all-state (10 Hz).
     pub kmc_polls: bool,
-    /// A device silent this long is `Disconnected` (`kmc:`, `zsl1:`, `zsl1w:`, `go2:`, `hg:` and
-    /// their simulators); `None`: each device's default (KMC 500 ms, ZSL-1 the vendor's 3 s
-    /// watchdog, Go2/HG 100 ms).
+    /// A device silent this long is `Disconnected` (`kmc:`, `zsl1:`, `zsl1w:`, `go2:`, `hg:`,
+    /// `g1:` and their simulators); `None`: each device's default (KMC 500 ms, ZSL-1 the vendor's
+    /// 3 s watchdog, Go2/HG/G1 100 ms).
     pub state_timeout: Option<Duration>,
     /// Record the device's links with this recorder (`None`: not recorded), named after the
     /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `dog/high_level`,
-    /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `spline/spline` (the states a
+    /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `g1/low_level` and `g1/api`
+    /// (described by `lowcmd_proto::description::HG_LOW_LEVEL` and `API_CLIENT`), `spline/spline` (the states a
     /// monitor takes from `/spline_shm`).
     pub record: Option<RecordLinks>,
 }
@@ -84,6 +86,9 @@ pub enum DeviceError {
     /// A Unitree robot's client.
     #[error("Unitree low-level client")]
     Unitree(#[from] go2::Go2Error),
+    /// A Unitree G1's client.
+    #[error("Unitree G1 client")]
+    G1(#[from] ::g1::G1Error),
     /// The spline daemon's shared memory.
     #[error("spline shared memory")]
     Spline(#[from] ::zsl::SplineError),
@@ -134,7 +139,7 @@ pub fn error_chain(error: &dyn std::error::Error) -> String {
 /// A device opened by address, in the one shape every app drives: state, connection, status, a
 /// neutral [`Observation`], drive, services, close. Typed access to the facade underneath for
 /// what is the device's own ([`kmc`](Self::kmc), [`zsl`](Self::zsl), [`go2`](Self::go2),
-/// [`hg`](Self::hg)). Dropping it does the device's safe thing and closes it (then stops its
+/// [`hg`](Self::hg), [`g1`](Self::g1)). Dropping it does the device's safe thing and closes it (then stops its
 /// simulator, if any).
 pub struct AnyDevice {
     address: DeviceAddress,
@@ -178,6 +183,7 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
         DeviceAddress::Hg(interface) => {
             Box::new(go2::LowLevel::<go2::Hg>::open(go2_options::<go2::Hg>(Some(interface), options))?)
         }
+        DeviceAddress::G1(interface) => Box::new(::g1::G1::open(g1_options(Some(interface), options))?),
         DeviceAddress::Spline(name) => Box::new(::zsl::spline::SplineMonitor::open(spline_options(name, options))?),
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
     };
@@ -239,13 +245,29 @@ fn zsl_options(
 }
 
 fn go2_options<R: unitree::Family>(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
+    unitree_options(interface, options, R::RECORDED_AS, R::LOW_LEVEL)
+}
+
+/// A G1 client's options: the HG low level, recorded as `g1/low_level` and `g1/api`.
+fn g1_options(interface: Option<&str>, options: &OpenOptions) -> ::g1::G1Options {
+    let low_level = unitree_options(interface, options, "g1", &lowcmd_proto::description::HG_LOW_LEVEL);
+    ::g1::G1Options { low_level, ..::g1::G1Options::default() }
+}
+
+/// A Unitree low-level client's options: the domain, the state timeout, and with a recorder its
+/// links `{recorded_as}/low_level` (described by `low_level`) and `{recorded_as}/api`.
+fn unitree_options(
+    interface: Option<&str>,
+    options: &OpenOptions,
+    recorded_as: &str,
+    low_level: &'static dyn robowire_core::json::LinkDescription,
+) -> go2::LowLevelOptions {
     let defaults = go2::LowLevelOptions::on(interface, options.domain);
     let record = options.record.as_ref();
     go2::LowLevelOptions {
         state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
-        low_level_tap: record.map(|r| r.link(&format!("{}/low_level", R::RECORDED_AS), R::LOW_LEVEL)),
-        services_tap: record
-            .map(|r| r.link(&format!("{}/api", R::RECORDED_AS), &lowcmd_proto::description::API_CLIENT)),
+        low_level_tap: record.map(|r| r.link(&format!("{recorded_as}/low_level"), low_level)),
+        services_tap: record.map(|r| r.link(&format!("{recorded_as}/api"), &lowcmd_proto::description::API_CLIENT)),
         ..defaults
     }
 }
@@ -393,8 +415,13 @@ impl AnyDevice {
         self.link().as_any().downcast_ref()
     }
 
-    /// The HG low-level client, if this is an HG robot.
+    /// The HG low-level client, if this is an HG robot opened as `hg:`.
     pub fn hg(&self) -> Option<&go2::LowLevel<go2::Hg>> {
+        self.link().as_any().downcast_ref()
+    }
+
+    /// The G1 client, if this is a G1 (`g1:`, `sim:g1`).
+    pub fn g1(&self) -> Option<&::g1::G1> {
         self.link().as_any().downcast_ref()
     }
 
@@ -439,11 +466,13 @@ mod tests {
         assert_eq!(kmc_options(&quick).state_timeout, Duration::from_millis(250));
         assert_eq!(zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &quick).watchdog, Duration::from_millis(250));
         assert_eq!(go2_options::<go2::Go2>(Some("lo"), &quick).state_timeout, Duration::from_millis(250));
+        assert_eq!(g1_options(Some("lo"), &quick).low_level.state_timeout, Duration::from_millis(250));
 
         let default = OpenOptions::default();
         assert_eq!(kmc_options(&default).state_timeout, ::kmc::DriverOptions::default().state_timeout);
         let zsl = zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &default);
         assert_eq!((zsl.watchdog, zsl.model), (zsl_client().watchdog, ::zsl::udp::Model::Zsl1W));
         assert_eq!(go2_options::<go2::Go2>(None, &default).state_timeout, go2::STATE_TIMEOUT);
+        assert_eq!(g1_options(None, &default).low_level.state_timeout, go2::STATE_TIMEOUT);
     }
 }

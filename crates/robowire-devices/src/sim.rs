@@ -1,6 +1,7 @@
 //! `sim:` addresses: the simulator first, then the same client a real device gets.
 
 use robowire_sim::dog::{DogSim, DogSimConfig};
+use robowire_sim::g1::{G1Sim, G1SimConfig};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
@@ -18,6 +19,8 @@ pub enum Simulator {
     Dog(DogSim),
     /// A Go2 on DDS.
     Go2(Go2Sim),
+    /// A G1 on DDS.
+    G1(G1Sim),
     /// The spline daemon on private shared memory.
     Spline(SplineSim),
 }
@@ -63,6 +66,15 @@ pub(crate) fn open(
                     .map_err(|e| failed(e.into()))?;
             let client = go2::LowLevel::<go2::Go2>::open(client)?;
             (Simulator::Go2(sim), Box::new(client))
+        }
+        SimKind::G1 => {
+            let interface = options.sim_interface.as_deref().unwrap_or("lo");
+            let client = crate::g1_options(Some(interface), options);
+            let participant = client.low_level.participant.clone();
+            let sim =
+                G1Sim::spawn(G1SimConfig { participant, ..G1SimConfig::default() }).map_err(|e| failed(e.into()))?;
+            let client = g1::G1::open(client)?;
+            (Simulator::G1(sim), Box::new(client))
         }
     })
 }

@@ -29,7 +29,8 @@ fn pose(q: &[f32]) -> String {
     q.chunks(3).map(|leg| format!("[{}]", floats(leg))).collect::<Vec<_>>().join(" ")
 }
 
-fn imu(quaternion: [F32; 4], gyroscope: [F32; 3], accelerometer: [F32; 3]) -> ImuReading {
+/// An IMU reading from a Unitree IMU state's fields (quaternion w, x, y, z).
+pub(crate) fn imu(quaternion: [F32; 4], gyroscope: [F32; 3], accelerometer: [F32; 3]) -> ImuReading {
     ImuReading {
         orientation_xyzw: xyzw(quaternion.map(|v| v.get())),
         gyro_radps: wide(gyroscope.map(|v| v.get())),
@@ -134,13 +135,31 @@ impl Family for Hg {
 
 /// The state, device-neutral, with the LowState itself to pass through.
 fn observation<R: Family>(state: &R::State) -> Observation {
-    let mut observation = R::observe(state);
+    Observation { passthrough: lowstate_passthrough(state), ..R::observe(state) }
+}
+
+/// A LowState (any Unitree family) as the `lowstate` passthrough: its DDS type name and body.
+pub(crate) fn lowstate_passthrough<S: CdrType>(state: &S) -> Option<Passthrough> {
     let mut body = vec![0u8; state.body_len()];
-    if let Ok(n) = state.encode_body(&mut body) {
-        body.truncate(n);
-        observation.passthrough = Some(Passthrough { topic: "lowstate", type_name: R::State::TYPE_NAME, body });
-    }
-    observation
+    let n = state.encode_body(&mut body).ok()?;
+    body.truncate(n);
+    Some(Passthrough { topic: "lowstate", type_name: S::TYPE_NAME, body })
+}
+
+/// The low-level client's counters as one line.
+pub(crate) fn low_level_stats(s: &go2::Go2Stats) -> String {
+    format!(
+        "lowcmd sent {} (damping {}) | lowstate received {} decode errors {} CRC errors {} lost by tick {} | \
+         send lateness p50 {} µs p99 {} µs",
+        s.commands_sent,
+        s.damping_sent,
+        s.lowstate.samples,
+        s.lowstate.decode_errors,
+        s.lowstate.checksum_errors,
+        s.lost_by_tick,
+        s.send_lateness.p50_us,
+        s.send_lateness.p99_us
+    )
 }
 
 impl<R: Family> Describe for LowLevel<R> {
@@ -159,19 +178,7 @@ impl<R: Family> Describe for LowLevel<R> {
     }
 
     fn stats_line(&self) -> String {
-        let s = self.stats();
-        format!(
-            "lowcmd sent {} (damping {}) | lowstate received {} decode errors {} CRC errors {} lost by tick {} | \
-             send lateness p50 {} µs p99 {} µs",
-            s.commands_sent,
-            s.damping_sent,
-            s.lowstate.samples,
-            s.lowstate.decode_errors,
-            s.lowstate.checksum_errors,
-            s.lost_by_tick,
-            s.send_lateness.p50_us,
-            s.send_lateness.p99_us
-        )
+        low_level_stats(&self.stats())
     }
 }
 

@@ -21,7 +21,7 @@ struct Cli {
 enum Command {
     /// Drive every simulated device through its client API and report what was seen.
     Demo(cmd::demo::DemoArgs),
-    /// Print one state of any device, by address (kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:KIND).
+    /// Print one state of any device, by address (kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, g1:IFACE, sim:KIND).
     Status(cmd::device::StatusArgs),
     /// Print the state of any device live, by address, until Ctrl-C.
     Watch(cmd::device::DeviceArgs),
@@ -34,6 +34,8 @@ enum Command {
     Dog(cmd::dog::DogArgs),
     /// Drive a Unitree Go2's low-level interface over DDS (status, watch, release, stand, damp).
     Go2(cmd::go2::Go2Args),
+    /// Drive a Unitree G1 humanoid's low-level interface over DDS (status, watch, release, damp, zero).
+    G1(cmd::g1::G1Args),
     /// Inspect DDS: the topics on the network, the samples of one.
     Dds(cmd::dds::DdsCommandArgs),
     /// Every device as a ROS 2 node on the wire (cmd_vel, odom, tf, imu, joint_states, …), no ROS install needed.
@@ -74,6 +76,7 @@ fn main() -> ExitCode {
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Dog(args) => cmd::dog::run(args),
         Command::Go2(args) => cmd::go2::run(args),
+        Command::G1(args) => cmd::g1::run(args),
         Command::Dds(args) => cmd::dds::run(args),
         Command::Ros2(args) => cmd::ros2::run(args),
         Command::Shm(command) => cmd::shm::run(&command),

@@ -3,7 +3,8 @@
 //! where loopback carries multicast (`robowire_dds::netns`): the peer drives a simulated chassis
 //! and dog through `cmd_vel`, sees them move on `odom` and stop after the deadman time, reads
 //! `joint_states`, `imu`, `battery_state` and `tf` field for field, calls `stand_up` in
-//! rmw_cyclonedds' request/reply format; unarmed, the same `cmd_vel` moves nothing.
+//! rmw_cyclonedds' request/reply format; unarmed, the same `cmd_vel` moves nothing. A simulated
+//! G1's topics are read by that peer (Unitree's HG classes) and by robowire's own DDS readers.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -183,5 +184,70 @@ fn a_go2_publishes_joint_states_and_passes_lowstate_through() {
         let counters = bridge.stop();
         assert!(counters[0]["published"].as_u64().unwrap() > 100);
         assert_eq!(counters[0]["namespace"], "/dog");
+    });
+}
+
+#[test]
+fn a_g1_publishes_its_joints_by_name_its_battery_and_passes_its_hg_lowstate_through() {
+    use lowcmd_proto::HgLowState;
+    use robowire_dds::qos::Qos;
+    use robowire_dds::{Participant, ParticipantOptions};
+    use ros2_proto::sensor::{BatteryState, Imu, JointState};
+
+    /// Generous: a topic silent this long is a failure, not slowness.
+    const WAIT: std::time::Duration = std::time::Duration::from_secs(20);
+    with_loopback_multicast(|| {
+        let bridge = Bridge::start(&["--device", "sim:g1", "--interface", "lo", "--namespace", "g1"]);
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        runtime.block_on(async {
+            let participant = Participant::new(ParticipantOptions::new(0, Some("lo"))).unwrap();
+            let mut joints = participant.reader::<JointState>("rt/g1/joint_states", Qos::ROS_SENSOR_DATA).unwrap();
+            let mut battery = participant.reader::<BatteryState>("rt/g1/battery_state", Qos::ROS_SENSOR_DATA).unwrap();
+            let mut imu = participant.reader::<Imu>("rt/g1/imu", Qos::ROS_SENSOR_DATA).unwrap();
+            // robowire's HG codec: a LowState whose CRC does not match is not read.
+            let mut lowstate = participant.reader::<HgLowState>("rt/g1/lowstate", Qos::ROS_SENSOR_DATA).unwrap();
+            let low = tokio::time::timeout(WAIT, lowstate.recv()).await.expect("rt/g1/lowstate").unwrap().value;
+            assert_eq!(low.mode_machine, 5);
+            let joints = tokio::time::timeout(WAIT, joints.recv()).await.expect("joint_states").unwrap().value;
+            assert_eq!(joints.name, g1::JOINT_NAMES);
+            assert_eq!(joints.header.frame_id, "g1/base_link");
+            let q = |slot: usize| low.motor_state[slot].q.get();
+            assert!(joints.position.iter().enumerate().all(|(i, p)| (*p as f32 - q(i)).abs() < 0.05), "{joints:?}");
+            let battery = tokio::time::timeout(WAIT, battery.recv()).await.expect("battery_state").unwrap().value;
+            assert!((0.5..=1.0).contains(&battery.percentage), "{battery:?}");
+            assert_eq!(battery.cell_voltage.len(), 13, "{battery:?}");
+            assert!(battery.voltage > 40.0 && battery.current < 0.0, "{battery:?}");
+            let imu = tokio::time::timeout(WAIT, imu.recv()).await.expect("imu").unwrap().value;
+            assert_eq!(imu.linear_acceleration.z, f64::from(9.81f32), "gravity, the f32 the robot sent");
+            let type_of = |name: &str| {
+                let topics = participant.discovered_topics();
+                topics.iter().find(|t| t.name == name).map(|t| t.type_name.clone()).unwrap_or_default()
+            };
+            assert_eq!(type_of("rt/g1/lowstate"), "unitree_hg::msg::dds_::LowState_");
+            assert_eq!(type_of("rt/g1/joint_states"), "sensor_msgs::msg::dds_::JointState_");
+            assert_eq!(type_of("rt/g1/battery_state"), "sensor_msgs::msg::dds_::BatteryState_");
+        });
+        let counters = bridge.stop();
+        assert!(counters[0]["published"].as_u64().unwrap() > 100);
+    });
+}
+
+#[test]
+fn a_cyclonedds_peer_reads_a_g1_with_unitrees_hg_classes() {
+    let Some(python) = interop_python() else { return };
+    with_loopback_multicast(|| {
+        let bridge = Bridge::start(&["--device", "sim:g1", "--interface", "lo", "--namespace", "g1"]);
+        let seen = peer(&python, "sense_g1", "/g1");
+        let names: Vec<&str> = seen["names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+        assert_eq!(names, g1::JOINT_NAMES);
+        assert_eq!(seen["crc_ok"], true, "Unitree's CRC accepts the passed-through HG LowState: {seen}");
+        assert_eq!(seen["mode_machine"], 5);
+        let q =
+            |key: &str| seen[key].as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect::<Vec<_>>();
+        assert!(q("position").iter().zip(q("lowstate_q")).all(|(a, b)| (a - b).abs() < 0.05), "{seen}");
+        let battery = &seen["battery"];
+        assert!((0.5..=1.0).contains(&f(&battery["percentage"])), "{battery}");
+        assert_eq!(battery["cell_voltage"].as_array().map(Vec::len), Some(13), "{battery}");
+        bridge.stop();
     });
 }

@@ -22,6 +22,8 @@
 //! - `rt/lowstate` (HG `LowState_`) at 500 Hz on robowire's runner, CRC by the encoder:
 //!   `mode_pr`, `mode_machine`, `tick` (ms), the IMU at rest (identity quaternion, gravity on
 //!   z), each driven joint's mode, q, dq, torque, temperatures and voltage.
+//! - `rt/lf/bmsstate` (HG `BmsState_`) once a second: a 13-cell pack draining slowly
+//!   ([`battery`]).
 //! - Services on `rt/api/<service>/…`: `motion_switcher`, `sport` (the G1 loco API, Unitree's
 //!   `LocoClient`) and `arm` (the arm actions). After ReleaseMode the loco service answers
 //!   `LOCO_STATE_UNAVAILABLE` and arm actions `INVALID_FSM_ID` until SelectMode.
@@ -40,6 +42,7 @@
 //! network namespace whose loopback has multicast when testing on one machine
 //! (`robowire_dds::netns`).
 
+pub mod battery;
 mod model;
 mod services;
 
@@ -264,6 +267,7 @@ impl G1Sim {
             switcher: server(motion_switcher::SERVICE)?,
             loco: server(g1_loco::SERVICE)?,
             arm: server(g1_arm::SERVICE)?,
+            battery: participant.writer(lowcmd_proto::bms::BMS_TOPIC, robowire_dds::qos::Qos::STREAM_WRITER)?,
         };
         let inbox = G1Inbox {
             lowcmd: CommandInbox::new(config.state_period),

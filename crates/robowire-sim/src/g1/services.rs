@@ -23,6 +23,8 @@ pub(super) struct Endpoints {
     pub(super) switcher: ServiceServer,
     pub(super) loco: ServiceServer,
     pub(super) arm: ServiceServer,
+    /// `rt/lf/bmsstate`.
+    pub(super) battery: robowire_dds::Writer<lowcmd_proto::bms::HgBmsState>,
 }
 
 /// What the robot checks a LowCmd against.
@@ -157,7 +159,7 @@ pub(super) async fn run(
     endpoints: Endpoints,
     rules: Rules,
 ) {
-    let Endpoints { lowcmd: mut lowcmd_reader, arm_sdk: mut arm_sdk_reader, switcher, loco, arm } = endpoints;
+    let Endpoints { lowcmd: mut lowcmd_reader, arm_sdk: mut arm_sdk_reader, switcher, loco, arm, battery } = endpoints;
     let loco_state = Loco {
         fsm_id: super::BOOT_FSM_ID,
         balance_mode: 0,
@@ -190,6 +192,7 @@ pub(super) async fn run(
         () = serve(switcher, &services, answered, answer_motion_switcher) => {}
         () = serve(loco, &services, answered, answer_loco) => {}
         () = serve(arm, &services, answered, answer_arm) => {}
+        () = super::battery::publish(battery) => {}
     }
 }
 

@@ -10,10 +10,10 @@ use robowire_record::RecordLinks;
 /// A device and how to reach it.
 #[derive(Debug, Args)]
 pub(crate) struct DeviceArgs {
-    /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0,
+    /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0,
     /// spline:/spline_shm, or sim:kmc|zsl1|zsl1w|go2|spline for a simulator started here.
     address: DeviceAddress,
-    /// DDS domain (go2:, hg:, sim:go2).
+    /// DDS domain (go2:, hg:, g1:, sim:go2).
     #[arg(long, default_value_t = 0)]
     domain: u16,
     /// Local address of a zsl1:/zsl1w: client: where the robot sends its state (its
@@ -24,7 +24,7 @@ pub(crate) struct DeviceArgs {
     #[arg(long, default_value_t = 5.0)]
     connect_timeout_s: f64,
     /// Record the device's links, both ways, named after the device (`kmc/serial`,
-    /// `dog/high_level`, `go2/low_level`, `spline/spline`, …).
+    /// `dog/high_level`, `go2/low_level`, `g1/low_level`, `spline/spline`, …).
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
 }
@@ -83,7 +83,7 @@ fn what_to_check(address: &DeviceAddress) -> &'static str {
         DeviceAddress::Zsl1(_) | DeviceAddress::Zsl1w(_) => {
             "is the robot on, and is its target_ip/target_port (sdk_config.yaml) this host's address, port 43988?"
         }
-        DeviceAddress::Go2(_) | DeviceAddress::Hg(_) => {
+        DeviceAddress::Go2(_) | DeviceAddress::Hg(_) | DeviceAddress::G1(_) => {
             "is the robot on, and is this the interface of its network (192.168.123.x)?"
         }
         DeviceAddress::Spline(_) => "is the spline daemon running (and publishing)?",

@@ -1,18 +1,21 @@
 //! `robowire go2 …`: a Unitree Go2's low-level interface over DDS through the `go2` facade.
 
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use go2::trajectory::JointTrajectory;
-use go2::{Connection, Device, Go2, LowLevel, LowLevelOptions};
+use go2::{Device, Go2, LowLevel};
 use robowire_devices::Describe;
 
-/// Where the robot is on DDS, shared by `go2`, `dds` and `sim go2`.
+use crate::cmd::seconds;
+use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};
+
+/// Where the robot is on DDS, shared by `go2`, `g1`, `dds` and the Unitree simulators.
 #[derive(Debug, Clone, Args)]
 pub(crate) struct DdsArgs {
-    /// The network interface by name (the Go2's network is 192.168.123.x: e.g. eth0, enp3s0).
+    /// The network interface by name (the robot's network is 192.168.123.x: e.g. eth0, enp3s0).
     #[arg(long)]
     pub(crate) interface: Option<String>,
     /// DDS domain.
@@ -29,12 +32,7 @@ impl DdsArgs {
 #[derive(Debug, Args)]
 pub(crate) struct Go2Args {
     #[command(flatten)]
-    dds: DdsArgs,
-    /// Seconds to wait for the robot's first LowState.
-    #[arg(long, default_value_t = 5.0)]
-    connect_timeout_s: f64,
-    #[command(flatten)]
-    record: crate::cmd::record::RecordArgs,
+    robot: RobotArgs,
     #[command(subcommand)]
     command: Go2Command,
 }
@@ -65,34 +63,11 @@ enum Go2Command {
     Damp,
 }
 
-/// Damping sent before exiting, after `stand` and by `damp`.
-const DAMP_FOR: Duration = Duration::from_millis(500);
-
-use crate::cmd::seconds;
-
 pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
-    let connect = seconds("--connect-timeout-s", args.connect_timeout_s)?;
-    let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
-    let recorder = args.record.start("robowire go2")?;
-    let code = runtime.block_on(async {
-        let options = LowLevelOptions {
-            participant: args.dds.participant(),
-            low_level_tap: recorder
-                .as_ref()
-                .map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
-            services_tap: recorder.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_CLIENT)),
-            ..LowLevelOptions::default()
-        };
+    let robot_args = &args.robot;
+    robot_args.run("go2", &lowcmd_proto::description::GO2_LOW_LEVEL, |options, connect| async move {
         let robot = LowLevel::<Go2>::open(options).context("joining DDS")?;
-        let state = robot.wait_state(connect, |_| true).await.with_context(|| {
-            format!(
-                "no rt/lowstate within {:.1} s on domain {} ({}): is the robot on, and is this the interface \
-                 of its network (192.168.123.x)?",
-                connect.as_secs_f64(),
-                args.dds.domain,
-                args.dds.interface.as_deref().map_or("the default interface".into(), |i| format!("interface {i}"))
-            )
-        })?;
+        let state = robot.wait_state(connect, |_| true).await.with_context(|| robot_args.silent(connect))?;
         let code = match args.command {
             Go2Command::Status { json } => {
                 if json {
@@ -129,10 +104,8 @@ pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
         };
         eprintln!("{}", robot.stats_line());
         robot.close();
-        anyhow::Ok(code)
-    })?;
-    crate::cmd::record::finish(recorder)?;
-    Ok(code)
+        Ok(code)
+    })
 }
 
 async fn release(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
@@ -150,20 +123,11 @@ async fn stand(robot: &LowLevel<Go2>, duration: Duration, hold: Duration) -> any
     let start = robot.joint_positions().context("no state")?;
     let stand = JointTrajectory::stand_up(start, duration);
     println!("moving from {} to the stand pose over {:.1} s", pose(&start), duration.as_secs_f64());
-    let began = Instant::now();
-    let mut ticker = tokio::time::interval(Duration::from_millis(2));
-    loop {
-        ticker.tick().await;
-        let elapsed = began.elapsed();
-        robot.set_joints(&stand.joints_at(elapsed)).context("the stand command")?;
-        if elapsed >= duration + hold {
-            break;
-        }
-        if robot.connection() == Connection::Disconnected {
-            robot.damp();
-            anyhow::bail!("rt/lowstate stopped while standing up; damping");
-        }
-    }
+    command_for(robot, duration + hold, "standing up", |elapsed| {
+        robot.set_joints(&stand.joints_at(elapsed)).context("the stand command")
+    })
+    .await
+    .inspect_err(|_| robot.damp())?;
     let reached = robot.joint_positions().context("no state")?;
     let worst = stand.largest_error_rad(&reached);
     println!("held the stand pose {:.1} s: {} (largest error {worst:.3} rad)", hold.as_secs_f64(), pose(&reached));

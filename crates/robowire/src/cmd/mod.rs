@@ -6,6 +6,7 @@ pub(crate) mod demo;
 pub(crate) mod device;
 pub(crate) mod dog;
 pub(crate) mod encode;
+pub(crate) mod g1;
 pub(crate) mod go2;
 pub(crate) mod kmc;
 pub(crate) mod live;
@@ -15,6 +16,7 @@ pub(crate) mod replay_device;
 pub(crate) mod ros2;
 pub(crate) mod shm;
 pub(crate) mod sim;
+pub(crate) mod unitree;
 
 /// A duration argument in seconds, 0–3600.
 pub(crate) fn seconds(name: &str, value: f64) -> anyhow::Result<std::time::Duration> {

@@ -10,8 +10,8 @@ use serde::Serialize;
 
 #[derive(Debug, Args)]
 pub(crate) struct Ros2Args {
-    /// A device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, or sim:kmc|zsl1|zsl1w|go2
-    /// for a simulator. Repeat for several devices.
+    /// A device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, g1:eth0, or
+    /// sim:kmc|zsl1|zsl1w|go2|g1 for a simulator. Repeat for several devices.
     #[arg(long = "device", required = true, value_name = "ADDRESS")]
     devices: Vec<DeviceAddress>,
     /// Namespace of the topics (several devices: NS/KIND INDEX each).

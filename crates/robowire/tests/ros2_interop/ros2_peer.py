@@ -13,6 +13,8 @@ Scenarios:
   stand before it walks).
 - sense_chassis: rt/NS/battery_state and rt/NS/diagnostics of a KMC chassis.
 - sense_go2: rt/NS/joint_states and rt/NS/imu of a Go2, and rt/NS/lowstate with Unitree's class.
+- sense_g1: rt/NS/joint_states and rt/NS/battery_state of a G1, and rt/NS/lowstate with Unitree's
+  HG class.
 """
 
 import json
@@ -128,15 +130,18 @@ def sense(dp, ns):
     return out
 
 
+def sensed(dp, ns, name, message_type):
+    """One sample of rt/NS/NAME, read with the sensor-data QoS."""
+    return take_one(DataReader(dp, Topic(dp, topic(ns, name), message_type), qos=SENSOR))
+
+
 def sense_go2(dp, ns):
     """joint_states and imu from the Go2's LowState, and the LowState itself passed through as
     unitree_go/msg/LowState (read with Unitree's own IDL class, its CRC checked by Unitree's code)."""
     from unitree_sdk2py.idl.unitree_go.msg.dds_ import LowState_
     from unitree_sdk2py.utils.crc import CRC
 
-    joints = take_one(DataReader(dp, Topic(dp, topic(ns, "joint_states"), JointState), qos=SENSOR))
-    imu = take_one(DataReader(dp, Topic(dp, topic(ns, "imu"), Imu), qos=SENSOR))
-    low = take_one(DataReader(dp, Topic(dp, topic(ns, "lowstate"), LowState_), qos=SENSOR))
+    joints, imu, low = (sensed(dp, ns, name, t) for name, t in [("joint_states", JointState), ("imu", Imu), ("lowstate", LowState_)])
     return {
         "names": joints.name,
         "position": joints.position,
@@ -144,6 +149,26 @@ def sense_go2(dp, ns):
         "crc_ok": CRC().Crc(low) == low.crc,
         "imu_w": imu.orientation.w,
         "lowstate_quaternion_w": low.imu_state.quaternion[0],
+    }
+
+
+def sense_g1(dp, ns):
+    """joint_states and battery_state from the G1's LowState and BmsState, and the LowState itself
+    passed through as unitree_hg/msg/LowState (read with Unitree's own HG IDL class, its CRC
+    checked by Unitree's code)."""
+    from unitree_sdk2py.idl.unitree_hg.msg.dds_ import LowState_
+    from unitree_sdk2py.utils.crc import CRC
+
+    joints, battery, low = (
+        sensed(dp, ns, name, t) for name, t in [("joint_states", JointState), ("battery_state", BatteryState), ("lowstate", LowState_)]
+    )
+    return {
+        "names": joints.name,
+        "position": joints.position,
+        "lowstate_q": [m.q for m in low.motor_state[:29]],
+        "mode_machine": low.mode_machine,
+        "crc_ok": CRC().Crc(low) == low.crc,
+        "battery": asdict(battery),
     }
 
 
@@ -183,6 +208,7 @@ def main():
         "stand_and_drive": stand_and_drive,
         "sense": sense,
         "sense_go2": sense_go2,
+        "sense_g1": sense_g1,
         "sense_chassis": sense_chassis,
         "stand_up": stand_up,
     }

@@ -1,0 +1,95 @@
+//! What `robowire go2` and `robowire g1` share: where the robot is, how long to wait for its
+//! first LowState, the recording and the runtime; the 2 ms command loop of a move; how long
+//! damping is sent before exiting.
+
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use go2::{Connection, Device, LowLevelOptions};
+use robowire_core::json::LinkDescription;
+
+use crate::cmd::go2::DdsArgs;
+use crate::cmd::seconds;
+
+/// Damping sent before exiting, after a move and by `damp`.
+pub(crate) const DAMP_FOR: Duration = Duration::from_millis(500);
+
+/// How often a move sends its command (the robots' 500 Hz).
+const COMMAND_PERIOD: Duration = Duration::from_millis(2);
+
+/// A Unitree robot on DDS: where, how long to wait for it, what to record.
+#[derive(Debug, Args)]
+pub(crate) struct RobotArgs {
+    #[command(flatten)]
+    pub(crate) dds: DdsArgs,
+    /// Seconds to wait for the robot's first LowState.
+    #[arg(long, default_value_t = 5.0)]
+    connect_timeout_s: f64,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
+}
+
+impl RobotArgs {
+    /// Runs `body` on a two-thread runtime with the low-level options (domain, interface; with
+    /// `--record`, the links `{name}/low_level` described by `low_level` and `{name}/api`) and the
+    /// connect timeout; then closes the capture, whatever `body` returned.
+    pub(crate) fn run<F>(
+        &self,
+        name: &str,
+        low_level: &'static dyn LinkDescription,
+        body: impl FnOnce(LowLevelOptions, Duration) -> F,
+    ) -> anyhow::Result<ExitCode>
+    where
+        F: Future<Output = anyhow::Result<ExitCode>>,
+    {
+        let connect = seconds("--connect-timeout-s", self.connect_timeout_s)?;
+        let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+        let recorder = self.record.start(&format!("robowire {name}"))?;
+        let options = LowLevelOptions {
+            participant: self.dds.participant(),
+            low_level_tap: recorder.as_ref().map(|r| r.link(&format!("{name}/low_level"), low_level)),
+            services_tap: recorder
+                .as_ref()
+                .map(|r| r.link(&format!("{name}/api"), &lowcmd_proto::description::API_CLIENT)),
+            ..LowLevelOptions::default()
+        };
+        let code = runtime.block_on(body(options, connect));
+        crate::cmd::record::finish(recorder)?;
+        code
+    }
+
+    /// What to say when no LowState came within `connect`.
+    pub(crate) fn silent(&self, connect: Duration) -> String {
+        format!(
+            "no rt/lowstate within {:.1} s on domain {} ({}): is the robot on, and is this the interface of its \
+             network (192.168.123.x)?",
+            connect.as_secs_f64(),
+            self.dds.domain,
+            self.dds.interface.as_deref().map_or("the default interface".into(), |i| format!("interface {i}"))
+        )
+    }
+}
+
+/// Calls `step` with the time since the start every 2 ms until `total` has passed (and once at
+/// or after it); fails when `step` does or when `rt/lowstate` stops (`during` says during what).
+pub(crate) async fn command_for(
+    robot: &impl Device,
+    total: Duration,
+    during: &str,
+    mut step: impl FnMut(Duration) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let began = Instant::now();
+    let mut ticker = tokio::time::interval(COMMAND_PERIOD);
+    loop {
+        ticker.tick().await;
+        let elapsed = began.elapsed();
+        step(elapsed)?;
+        if elapsed >= total {
+            return Ok(());
+        }
+        if robot.connection() == Connection::Disconnected {
+            anyhow::bail!("rt/lowstate stopped while {during}; damping");
+        }
+    }
+}
