@@ -40,13 +40,10 @@ pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
     super::on_dds_loopback(out, || scenario(duration_s, out, record))
 }
 
-/// The simulator and the client on domain 0, interface lo.
-fn open(record: Option<&RecordLinks>) -> anyhow::Result<(G1Sim, G1)> {
-    let _ = record;
-    let participant = robowire_dds::ParticipantOptions::new(0, Some("lo"));
-    let sim = G1Sim::spawn(robowire_sim::g1::G1SimConfig { participant, ..Default::default() })?;
-    let robot = G1::open(g1::G1Options::on(Some("lo"), 0))?;
-    Ok((sim, robot))
+/// `sim:g1`: the simulator and the client on DDS domain 0, interface lo.
+fn open(record: Option<&RecordLinks>) -> anyhow::Result<robowire_devices::AnyDevice> {
+    let options = robowire_devices::OpenOptions { record: record.cloned(), ..robowire_devices::OpenOptions::default() };
+    super::open_simulated(robowire_devices::SimKind::G1, &options)
 }
 
 /// Every joint held at `q` with the example's gains (PR mode).
@@ -148,8 +145,10 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
         let started = Instant::now();
-        let (sim, robot) = open(record)?;
-        let (sim, robot) = (&sim, &robot);
+        let device = open(record)?;
+        let (Some(robowire_devices::Simulator::G1(sim)), Some(robot)) = (device.simulator(), device.g1()) else {
+            anyhow::bail!("sim:g1 opened something other than a simulated G1");
+        };
         let first = robot.wait_state(Duration::from_secs(10), |_| true).await.context("no rt/lowstate")?;
         let mode_machine = first.mode_machine;
         out.line(format_args!(

@@ -138,12 +138,12 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         (Device::Lowcmd, lowcmd::run),
         (Device::G1, g1::run),
     ];
+    if let Some(dir) = &args.plot {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     let capture = match (&args.record.record, &args.plot) {
         (Some(file), _) => Some(file.clone()),
-        (None, Some(dir)) => {
-            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-            Some(dir.join("demo.mcap"))
-        }
+        (None, Some(dir)) => Some(dir.join("demo.mcap")),
         (None, None) => None,
     };
     let recorder = crate::cmd::record::start_with(capture.as_deref(), "robowire demo", args.record.compression)?;
