@@ -156,3 +156,9 @@ pub fn unitree_go2_examples() -> Result<PathBuf, String> {
     unitree_python()?;
     Ok(env_dir().join("unitree_sdk2_python/example/go2/low_level"))
 }
+
+/// Unitree's G1 examples (`low_level/`, `high_level/`, in the environment's copy of the SDK).
+pub fn unitree_g1_examples() -> Result<PathBuf, String> {
+    unitree_python()?;
+    Ok(env_dir().join("unitree_sdk2_python/example/g1"))
+}

@@ -16,10 +16,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use crossbeam_queue::ArrayQueue;
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 use robowire_core::{schedule::Tick, timing::LatenessSummary};
 use robowire_rt::lock;
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 use robowire_rt::stats::{Counter, SharedLateness, micros};
 
 /// How long an API call waits for a stalled stream thread before it returns anyway (its request
@@ -169,7 +169,7 @@ impl<T: Clone> Published<T> {
 }
 
 /// A periodic stream's own statistics, written by its thread with relaxed stores.
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 #[derive(Debug, Default)]
 pub(crate) struct StreamStats<const N: usize> {
     cycles: Counter,
@@ -178,7 +178,7 @@ pub(crate) struct StreamStats<const N: usize> {
 }
 
 /// What a [`StreamStats`] counted.
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 #[derive(Debug, Clone, Copy)]
 #[cfg_attr(not(feature = "zsl"), expect(dead_code, reason = "the Go2's snapshot shows the lateness only"))]
 pub(crate) struct StreamSummary {
@@ -190,7 +190,7 @@ pub(crate) struct StreamSummary {
     pub(crate) lateness: LatenessSummary,
 }
 
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 impl<const N: usize> StreamStats<N> {
     /// A tick of the grid: the slots it skipped, and if the stream `served` it (ran its cycle),
     /// its lateness.

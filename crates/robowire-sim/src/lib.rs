@@ -3,11 +3,13 @@
 
 #[cfg(feature = "zsl")]
 pub mod dog;
+#[cfg(feature = "g1")]
+pub mod g1;
 #[cfg(feature = "go2")]
 pub mod go2;
-#[cfg(any(feature = "kmc", feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "kmc", feature = "zsl", feature = "go2", feature = "g1"))]
 mod handover;
-#[cfg(any(feature = "zsl", feature = "go2"))]
+#[cfg(any(feature = "zsl", feature = "go2", feature = "g1"))]
 mod joints;
 #[cfg(feature = "kmc")]
 pub mod kmc;
@@ -15,3 +17,5 @@ pub mod kmc;
 pub mod replay;
 #[cfg(feature = "zsl")]
 pub mod spline;
+#[cfg(any(feature = "go2", feature = "g1"))]
+mod unitree;

@@ -5,11 +5,11 @@
 
 mod support;
 
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
+use std::io::{BufRead, BufReader};
+use std::process::Stdio;
 
 use robowire_dds::netns::with_loopback_multicast;
-use support::{Running, robowire};
+use support::{Running, robowire, start_example, with_unitree_examples};
 
 /// `robowire sim go2 --interface lo`, started and waited for.
 fn start_sim() -> Running {
@@ -20,23 +20,9 @@ fn start_sim() -> Running {
 
 #[test]
 fn unitree_go2_stand_example_runs_unchanged_against_the_simulator() {
-    let Some(python) = robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python()) else {
-        return;
-    };
-    let examples = robowire_fixtures::peers::unitree_go2_examples().unwrap();
-    with_loopback_multicast(|| {
+    with_unitree_examples(robowire_fixtures::peers::unitree_go2_examples, |python, examples| {
         let sim = start_sim();
-        let mut example = Command::new(&python)
-            .arg("go2_stand_example.py")
-            .arg("lo")
-            .current_dir(&examples)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        // "Press Enter to continue..."
-        example.stdin.take().unwrap().write_all(b"\n").unwrap();
+        let example = start_example(python, examples, "go2_stand_example.py");
         let out = example.wait_with_output().unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout);
         // The example ends with sys.exit(-1) after printing "Done!".

@@ -9,6 +9,7 @@
 use lowcmd_proto::{LowCmd, LowState};
 
 use crate::joints::{JointModel, PdTarget};
+use crate::unitree::COMMAND_HOLD_S;
 
 /// The pose Unitree's stand example starts from, per motor (hip, thigh, calf × FR, FL, RR, RL):
 /// lying, rear hips turned out.
@@ -17,9 +18,6 @@ pub const LYING_POSE_RAD: [f32; 12] = [0.0, 1.36, -2.65, 0.0, 1.36, -2.65, -0.2,
 pub const STAND_POSE_RAD: [f32; 3] = [0.0, 0.67, -1.3];
 /// Motors driven on the Go2.
 pub const JOINTS: usize = 12;
-
-/// Without a LowCmd for this long the motors go passive (kp = kd = 0).
-pub const COMMAND_HOLD_S: f32 = 0.1;
 
 /// The body.
 #[derive(Debug, Clone)]

@@ -19,6 +19,48 @@ pub(crate) enum SimCommand {
     /// A Unitree Go2 on DDS (rt/lowcmd, rt/lowstate at 500 Hz, motion_switcher and sport), booted
     /// with its sport mode owning the motors, as Unitree's software expects.
     Go2(Go2SimArgs),
+    /// A Unitree G1 humanoid on DDS (rt/lowcmd, rt/arm_sdk, rt/lowstate at 500 Hz,
+    /// motion_switcher, the loco service `sport` and `arm`), booted standing under its own
+    /// controller, as Unitree's software expects.
+    G1(G1SimArgs),
+}
+
+/// The G1's joint count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Dof {
+    /// 29 joints.
+    #[value(name = "29")]
+    Dof29,
+    /// 23 joints.
+    #[value(name = "23")]
+    Dof23,
+}
+
+impl Dof {
+    fn variant(self) -> lowcmd_proto::g1::G1Variant {
+        match self {
+            Self::Dof29 => lowcmd_proto::g1::G1Variant::Dof29,
+            Self::Dof23 => lowcmd_proto::g1::G1Variant::Dof23,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct G1SimArgs {
+    #[command(flatten)]
+    dds: crate::cmd::go2::DdsArgs,
+    /// Joints: 29 (waist roll and pitch, 3-joint wrists) or 23 (neither; the same 29 slots).
+    #[arg(long, value_enum, default_value = "29")]
+    dof: Dof,
+    /// The mode_machine the robot reports and its LowCmds must carry (default: the variant's,
+    /// 5 for 29 joints, 4 for 23).
+    #[arg(long)]
+    mode_machine: Option<u8>,
+    /// Print the simulator's state every this many seconds (0: never).
+    #[arg(long, default_value_t = 1.0)]
+    report_every_s: f64,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Debug, Args)]
@@ -104,6 +146,7 @@ pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
         SimCommand::Spline(args) => run_spline(&args),
         SimCommand::Dog(args) => run_dog(&args),
         SimCommand::Go2(args) => run_go2(&args),
+        SimCommand::G1(args) => run_g1(&args),
     }
 }
 
@@ -255,6 +298,75 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Joint positions as a report shows them (`+0.00 -1.30 …`).
+fn joints(q_rad: &[f32]) -> String {
+    q_rad.iter().map(|q| format!("{q:+.2}")).collect::<Vec<_>>().join(" ")
+}
+
+/// The Go2 simulator's periodic report line.
+fn go2_report(s: &robowire_sim::go2::Go2Snapshot) -> String {
+    format!(
+        "sport mode {:?} | q {} | lowcmd accepted {} ignored {} bad CRC {} bad head {} | lowstate {} | requests {}",
+        s.sport_mode,
+        joints(&s.joints_rad),
+        s.lowcmd.accepted,
+        s.lowcmd.ignored_sport_mode,
+        s.lowcmd.bad_crc,
+        s.lowcmd.bad_head,
+        s.lowstate.samples,
+        s.requests
+    )
+}
+
+/// The G1 simulator's LowCmd counters as its report lines say them.
+fn g1_lowcmd(c: &robowire_sim::g1::G1LowCmdCounters) -> String {
+    format!(
+        "lowcmd accepted {} ignored {} bad CRC {} bad mode_machine {} disabled motors {}",
+        c.accepted, c.ignored_mode, c.bad_crc, c.bad_mode_machine, c.disabled_motors
+    )
+}
+
+/// The G1 simulator's periodic report line.
+fn g1_report(s: &robowire_sim::g1::G1Snapshot) -> String {
+    format!(
+        "mode {:?} fsm {} | q {} | {} | arm_sdk accepted {} weight {:.2} | lowstate {} | requests {}",
+        s.mode,
+        s.fsm_id,
+        joints(&s.joints_rad),
+        g1_lowcmd(&s.lowcmd),
+        s.arm_sdk.accepted,
+        s.arm_sdk.weight,
+        s.stream.lowstate.samples,
+        s.stream.requests
+    )
+}
+
+/// Runs a simulator that keeps a log until Ctrl-C: its log lines on stdout as they come (every
+/// 0.1 s), the line `report()` gives on stderr every `every_s` seconds (0: never), the last log
+/// lines once stopped.
+fn until_ctrl_c_with_log(
+    every_s: f64,
+    take_log: impl Fn() -> Vec<String>,
+    report: impl Fn() -> String,
+) -> anyhow::Result<()> {
+    let print_log = || {
+        for line in take_log() {
+            println!("{line}");
+        }
+    };
+    print_log();
+    let mut last_report = std::time::Instant::now();
+    until_ctrl_c(0.1, || {
+        print_log();
+        if every_s.is_finite() && every_s > 0.0 && last_report.elapsed().as_secs_f64() >= every_s {
+            last_report = std::time::Instant::now();
+            eprintln!("{}", report());
+        }
+    })?;
+    print_log();
+    Ok(())
+}
+
 fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::go2::{Go2Sim, Go2SimConfig};
     let recorder = args.record.start("robowire sim go2")?;
@@ -273,38 +385,60 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
          Try: robowire go2 --domain {} status. Ctrl-C stops.",
         args.dds.domain, args.dds.domain
     );
-    let print_log = |sim: &Go2Sim| {
-        for line in sim.take_log() {
-            println!("{line}");
-        }
-    };
-    print_log(&sim);
-    let every_s = args.report_every_s;
-    let mut last_report = std::time::Instant::now();
-    until_ctrl_c(0.1, || {
-        print_log(&sim);
-        if every_s.is_finite() && every_s > 0.0 && last_report.elapsed().as_secs_f64() >= every_s {
-            last_report = std::time::Instant::now();
-            let s = sim.snapshot();
-            let q: Vec<String> = s.joints_rad.iter().map(|q| format!("{q:+.2}")).collect();
-            eprintln!(
-                "sport mode {:?} | q {} | lowcmd accepted {} ignored {} bad CRC {} bad head {} | lowstate {} | requests {}",
-                s.sport_mode,
-                q.join(" "),
-                s.lowcmd.accepted,
-                s.lowcmd.ignored_sport_mode,
-                s.lowcmd.bad_crc,
-                s.lowcmd.bad_head,
-                s.lowstate.samples,
-                s.requests
-            );
-        }
-    })?;
-    print_log(&sim);
+    until_ctrl_c_with_log(args.report_every_s, || sim.take_log(), || go2_report(&sim.snapshot()))?;
     let s = sim.snapshot();
     println!(
         "lowcmd accepted {} ignored {} bad CRC {} bad head {}; final q {:?}",
         s.lowcmd.accepted, s.lowcmd.ignored_sport_mode, s.lowcmd.bad_crc, s.lowcmd.bad_head, s.joints_rad
+    );
+    drop(sim);
+    crate::cmd::record::finish(recorder)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
+    use lowcmd_proto::g1::G1Variant;
+    use robowire_sim::g1::{G1Sim, G1SimConfig};
+    let variant = args.dof.variant();
+    let dof = variant.joint_count();
+    let mode_machine = args.mode_machine.unwrap_or(variant.mode_machine());
+    match G1Variant::of_mode_machine(mode_machine) {
+        None => eprintln!(
+            "warning: mode_machine {mode_machine} is no G1 in Unitree's table (4: 23 joints, 5: 29 joints, …); \
+             clients that copy it from rt/lowstate still work"
+        ),
+        Some(named) if named != variant => {
+            eprintln!("warning: mode_machine {mode_machine} names a {named:?} G1, not the {dof}-joint one simulated")
+        }
+        Some(_) => {}
+    }
+    let recorder = args.record.start("robowire sim g1")?;
+    let config = G1SimConfig {
+        participant: args.dds.participant(),
+        mode_machine,
+        low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
+        services_tap: recorder.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_SERVER)),
+        ..G1SimConfig::new(variant)
+    };
+    let sim = G1Sim::spawn(config).context("starting the G1 simulator")?;
+    let interface = args.dds.interface.as_deref().unwrap_or("the default interface");
+    // The first line, alone, for scripts.
+    println!("g1 domain {} {interface} dof {dof} mode_machine {mode_machine}", args.dds.domain);
+    eprintln!(
+        "G1 simulator ({dof} joints) on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, rt/arm_sdk, \
+         motion_switcher, sport (loco) and arm. Ctrl-C stops.",
+        args.dds.domain
+    );
+    until_ctrl_c_with_log(args.report_every_s, || sim.take_log(), || g1_report(&sim.snapshot()))?;
+    let s = sim.snapshot();
+    println!(
+        "{}; arm_sdk accepted {} ignored {} unsealed {} weight {:.2}; final q {:?}",
+        g1_lowcmd(&s.lowcmd),
+        s.arm_sdk.accepted,
+        s.arm_sdk.ignored_released,
+        s.arm_sdk.unsealed,
+        s.arm_sdk.weight,
+        s.joints_rad
     );
     drop(sim);
     crate::cmd::record::finish(recorder)?;

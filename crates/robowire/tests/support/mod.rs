@@ -6,6 +6,39 @@
 use std::io::{BufRead, BufReader, Read};
 use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
 
+/// Runs `test` with the peers' Python and the directory `examples` gives (one of
+/// `robowire_fixtures::peers`' Unitree example directories), in a network namespace where
+/// loopback carries multicast; skipped with one line, or failed under `ROBOWIRE_INTEROP=1`, when
+/// they are missing (`robowire_fixtures::interop::require`).
+pub(crate) fn with_unitree_examples(
+    examples: fn() -> Result<std::path::PathBuf, String>,
+    test: impl FnOnce(&std::path::Path, &std::path::Path) + Send,
+) {
+    let Some(python) = robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python()) else {
+        return;
+    };
+    let examples = examples().unwrap();
+    robowire_dds::netns::with_loopback_multicast(|| test(&python, &examples));
+}
+
+/// Unitree's Python example `name` in `dir` with `python`, its Enter prompt answered, on `lo`
+/// (domain 0); stdout and stderr piped.
+pub(crate) fn start_example(python: &std::path::Path, dir: &std::path::Path, name: &str) -> Child {
+    use std::io::Write;
+    let mut example = Command::new(python)
+        .arg(name)
+        .arg("lo")
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // "Press Enter to continue..."
+    example.stdin.take().unwrap().write_all(b"\n").unwrap();
+    example
+}
+
 /// The `robowire` binary under test.
 pub(crate) fn robowire() -> Command {
     Command::new(env!("CARGO_BIN_EXE_robowire"))

@@ -1,0 +1,455 @@
+//! The G1's body without I/O: 29 joint slots on the shared PD joint model (each joint with its
+//! torque and range from [`lowcmd_proto::g1::JOINT_LIMITS`]), the robot's own controller
+//! holding the stand pose with `rt/arm_sdk` blended in, `rt/lowcmd` once released, and the HG
+//! `LowState` it reports.
+
+use lowcmd_proto::g1::{
+    self, ARM_SDK_JOINTS, ARM_SDK_WEIGHT_RATE_PER_S, G1Variant, Gains, ModePr, PARALLEL_PAIRS, ab_to_pr, pr_to_ab, slot,
+};
+use lowcmd_proto::{HgLowCmd, HgLowState, HgMotorCmd};
+
+use crate::joints::{JointStops, Joints, PdTarget};
+use crate::unitree::COMMAND_HOLD_S;
+
+/// Joint slots of the G1 (0..29).
+pub const JOINTS: usize = g1::JOINTS;
+
+/// The pose the robot's controller holds: unitree_rl_gym's G1 default angles (per leg hip pitch
+/// −0.1, knee 0.3, ankle pitch −0.2 rad; every other joint 0), by slot.
+pub const STAND_POSE_RAD: [f32; JOINTS] = {
+    let mut pose = [0.0; JOINTS];
+    let mut leg = 0;
+    while leg < 2 {
+        pose[6 * leg] = -0.1;
+        pose[6 * leg + 3] = 0.3;
+        pose[6 * leg + 4] = -0.2;
+        leg += 1;
+    }
+    pose
+};
+
+const fn gains(kp: f32, kd: f32) -> Gains {
+    Gains { kp, kd }
+}
+
+/// The gains the robot's controller holds its pose with, by slot: unitree_rl_gym's G1 deploy
+/// gains (legs 100/100/100/150/40/40, kd 2/2/2/4/2/2; waist 300, kd 3; per arm
+/// 100/100/50/50/20/20/20, kd 2/2/2/2/1/1/1). robowire's choice: the robot's own are not public.
+pub const CONTROLLER_GAINS: [Gains; JOINTS] = {
+    const LEG: [Gains; 6] = [
+        gains(100.0, 2.0),
+        gains(100.0, 2.0),
+        gains(100.0, 2.0),
+        gains(150.0, 4.0),
+        gains(40.0, 2.0),
+        gains(40.0, 2.0),
+    ];
+    const ARM: [Gains; 7] = [
+        gains(100.0, 2.0),
+        gains(100.0, 2.0),
+        gains(50.0, 2.0),
+        gains(50.0, 2.0),
+        gains(20.0, 1.0),
+        gains(20.0, 1.0),
+        gains(20.0, 1.0),
+    ];
+    let mut all = [gains(300.0, 3.0); JOINTS];
+    let mut i = 0;
+    while i < 6 {
+        all[i] = LEG[i];
+        all[6 + i] = LEG[i];
+        i += 1;
+    }
+    let mut i = 0;
+    while i < 7 {
+        all[15 + i] = ARM[i];
+        all[22 + i] = ARM[i];
+        i += 1;
+    }
+    all
+};
+
+/// The motors' supply voltage the state reports, V (robowire's choice: a constant).
+pub const SUPPLY_V: f32 = 48.0;
+
+/// The joints' stops: each joint's torque and range.
+const STOPS: [JointStops; JOINTS] = {
+    let mut stops = [JointStops { tau_max_nm: 0.0, q_min_rad: 0.0, q_max_rad: 0.0 }; JOINTS];
+    let mut j = 0;
+    while j < JOINTS {
+        let l = &g1::JOINT_LIMITS[j];
+        stops[j] = JointStops { tau_max_nm: l.tau_max, q_min_rad: l.q_min, q_max_rad: l.q_max };
+        j += 1;
+    }
+    stops
+};
+
+/// The body.
+#[derive(Debug, Clone)]
+pub struct G1Body {
+    variant: G1Variant,
+    mode_machine: u8,
+    joints: Joints<JOINTS>,
+    /// The robot's controller owns the motors.
+    controller: bool,
+    lowcmd: Option<HgLowCmd>,
+    lowcmd_age_s: f32,
+    /// How the last applied LowCmd addressed the parallel joints (what the state echoes).
+    mode_pr: ModePr,
+    arm_sdk: Option<HgLowCmd>,
+    arm_sdk_age_s: f32,
+    /// The weight `rt/arm_sdk` is blended in with, 0..=1.
+    arm_weight: f32,
+    /// Motors that failed: they report mode 0 and produce no torque.
+    faulted: [bool; JOINTS],
+    tick_ms: u32,
+}
+
+/// Whether a motor command sets any target, gain or torque.
+fn commands_something(m: &HgMotorCmd) -> bool {
+    [m.q, m.dq, m.tau, m.kp, m.kd].iter().any(|v| v.get() != 0.0)
+}
+
+/// Whether `cmd` has a motor that `variant` drives with `mode` 0 and a target, gain or torque
+/// set: that motor exerts no torque, whatever the frame asks of it.
+pub fn has_disabled_motor(cmd: &HgLowCmd, variant: G1Variant) -> bool {
+    cmd.motor_cmd.iter().enumerate().any(|(slot, m)| variant.drives(slot) && m.mode == 0 && commands_something(m))
+}
+
+/// `values` by slot with each parallel pair's A/B motors (roll slot A, pitch slot B) mapped
+/// to pitch and roll.
+fn ab_values_to_pr(mut values: [f32; JOINTS]) -> [f32; JOINTS] {
+    for (pitch, roll) in PARALLEL_PAIRS {
+        (values[pitch], values[roll]) = ab_to_pr(values[roll], values[pitch]);
+    }
+    values
+}
+
+impl G1Body {
+    /// Standing at [`STAND_POSE_RAD`] (the slots `variant` does not drive at 0), at rest, held
+    /// by the robot's controller; the state says `mode_machine`.
+    pub fn new(variant: G1Variant, mode_machine: u8) -> Self {
+        let pose = core::array::from_fn(|s| if variant.drives(s) { STAND_POSE_RAD[s] } else { 0.0 });
+        Self {
+            variant,
+            mode_machine,
+            joints: Joints::at(pose, STOPS),
+            controller: true,
+            lowcmd: None,
+            lowcmd_age_s: 0.0,
+            mode_pr: ModePr::Pr,
+            arm_sdk: None,
+            arm_sdk_age_s: 0.0,
+            arm_weight: 0.0,
+            faulted: [false; JOINTS],
+            tick_ms: 0,
+        }
+    }
+
+    /// Which G1 this is.
+    pub fn variant(&self) -> G1Variant {
+        self.variant
+    }
+
+    /// The robot's controller takes the motors (`true`: a mode was selected; the last LowCmd is
+    /// forgotten) or lets them go (`false`: released; `rt/arm_sdk` is forgotten, its weight 0).
+    pub fn set_controller(&mut self, owns: bool) {
+        if owns && !self.controller {
+            self.lowcmd = None;
+            self.mode_pr = ModePr::Pr;
+        }
+        if !owns {
+            self.arm_sdk = None;
+            self.arm_weight = 0.0;
+        }
+        self.controller = owns;
+    }
+
+    /// Whether the robot's controller owns the motors.
+    pub fn controller_owns(&self) -> bool {
+        self.controller
+    }
+
+    /// A `rt/lowcmd` LowCmd the robot accepted (its `mode_machine` checked): the motors with
+    /// `mode` 1 follow it until it is [`COMMAND_HOLD_S`] old. Ignored while the controller owns
+    /// the motors.
+    pub fn command(&mut self, command: &HgLowCmd) {
+        if self.controller {
+            return;
+        }
+        self.lowcmd = Some(*command);
+        self.lowcmd_age_s = 0.0;
+        self.mode_pr = ModePr::from_byte(command.mode_pr).unwrap_or_default();
+    }
+
+    /// A `rt/arm_sdk` frame: while the controller owns the motors, the arm and waist joints
+    /// follow `(1 − w)·controller + w·frame` (targets and gains), `w` its slot 29's `q` clamped
+    /// to 0..=1. A frame older than [`COMMAND_HOLD_S`] still holds its targets while `w` decays
+    /// to 0 at [`ARM_SDK_WEIGHT_RATE_PER_S`]: the controller takes the arms back, never at a
+    /// jump. Ignored once released.
+    pub fn arm_sdk(&mut self, command: &HgLowCmd) {
+        if !self.controller {
+            return;
+        }
+        let w = command.motor_cmd[slot::ARM_SDK_WEIGHT].q.get();
+        self.arm_weight = if w.is_nan() { 0.0 } else { w.clamp(0.0, 1.0) };
+        self.arm_sdk = Some(*command);
+        self.arm_sdk_age_s = 0.0;
+    }
+
+    /// The weight `rt/arm_sdk` is blended in with now, 0..=1.
+    pub fn arm_sdk_weight(&self) -> f32 {
+        self.arm_weight
+    }
+
+    /// Fault: motor `motor` fails (or recovers).
+    pub fn set_motor_fault(&mut self, motor: usize, faulted: bool) {
+        if let Some(f) = self.faulted.get_mut(motor) {
+            *f = faulted;
+        }
+    }
+
+    /// Joint positions, rad, by slot (pitch and roll for the parallel joints).
+    pub fn joint_positions(&self) -> [f32; JOINTS] {
+        self.joints.q_rad
+    }
+
+    /// Advances the `tick` counter by `ms` (the state stream: its period per slot, skipped slots
+    /// included).
+    pub fn advance_tick(&mut self, ms: u32) {
+        self.tick_ms = self.tick_ms.wrapping_add(ms);
+    }
+
+    /// What the controller commands slot `slot`, `rt/arm_sdk` blended in.
+    fn controller_target(&self, slot: usize) -> PdTarget {
+        let own = CONTROLLER_GAINS[slot];
+        let target = PdTarget { q_rad: STAND_POSE_RAD[slot], kp: own.kp, kd: own.kd, ..PdTarget::default() };
+        let w = self.arm_weight;
+        match &self.arm_sdk {
+            Some(arm) if w > 0.0 && ARM_SDK_JOINTS.contains(&slot) => {
+                let m = &arm.motor_cmd[slot];
+                let blend = |own: f32, arm: f32| (1.0 - w) * own + w * arm;
+                PdTarget {
+                    q_rad: blend(target.q_rad, m.q.get()),
+                    qd_radps: w * m.dq.get(),
+                    kp: blend(target.kp, m.kp.get()),
+                    kd: blend(target.kd, m.kd.get()),
+                    tau_ff_nm: w * m.tau.get(),
+                }
+            }
+            _ => target,
+        }
+    }
+
+    /// What each slot is commanded now.
+    fn targets(&self) -> [PdTarget; JOINTS] {
+        let lowcmd = self.lowcmd.as_ref().filter(|_| !self.controller && self.lowcmd_age_s <= COMMAND_HOLD_S);
+        let (q, dq) = match lowcmd {
+            Some(cmd) => (
+                g1::joint_targets(cmd),
+                match self.mode_pr {
+                    ModePr::Ab => ab_values_to_pr(core::array::from_fn(|s| cmd.motor_cmd[s].dq.get())),
+                    ModePr::Pr => core::array::from_fn(|s| cmd.motor_cmd[s].dq.get()),
+                },
+            ),
+            None => ([0.0; JOINTS], [0.0; JOINTS]),
+        };
+        core::array::from_fn(|slot| {
+            if !self.variant.drives(slot) || self.faulted[slot] {
+                return PdTarget::default();
+            }
+            if self.controller {
+                return self.controller_target(slot);
+            }
+            match lowcmd.map(|cmd| &cmd.motor_cmd[slot]) {
+                Some(m) if m.mode == 1 => PdTarget {
+                    q_rad: q[slot],
+                    qd_radps: dq[slot],
+                    kp: m.kp.get(),
+                    kd: m.kd.get(),
+                    tau_ff_nm: m.tau.get(),
+                },
+                // Disabled (mode 0), stale or no command: passive.
+                _ => PdTarget::default(),
+            }
+        })
+    }
+
+    /// Advances the body by `dt_s` seconds.
+    pub fn step(&mut self, dt_s: f32) {
+        self.lowcmd_age_s += dt_s;
+        self.arm_sdk_age_s += dt_s;
+        if self.arm_sdk_age_s > COMMAND_HOLD_S {
+            self.arm_weight = (self.arm_weight - ARM_SDK_WEIGHT_RATE_PER_S * dt_s).max(0.0);
+        }
+        let targets = self.targets();
+        self.joints.step(dt_s, |j| targets[j]);
+    }
+
+    /// The state the robot reports now (the CRC is written by the encoder). In AB mode (the
+    /// last applied LowCmd's `mode_pr`) the parallel pairs are reported as their A and B motors
+    /// ([`pr_to_ab`]: roll slot A, pitch slot B), as they are commanded.
+    pub fn low_state(&self) -> HgLowState {
+        let mut state = HgLowState::default();
+        state.mode_pr = self.mode_pr as u8;
+        state.mode_machine = self.mode_machine;
+        state.tick = self.tick_ms.into();
+        state.imu_state.quaternion = [1.0, 0.0, 0.0, 0.0].map(Into::into);
+        state.imu_state.accelerometer = [0.0, 0.0, 9.81].map(Into::into);
+        state.imu_state.temperature = 40.into();
+        let (mut q, mut dq, mut tau) = (self.joints.q_rad, self.joints.qd_radps, self.joints.tau_nm);
+        if self.mode_pr == ModePr::Ab {
+            for (pitch, roll) in PARALLEL_PAIRS {
+                for v in [&mut q, &mut dq, &mut tau] {
+                    let (a, b) = pr_to_ab(v[pitch], v[roll]);
+                    (v[roll], v[pitch]) = (a, b);
+                }
+            }
+        }
+        for slot in (0..JOINTS).filter(|&s| self.variant.drives(s)) {
+            let s = &mut state.motor_state[slot];
+            let load = self.joints.tau_nm[slot].abs();
+            s.mode = u8::from(!self.faulted[slot]);
+            s.q = q[slot].into();
+            s.dq = dq[slot].into();
+            s.tau_est = tau[slot].into();
+            s.temperature = [30 + (load / 3.0) as i16, 35 + (load / 2.0) as i16].map(Into::into);
+            s.vol = SUPPLY_V.into();
+            // robowire's choice: bit 0 on a failed motor (the bits' meanings are not public).
+            s.motorstate = u32::from(self.faulted[slot]).into();
+        }
+        state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lowcmd_proto::HgMotorCmd;
+
+    fn hold(q: &[f32; JOINTS], variant: G1Variant) -> HgLowCmd {
+        g1::hold(q, variant.mode_machine(), variant)
+    }
+
+    /// `seconds` of 2 ms steps, `each` called before every step.
+    fn run(body: &mut G1Body, seconds: f32, mut each: impl FnMut(&mut G1Body, f32)) {
+        let steps = (seconds * 500.0).round() as u32;
+        for i in 0..steps {
+            each(body, i as f32 * 0.002);
+            body.step(0.002);
+            body.advance_tick(2);
+        }
+    }
+
+    fn near(a: f32, b: f32, tolerance: f32) -> bool {
+        (a - b).abs() < tolerance
+    }
+
+    #[test]
+    fn it_stands_under_its_controller_and_ignores_lowcmds_until_released() {
+        let mut body = G1Body::new(G1Variant::Dof29, 5);
+        run(&mut body, 1.0, |b, _| b.command(&hold(&[0.0; JOINTS], G1Variant::Dof29)));
+        assert_eq!(body.joint_positions(), STAND_POSE_RAD, "held where it stands");
+        let state = body.low_state();
+        assert_eq!((state.mode_machine, state.mode_pr, state.tick.get()), (5, 0, 1000));
+        assert!(state.motor_state[..JOINTS].iter().all(|m| m.mode == 1 && m.vol.get() == SUPPLY_V));
+        body.set_controller(false);
+        run(&mut body, 1.0, |b, _| b.command(&hold(&[0.0; JOINTS], G1Variant::Dof29)));
+        assert!(body.joint_positions().iter().all(|q| q.abs() < 0.01), "{:?}", body.joint_positions());
+    }
+
+    #[test]
+    fn a_stale_or_disabled_command_leaves_the_motors_passive() {
+        let mut body = G1Body::new(G1Variant::Dof29, 5);
+        body.set_controller(false);
+        let mut cmd = hold(&[0.0; JOINTS], G1Variant::Dof29);
+        cmd.motor_cmd[slot::LEFT_KNEE].mode = 0;
+        assert!(has_disabled_motor(&cmd, G1Variant::Dof29));
+        run(&mut body, 1.0, |b, _| b.command(&cmd));
+        let q = body.joint_positions();
+        assert!(near(q[slot::LEFT_KNEE], 0.3, 1e-6), "mode 0: no torque, the knee stays: {q:?}");
+        assert!(near(q[slot::RIGHT_KNEE], 0.0, 0.01), "mode 1 motors of the frame are applied: {q:?}");
+        // No command for longer than the hold: passive, no torque.
+        run(&mut body, 0.2, |_, _| {});
+        assert!(body.low_state().motor_state[..JOINTS].iter().all(|m| m.tau_est.get() == 0.0));
+    }
+
+    #[test]
+    fn pr_and_ab_both_move_the_ankle_and_the_state_reports_the_mode() {
+        let variant = G1Variant::Dof29;
+        let mut body = G1Body::new(variant, 5);
+        body.set_controller(false);
+        let mut target = [0.0; JOINTS];
+        (target[slot::LEFT_ANKLE_PITCH], target[slot::LEFT_ANKLE_ROLL]) = (0.3, 0.1);
+        let pr = hold(&target, variant);
+        run(&mut body, 1.0, |b, _| b.command(&pr));
+        let q = body.joint_positions();
+        assert!(near(q[4], 0.3, 0.01) && near(q[5], 0.1, 0.01), "{q:?}");
+        // The same pose as A and B motors; the state then says A and B too.
+        let mut ab = hold(&[0.0; JOINTS], variant);
+        ab.mode_pr = ModePr::Ab as u8;
+        let (a, b) = pr_to_ab(-0.2, 0.15);
+        (ab.motor_cmd[slot::LEFT_ANKLE_ROLL].q, ab.motor_cmd[slot::LEFT_ANKLE_PITCH].q) = (a.into(), b.into());
+        run(&mut body, 1.0, |body, _| body.command(&ab));
+        let q = body.joint_positions();
+        assert!(near(q[4], -0.2, 0.01) && near(q[5], 0.15, 0.01), "pitch and roll: {q:?}");
+        let state = body.low_state();
+        assert_eq!(state.mode_pr, ModePr::Ab as u8);
+        assert!(near(state.motor_state[5].q.get(), a, 0.02) && near(state.motor_state[4].q.get(), b, 0.02));
+    }
+
+    #[test]
+    fn joints_stop_at_their_range_and_undriven_slots_do_nothing() {
+        let variant = G1Variant::Dof23;
+        let mut body = G1Body::new(variant, 4);
+        body.set_controller(false);
+        let mut cmd = hold(&[0.0; JOINTS], variant);
+        cmd.motor_cmd[slot::LEFT_ANKLE_ROLL].q = 1.0.into();
+        cmd.motor_cmd[20] = HgMotorCmd::servo(1.0, 0.0, 40.0, 1.0, 0.0);
+        run(&mut body, 1.0, |b, _| b.command(&cmd));
+        let q = body.joint_positions();
+        assert_eq!(q[slot::LEFT_ANKLE_ROLL], g1::JOINT_LIMITS[5].q_max, "at its stop");
+        assert_eq!(q[20], 0.0, "the 23-dof G1 has no wrist pitch");
+        let state = body.low_state();
+        assert_eq!((state.motor_state[20].mode, state.motor_state[20].q.get()), (0, 0.0));
+        body.set_motor_fault(3, true);
+        let state = body.low_state();
+        assert_eq!((state.motor_state[3].mode, state.motor_state[3].motorstate.get()), (0, 1));
+    }
+
+    #[test]
+    fn arm_sdk_blends_by_its_weight_and_a_silent_arm_sdk_fades_out() {
+        let variant = G1Variant::Dof29;
+        let mut body = G1Body::new(variant, 5);
+        let mut arm = HgLowCmd::default();
+        for &j in &ARM_SDK_JOINTS {
+            arm.motor_cmd[j].kp = 60.0.into();
+            arm.motor_cmd[j].kd = 1.5.into();
+        }
+        arm.motor_cmd[slot::LEFT_ELBOW].q = 1.0.into();
+        arm.motor_cmd[slot::LEFT_KNEE].q = 1.0.into(); // not an arm_sdk joint
+        arm.motor_cmd[slot::ARM_SDK_WEIGHT].q = 0.5.into();
+        run(&mut body, 2.0, |b, _| b.arm_sdk(&arm));
+        let q = body.joint_positions();
+        // Elbow: kp (0.5·50 + 0.5·60) toward 0.5·0 + 0.5·1.0.
+        assert!(near(q[slot::LEFT_ELBOW], 0.5, 0.01), "{q:?}");
+        assert!(near(q[slot::LEFT_KNEE], 0.3, 1e-3), "the legs stay the controller's: {q:?}");
+        arm.motor_cmd[slot::ARM_SDK_WEIGHT].q = 2.0.into();
+        run(&mut body, 2.0, |b, _| b.arm_sdk(&arm));
+        assert_eq!(body.arm_sdk_weight(), 1.0, "clamped");
+        assert!(near(body.joint_positions()[slot::LEFT_ELBOW], 1.0, 0.01));
+        // Silent: after the hold the weight decays at its rate, never a jump.
+        let mut last = body.arm_sdk_weight();
+        run(&mut body, 3.0, |b, _| {
+            let w = b.arm_sdk_weight();
+            assert!(last - w <= ARM_SDK_WEIGHT_RATE_PER_S * 0.002 + 1e-6, "{last} → {w}");
+            last = w;
+        });
+        assert_eq!(body.arm_sdk_weight(), 0.0);
+        assert!(near(body.joint_positions()[slot::LEFT_ELBOW], 0.0, 0.01), "back to the controller's pose");
+        // Released: arm_sdk does nothing.
+        body.set_controller(false);
+        body.arm_sdk(&arm);
+        assert_eq!(body.arm_sdk_weight(), 0.0);
+    }
+}

@@ -1,0 +1,306 @@
+//! What the simulated Unitree robots (the Go2, the G1) share: the handle's skeleton (a state
+//! stream on robowire's runner, a services thread with its own tokio runtime, the handle's
+//! requests to the stream, the log), the state stream itself with its wire faults, and the
+//! services' server with `motion_switcher`. Each robot brings its body ([`StreamBody`]), its
+//! inbox (what its services thread hands its stream) and its services' answers.
+
+mod services;
+mod stream;
+
+use std::future::Future;
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use robowire_core::schedule::Periodic;
+use robowire_core::timing::LatenessSummary;
+use robowire_dds::qos::Qos;
+use robowire_dds::{DdsError, Participant, ParticipantOptions, Reader, StatsHandle, TopicStats};
+use robowire_rt::runner::{Runner, RunnerOptions, Waker};
+use robowire_rt::stats::Counter;
+use robowire_rt::{Latest, lock};
+use robowire_tap::Tap;
+use tokio::sync::watch;
+
+pub(crate) use services::{CommandInbox, Owner, ServiceServer, serve, service_server};
+pub(crate) use stream::{FlipSite, StreamBody, forward_to_body};
+
+use crate::handover::{Requests, StreamStats};
+use stream::{BitFlipped, StateStream};
+
+/// Without a command for this long the motors go passive (kp = kd = 0), s.
+pub const COMMAND_HOLD_S: f32 = 0.1;
+
+/// Faults to inject.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// `rt/lowstate` stops.
+    Silence,
+    /// Motor `motor` fails: it reports mode 0, exerts no torque (and on the Go2 counts lost
+    /// frames).
+    MotorFault {
+        /// Motor slot (0..12 on the Go2, 0..29 on the G1).
+        motor: usize,
+    },
+    /// Every `every`-th LowState goes out with one bit flipped after its CRC was computed.
+    BitFlips {
+        /// Period in samples (at least 1).
+        every: u32,
+    },
+}
+
+/// What a simulated Unitree robot counts of its state stream and its services.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamCounters {
+    /// The `rt/lowstate` writer's counters.
+    pub lowstate: TopicStats,
+    /// LowStates sent with a flipped bit.
+    pub corrupted_states: u64,
+    /// Service requests answered.
+    pub requests: u64,
+    /// Lateness of the state stream against its absolute deadlines, µs.
+    pub state_lateness: LatenessSummary,
+}
+
+/// Why the simulator could not start.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// DDS.
+    #[error(transparent)]
+    Dds(#[from] DdsError),
+    /// The state stream's thread.
+    #[error(transparent)]
+    Thread(#[from] robowire_rt::RtError),
+    /// The services' thread.
+    #[error("cannot start the services' thread: {0}")]
+    Services(#[source] std::io::Error),
+}
+
+/// What the user is told: the mode owning the motors and the log. Written by the services
+/// thread when a mode changes and by the handle; never by the state stream.
+#[derive(Debug)]
+pub(crate) struct Report {
+    /// The `motion_switcher` mode owning the motors; empty once released.
+    pub(crate) mode: String,
+    log: Vec<String>,
+}
+
+impl Report {
+    /// Booted with `mode` owning the motors, the log's first line `booted`.
+    pub(crate) fn booted(mode: &str, booted: String) -> Self {
+        Self { mode: mode.into(), log: vec![booted] }
+    }
+
+    pub(crate) fn say(&mut self, line: impl Into<String>) {
+        self.log.push(line.into());
+    }
+}
+
+/// What the state stream shares with the services thread and the handle, none of it a lock the
+/// stream takes.
+#[derive(Debug)]
+pub(crate) struct Handover<B: StreamBody> {
+    requests: Requests<Request>,
+    /// What the services thread hands the stream, and its counters.
+    pub(crate) inbox: B::Inbox,
+    /// The state the stream sent last.
+    pub(crate) state: Latest<B::State>,
+    /// What the handle reads of the body, as the stream last stepped it.
+    pub(crate) published: Latest<B::Published>,
+    pub(crate) stream: StreamStats<4096>,
+    pub(crate) corrupted: Counter,
+    /// Service requests answered (the services thread).
+    pub(crate) requests_answered: Counter,
+}
+
+/// What the handle asks of the state stream.
+#[derive(Debug, Clone, Copy)]
+enum Request {
+    Inject(Fault),
+    ClearFaults,
+}
+
+/// Requests the stream has not taken yet (the handle waits for each).
+const REQUESTS: usize = 16;
+
+/// How a robot's stream runs.
+#[derive(Debug)]
+pub(crate) struct StreamOptions {
+    /// `rt/lowstate` period.
+    pub(crate) period: Duration,
+    /// Pin the stream to this CPU.
+    pub(crate) cpu: Option<usize>,
+    /// Where each `rt/lowstate` written goes.
+    pub(crate) tap: Option<Tap>,
+    /// The threads' names start with this (`"go2-sim"`).
+    pub(crate) name: &'static str,
+}
+
+/// Joins the domain.
+pub(crate) fn join(options: &ParticipantOptions) -> Result<Arc<Participant>, SimError> {
+    Ok(Arc::new(Participant::new(options.clone())?))
+}
+
+/// A reader of the commands on `topic`, each taken recorded into `tap`, and its counters.
+pub(crate) fn command_reader<T: robowire_core::cdr::CdrType + Send + 'static>(
+    participant: &Participant,
+    topic: &str,
+    tap: &Option<Tap>,
+) -> Result<(Reader<T>, StatsHandle), DdsError> {
+    let mut reader = participant.reader::<T>(topic, Qos::READER)?;
+    reader.set_tap(tap.clone());
+    let stats = reader.stats_handle();
+    Ok((reader, stats))
+}
+
+/// The handle's methods every simulated Unitree robot has (`inject`, `clear_faults`,
+/// `take_log`), for a handle whose field `sim` is a [`Sim`].
+macro_rules! handle_methods {
+    ($fault:ty) => {
+        /// Injects a fault; in force when this returns.
+        pub fn inject(&self, fault: $fault) {
+            self.sim.inject(fault);
+        }
+
+        /// Clears every fault.
+        pub fn clear_faults(&self) {
+            self.sim.clear_faults();
+        }
+
+        /// The log lines since the last call (what the robot did that a user should know).
+        pub fn take_log(&self) -> Vec<String> {
+            self.sim.take_log()
+        }
+    };
+}
+pub(crate) use handle_methods;
+
+/// A running simulated robot's threads and what they share; stopped on drop.
+pub(crate) struct Sim<B: StreamBody> {
+    pub(crate) handover: Arc<Handover<B>>,
+    pub(crate) report: Arc<Mutex<Report>>,
+    lowstate: StatsHandle,
+    stream: Option<Runner<StateStream<B>>>,
+    waker: Waker,
+    stop: watch::Sender<bool>,
+    services: Option<JoinHandle<()>>,
+    _participant: Arc<Participant>,
+}
+
+impl<B: StreamBody> std::fmt::Debug for Sim<B> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Sim").field("mode", &lock(&self.report).mode).finish_non_exhaustive()
+    }
+}
+
+impl<B: StreamBody> Sim<B> {
+    /// Starts the state stream of `body` on `participant`, then the services thread, which
+    /// runs the future `services` makes (given the handover and the report) until the handle
+    /// is dropped.
+    pub(crate) fn spawn<F, Fut>(
+        participant: Arc<Participant>,
+        options: StreamOptions,
+        body: B,
+        inbox: B::Inbox,
+        report: Report,
+        services: impl FnOnce(Arc<Handover<B>>, Arc<Mutex<Report>>) -> F,
+    ) -> Result<Self, SimError>
+    where
+        F: FnOnce() -> Fut + Send + 'static,
+        Fut: Future<Output = ()>,
+    {
+        let handover = Arc::new(Handover {
+            requests: Requests::new(REQUESTS),
+            inbox,
+            state: Latest::new(),
+            published: Latest::new(),
+            stream: StreamStats::default(),
+            corrupted: Counter::default(),
+            requests_answered: Counter::default(),
+        });
+        handover.published.write(robowire_rt::now(), &body.published());
+        let report = Arc::new(Mutex::new(report));
+        // The stream's writers never wait: a full send window is a dropped sample, counted.
+        let mut writer =
+            participant.writer::<B::State>(<B::State as lowcmd_proto::Message>::TOPIC, Qos::STREAM_WRITER)?;
+        let mut corrupt =
+            participant.writer::<BitFlipped<B>>(<B::State as lowcmd_proto::Message>::TOPIC, Qos::STREAM_WRITER)?;
+        writer.set_tap(options.tap.clone());
+        corrupt.set_tap(options.tap);
+        let lowstate = writer.stats_handle();
+        let job = StateStream::new(
+            body,
+            handover.clone(),
+            writer,
+            corrupt,
+            Periodic::new(robowire_rt::now(), options.period),
+        );
+        let placement = robowire_rt::Placement { cpu: options.cpu, ..Default::default() };
+        let stream = Runner::spawn(RunnerOptions::placed(format!("{}-state", options.name), placement), job)?;
+        let (stop, stop_rx) = watch::channel(false);
+        let tasks = services(handover.clone(), report.clone());
+        let services = services::spawn(format!("{}-services", options.name), report.clone(), stop_rx, tasks)
+            .map_err(SimError::Services)?;
+        Ok(Self {
+            handover,
+            report,
+            lowstate,
+            waker: stream.waker(),
+            stream: Some(stream),
+            stop,
+            services: Some(services),
+            _participant: participant,
+        })
+    }
+
+    /// Injects a fault; in force when this returns.
+    pub(crate) fn inject(&self, fault: Fault) {
+        self.handover.requests.call(Request::Inject(fault), || self.waker.wake());
+        lock(&self.report).say(format!("fault injected: {fault:?}"));
+    }
+
+    /// Clears every fault.
+    pub(crate) fn clear_faults(&self) {
+        self.handover.requests.call(Request::ClearFaults, || self.waker.wake());
+        lock(&self.report).say("faults cleared");
+    }
+
+    /// The log lines since the last call.
+    pub(crate) fn take_log(&self) -> Vec<String> {
+        std::mem::take(&mut lock(&self.report).log)
+    }
+
+    /// The stream's and the services' counts now.
+    pub(crate) fn counters(&self) -> StreamCounters {
+        let h = &self.handover;
+        StreamCounters {
+            lowstate: self.lowstate.get(),
+            corrupted_states: h.corrupted.get(),
+            requests: h.requests_answered.get(),
+            state_lateness: h.stream.summary().lateness,
+        }
+    }
+
+    /// The mode owning the motors; empty once released.
+    pub(crate) fn mode(&self) -> String {
+        lock(&self.report).mode.clone()
+    }
+
+    /// What the stream last published of the body (published once before the stream starts).
+    pub(crate) fn published(&self) -> Option<B::Published> {
+        self.handover.published.read().map(|(_, p)| p)
+    }
+}
+
+impl<B: StreamBody> Drop for Sim<B> {
+    fn drop(&mut self) {
+        if let Some(stream) = self.stream.take() {
+            stream.stop();
+        }
+        let _ = self.stop.send(true);
+        if let Some(services) = self.services.take() {
+            let _ = services.join();
+        }
+    }
+}
