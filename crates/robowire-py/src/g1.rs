@@ -29,7 +29,7 @@ const VARIANTS: [(&str, u8, G1Variant); 4] = [
 ];
 
 /// The Python name of `variant`.
-fn variant_name(variant: G1Variant) -> &'static str {
+pub(crate) fn variant_name(variant: G1Variant) -> &'static str {
     VARIANTS.iter().find(|(_, _, v)| *v == variant).map_or("29dof", |(name, _, _)| name)
 }
 
@@ -39,6 +39,15 @@ fn variant_named(name: &str) -> PyResult<G1Variant> {
         let names: Vec<_> = VARIANTS.iter().map(|(n, _, _)| format!("{n:?}")).collect();
         error(Kind::Argument, format!("variant = {name:?}: one of {}", names.join(", ")))
     })
+}
+
+/// The variant with `dof` joints, or `ArgumentError`.
+pub(crate) fn variant_of_dof(dof: u8) -> PyResult<G1Variant> {
+    VARIANTS
+        .iter()
+        .find(|(_, d, _)| *d == dof)
+        .map(|(_, _, v)| *v)
+        .ok_or_else(|| error(Kind::Argument, format!("dof = {dof}: 29, 27 (waist locked), 23 or 14 (dual arm)")))
 }
 
 /// A `G1Error` as the exception a Python user expects: a refused command or argument
@@ -71,6 +80,43 @@ fn blocking<T: Send>(py: Python<'_>, call: impl Future<Output = Result<T, G1Erro
         Some(outcome) => outcome.map_err(raise),
         None => Err(error(Kind::Timeout, "the call did not end")),
     }
+}
+
+/// Runs `call` on the client's service that `service` picks (a clone: the client's lock is not
+/// held while it waits), with the GIL released.
+fn service_call<S: Clone, T: Send, F>(
+    py: Python<'_>,
+    shared: &Shared,
+    service: impl FnOnce(&G1) -> &S,
+    call: impl FnOnce(S) -> F,
+) -> PyResult<T>
+where
+    F: Future<Output = Result<T, G1Error>> + Send,
+{
+    let robot = client(shared)?;
+    let service = service(&robot).clone();
+    blocking(py, call(service))
+}
+
+/// `#[pyclass] struct $class` (a service of the client, `$pick` picks it: the facade's
+/// `$service`) and its `call`: runs a call on the service with the GIL released.
+macro_rules! service_class {
+    ($(#[$doc:meta])* $class:ident, $service:ty, $pick:path) => {
+        $(#[$doc])*
+        #[pyclass(module = "robowire.g1", frozen)]
+        pub(crate) struct $class {
+            client: Shared,
+        }
+
+        impl $class {
+            fn call<T: Send, F>(&self, py: Python<'_>, call: impl FnOnce($service) -> F) -> PyResult<T>
+            where
+                F: Future<Output = Result<T, G1Error>> + Send,
+            {
+                service_call(py, &self.client, $pick, call)
+            }
+        }
+    };
 }
 
 /// The client, shared by the `G1` object and its `loco` and `arm` objects until `close()`.
@@ -354,25 +400,13 @@ closeable!(
      Idempotent."
 );
 
-/// The G1's locomotion service (service `sport`, Unitree's `LocoClient`). Arguments are checked
-/// before anything is sent (`ArgumentError`); a refusal is a `ServiceError` with its `code`:
-/// 7301 (locomotion unavailable after `G1.release()`, until `G1.select_mode()`), 7302 (no such
-/// FSM id), 7303 (no such arm task). Every call waits at most the client's `service_timeout_s`.
-#[pyclass(module = "robowire.g1", frozen)]
-pub(crate) struct Loco {
-    client: Shared,
-}
-
-impl Loco {
-    /// Runs `call` on the facade's `Loco` with the GIL released.
-    fn call<T: Send, F>(&self, py: Python<'_>, call: impl FnOnce(g1::Loco) -> F) -> PyResult<T>
-    where
-        F: Future<Output = Result<T, G1Error>> + Send,
-    {
-        let loco = client(&self.client)?.loco().clone();
-        blocking(py, call(loco))
-    }
-}
+service_class!(
+    /// The G1's locomotion service (service `sport`, Unitree's `LocoClient`). Arguments are checked
+    /// before anything is sent (`ArgumentError`); a refusal is a `ServiceError` with its `code`:
+    /// 7301 (locomotion unavailable after `G1.release()`, until `G1.select_mode()`), 7302 (no such
+    /// FSM id), 7303 (no such arm task). Every call waits at most the client's `service_timeout_s`.
+    Loco, g1::Loco, G1::loco
+);
 
 #[pymethods]
 impl Loco {
@@ -485,24 +519,13 @@ impl Loco {
     }
 }
 
-/// The G1's arm action service (service `arm`, Unitree's `G1ArmActionClient`). A refusal is a
-/// `ServiceError` with its `code`: 7400 (`rt/arm_sdk` in use: ramp its weight to 0 first), 7401
-/// (the arms hold an action: `release_arm()`), 7402 (no such action), 7404 (actions run only in
-/// FSM 500, 501 and 801). Every call waits at most the client's `service_timeout_s`.
-#[pyclass(module = "robowire.g1", frozen)]
-pub(crate) struct ArmActions {
-    client: Shared,
-}
-
-impl ArmActions {
-    fn call<T: Send, F>(&self, py: Python<'_>, call: impl FnOnce(g1::ArmActions) -> F) -> PyResult<T>
-    where
-        F: Future<Output = Result<T, G1Error>> + Send,
-    {
-        let arm = client(&self.client)?.arm().clone();
-        blocking(py, call(arm))
-    }
-}
+service_class!(
+    /// The G1's arm action service (service `arm`, Unitree's `G1ArmActionClient`). A refusal is a
+    /// `ServiceError` with its `code`: 7400 (`rt/arm_sdk` in use: ramp its weight to 0 first), 7401
+    /// (the arms hold an action: `release_arm()`), 7402 (no such action), 7404 (actions run only in
+    /// FSM 500, 501 and 801). Every call waits at most the client's `service_timeout_s`.
+    ArmActions, g1::ArmActions, G1::arm
+);
 
 #[pymethods]
 impl ArmActions {
