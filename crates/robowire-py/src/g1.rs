@@ -93,8 +93,8 @@ fn service_call<S: Clone, T: Send, F>(
 where
     F: Future<Output = Result<T, G1Error>> + Send,
 {
-    let robot = client(shared)?;
-    let service = service(&robot).clone();
+    // The client itself is not kept while the call waits: `close()` does not wait for it.
+    let service = service(&*client(shared)?).clone();
     blocking(py, call(service))
 }
 
