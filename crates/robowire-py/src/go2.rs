@@ -3,11 +3,12 @@
 
 use std::sync::Arc;
 
-use go2::{Connection, Device, Go2, Go2Error, Hg, JointCommand, LowLevel, LowLevelOptions};
+use go2::{Connection, Device, Go2, Go2Error, Go2Stats, Hg, LowLevel, LowLevelOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{Kind, chain, error, service_error};
+use crate::joints::JointArgs;
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
@@ -45,21 +46,7 @@ pub(crate) fn raise(e: Go2Error) -> PyErr {
     }
 }
 
-/// Twelve values from a number (every joint) or a sequence of 12.
-fn twelve(name: &str, value: &Bound<'_, PyAny>) -> PyResult<[f32; 12]> {
-    if let Ok(v) = value.extract::<f64>() {
-        return Ok([v as f32; 12]);
-    }
-    let values: Vec<f64> = value.try_iter()?.map(|item| item?.extract::<f64>()).collect::<PyResult<_>>()?;
-    <[f64; 12]>::try_from(values.as_slice()).map(|v| v.map(|x| x as f32)).map_err(|_| {
-        error(
-            Kind::Argument,
-            format!("{name}: one number or 12 (motor order FR, FL, RR, RL × hip, thigh, calf), {} given", values.len()),
-        )
-    })
-}
-
-fn connection(c: Connection) -> &'static str {
+pub(crate) fn connection(c: Connection) -> &'static str {
     match c {
         Connection::Waiting => "waiting",
         Connection::Connected => "connected",
@@ -173,17 +160,8 @@ impl Go2LowLevel {
         let Client::Go2(c) = self.client()? else {
             return Err(error(Kind::Argument, "set_joints is the Go2's; an HG robot takes set_command(HgLowCmd)"));
         };
-        let zero = [0.0; 12];
-        let (q, kp, kd) = (twelve("q", q)?, twelve("kp", kp)?, twelve("kd", kd)?);
-        let dq = dq.map(|v| twelve("dq", v)).transpose()?.unwrap_or(zero);
-        let tau = tau.map(|v| twelve("tau", v)).transpose()?.unwrap_or(zero);
-        let joints: [JointCommand; 12] = std::array::from_fn(|i| JointCommand {
-            q_rad: q[i],
-            dq_radps: dq[i],
-            kp: kp[i],
-            kd: kd[i],
-            tau_nm: tau[i],
-        });
+        let joints = JointArgs { q, kp, kd, dq, tau }
+            .commands::<12>("motor order FR, FL, RR, RL × hip, thigh, calf", |_| true)?;
         c.set_joints(&joints).map_err(raise)
     }
 
@@ -278,22 +256,7 @@ impl Go2LowLevel {
 
     /// Topics, commands sent, damping, timeouts, lost states, timing.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = with_client!(self.client()?, |c| c.stats());
-        Ok(dict!(py, {
-            "lowcmd" => topic(py, &s.lowcmd)?,
-            "lowstate" => topic(py, &s.lowstate)?,
-            "commands_sent" => s.commands_sent,
-            "damping_sent" => s.damping_sent,
-            "command_timeouts" => s.command_timeouts,
-            "missed_ticks" => s.missed_ticks,
-            "write_drops" => s.write_drops,
-            "lost_by_tick" => s.lost_by_tick,
-            "late_by_tick" => s.late_by_tick,
-            "disconnects" => s.disconnects,
-            "reconnects" => s.reconnects,
-            "send_lateness_us" => lateness(py, &s.send_lateness)?,
-            "state_gap_us" => lateness(py, &s.state_gap)?,
-        }))
+        low_level_stats(py, &with_client!(self.client()?, |c| c.stats()))
     }
 
     fn __repr__(&self) -> String {
@@ -307,6 +270,26 @@ closeable!(
     capture,
     "Sends damping last, leaves the domain, then finishes its own capture. Idempotent."
 );
+
+/// A low-level client's stats as a dict: topics, commands sent, damping, timeouts, lost states,
+/// timing (µs).
+pub(crate) fn low_level_stats<'py>(py: Python<'py>, s: &Go2Stats) -> PyResult<Bound<'py, PyDict>> {
+    Ok(dict!(py, {
+        "lowcmd" => topic(py, &s.lowcmd)?,
+        "lowstate" => topic(py, &s.lowstate)?,
+        "commands_sent" => s.commands_sent,
+        "damping_sent" => s.damping_sent,
+        "command_timeouts" => s.command_timeouts,
+        "missed_ticks" => s.missed_ticks,
+        "write_drops" => s.write_drops,
+        "lost_by_tick" => s.lost_by_tick,
+        "late_by_tick" => s.late_by_tick,
+        "disconnects" => s.disconnects,
+        "reconnects" => s.reconnects,
+        "send_lateness_us" => lateness(py, &s.send_lateness)?,
+        "state_gap_us" => lateness(py, &s.state_gap)?,
+    }))
+}
 
 /// Adds the classes to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

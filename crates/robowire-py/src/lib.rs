@@ -5,7 +5,9 @@
 
 mod device;
 mod errors;
+mod g1;
 mod go2;
+mod joints;
 mod kmc;
 mod owned;
 mod pyjson;
@@ -27,6 +29,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     kmc::register(m)?;
     unitree::register(m)?;
     go2::register(m)?;
+    g1::register(m)?;
     spline::register(m)?;
     device::register(m)?;
     record::register(m)?;

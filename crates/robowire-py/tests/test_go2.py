@@ -9,7 +9,7 @@ import pytest
 import robowire
 import robowire.go2
 import robowire.sim
-from helpers import wait_until
+from helpers import silence_is_noticed, wait_until
 from robowire.unitree import LowCmd, LowState
 
 STAND = list(robowire.go2.STAND_POSE_RAD) * 4
@@ -71,12 +71,7 @@ def test_a_whole_lowcmd_and_damping(go2_sim, robot):
 
 def test_a_silent_robot_is_noticed(go2_sim, robot):
     robot.wait_state(timeout_s=5.0)
-    go2_sim.inject_silence()
-    wait_until(lambda: robot.connection == "disconnected", timeout_s=10.0)
-    with pytest.raises(robowire.NoStateError, match="silent"):
-        robot.state()
-    go2_sim.clear_faults()
-    wait_until(lambda: robot.connection == "connected", timeout_s=10.0)
+    silence_is_noticed(go2_sim, robot)
 
 
 def test_bit_flips_are_counted_and_dropped(go2_sim, robot):

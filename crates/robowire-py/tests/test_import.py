@@ -20,7 +20,7 @@ def test_importing_every_module_starts_no_thread_and_opens_nothing():
         def fds(): return len(os.listdir("/proc/self/fd"))
         before = (tasks(), fds())
         import robowire, robowire.zsl1, robowire.zsl1w, robowire.kmc, robowire.unitree
-        import robowire.go2, robowire.sim, robowire.spline, robowire.errors, robowire.device, robowire.record
+        import robowire.go2, robowire.g1, robowire.sim, robowire.spline, robowire.errors, robowire.device, robowire.record
         after = (tasks(), fds())
         print(before, after)
         assert before == after, (before, after)

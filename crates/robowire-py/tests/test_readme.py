@@ -21,13 +21,13 @@ BLOCKS = python_blocks()
 
 def test_the_readme_has_an_example_per_device():
     text = "".join(BLOCKS)
-    for module in ["robowire.zsl1", "robowire.kmc", "robowire.go2", "robowire.unitree", "robowire.spline"]:
+    for module in ["robowire.zsl1", "robowire.kmc", "robowire.go2", "robowire.g1", "robowire.unitree", "robowire.spline"]:
         assert module in text, module
 
 
 @pytest.mark.parametrize("block", [b for b in BLOCKS if "robowire.sim" in b or "LowCmd" in b], ids=lambda b: b.split("\n")[0])
 def test_a_readme_example_runs(block, request):
-    if "robowire.go2" in block:
+    if "robowire.go2" in block or "robowire.g1" in block:
         request.getfixturevalue("dds")  # the child inherits this process's network namespace
     result = subprocess.run([sys.executable, "-c", block], capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr

@@ -5,6 +5,7 @@
 - :mod:`robowire.kmc`: the KMC UART chassis.
 - :mod:`robowire.unitree`: Unitree LowCmd/LowState (Go2 and HG), struct image and CDR.
 - :mod:`robowire.go2`: the Go2's low-level interface over DDS.
+- :mod:`robowire.g1`: the Unitree G1 humanoid over DDS (low level, ``rt/arm_sdk``, its services).
 - :mod:`robowire.sim`: every simulator, in-process, as a context manager.
 - :func:`robowire.open`: any device by its address (``kmc:/dev/ttyUSB0``, ``zsl1:IP``,
   ``go2:eth0``, ``sim:zsl1``, …) as a :class:`robowire.Device` of one shape.

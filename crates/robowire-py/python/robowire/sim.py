@@ -5,14 +5,16 @@ without hardware exactly as robowire's own Rust tests do.
 - :class:`Chassis`: a KMC chassis behind a pseudo-terminal (drive it with :mod:`robowire.kmc`).
 - :class:`Spline`: the ZSL-1 spline daemon on POSIX shared memory.
 - :class:`Go2`: a Unitree Go2 on DDS (drive it with :mod:`robowire.go2` or Unitree's SDK).
+- :class:`G1`: a Unitree G1 humanoid on DDS (drive it with :mod:`robowire.g1` or Unitree's SDK).
 
 Each starts in its constructor and stops on ``close()`` or at the end of a ``with`` block.
 """
 
 from ._native import SimChassis as Chassis
 from ._native import SimDog as Dog
+from ._native import SimG1 as G1
 from ._native import SimGo2 as Go2
 from ._native import SimSpline as Spline
 from ._native import enter_loopback_namespace, loopback_has_multicast
 
-__all__ = ["Dog", "Chassis", "Spline", "Go2", "loopback_has_multicast", "enter_loopback_namespace"]
+__all__ = ["Dog", "Chassis", "Spline", "Go2", "G1", "loopback_has_multicast", "enter_loopback_namespace"]

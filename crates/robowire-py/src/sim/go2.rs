@@ -3,8 +3,9 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robowire_dds::{ParticipantOptions, TopicStats};
-use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
+use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 
+use super::unitree::faults;
 use crate::errors::{Kind, chain, error};
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
@@ -68,38 +69,6 @@ impl Go2 {
         self.domain
     }
 
-    /// Stop `rt/lowstate` (a client's watchdog reports the robot lost).
-    fn inject_silence(&self) -> PyResult<()> {
-        self.sim.with(|s| s.inject(Go2Fault::Silence))
-    }
-
-    /// Motor `motor` (0..12) fails: it reports mode 0 and exerts no torque.
-    fn inject_motor_fault(&self, motor: usize) -> PyResult<()> {
-        if motor >= 12 {
-            return Err(error(Kind::Argument, format!("motor {motor}: the Go2 has motors 0..12")));
-        }
-        self.sim.with(|s| s.inject(Go2Fault::MotorFault { motor }))
-    }
-
-    /// Every `every`-th LowState goes out with one bit flipped after its CRC (a client counts
-    /// and drops it).
-    fn inject_bit_flips(&self, every: u32) -> PyResult<()> {
-        if every == 0 {
-            return Err(error(Kind::Argument, "every must be at least 1"));
-        }
-        self.sim.with(|s| s.inject(Go2Fault::BitFlips { every }))
-    }
-
-    /// Clear every fault.
-    fn clear_faults(&self) -> PyResult<()> {
-        self.sim.with(|s| s.clear_faults())
-    }
-
-    /// What the robot did that a user should know, since the last call.
-    fn take_log(&self) -> PyResult<Vec<String>> {
-        self.sim.with(|s| s.take_log())
-    }
-
     /// Sport mode, joint positions, LowCmd and LowState counters, timing.
     fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.sim.with(|s| s.snapshot())?;
@@ -126,6 +95,8 @@ impl Go2 {
         format!("Go2(domain={})", self.domain)
     }
 }
+
+faults!(Go2, robowire_sim::go2::Go2Fault, robowire_sim::go2::JOINTS, "the Go2 has motors 0..12");
 
 closeable!(Go2, sim, capture, "Leaves the domain and stops the robot, then finishes its own capture. Idempotent.");
 

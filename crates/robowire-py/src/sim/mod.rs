@@ -2,7 +2,9 @@
 
 mod chassis;
 mod dog;
+mod g1;
 mod go2;
+mod unitree;
 
 pub(crate) use go2::topic;
 pub(crate) use spline::state_dict;
@@ -17,6 +19,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SimChassis", py.get_type::<chassis::Chassis>())?;
     m.add("SimSpline", py.get_type::<spline::Spline>())?;
     m.add("SimGo2", py.get_type::<go2::Go2>())?;
+    m.add("SimG1", py.get_type::<g1::G1>())?;
     m.add_function(wrap_pyfunction!(go2::loopback_has_multicast, m)?)?;
     m.add_function(wrap_pyfunction!(go2::enter_loopback_namespace, m)?)?;
     Ok(())
