@@ -38,7 +38,12 @@ fn start_observer(python: &Path, mode: &str) -> (Child, BufReader<std::process::
     let mut stdout = BufReader::new(child.stdout.take().unwrap());
     let mut line = String::new();
     stdout.read_line(&mut line).unwrap();
-    assert_eq!(line.trim(), "ready", "the observer saw no state: {line}");
+    if line.trim() != "ready" {
+        let _ = child.kill();
+        let mut err = String::new();
+        child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+        panic!("the observer saw no state: {line:?}\nits stderr: {err}");
+    }
     (child, stdout)
 }
 
