@@ -462,6 +462,20 @@ fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
         });
     }
+    let (g_half50, g_half99) =
+        (us(["ddsperf_1000_half_round_trip_us", "p50"])?, us(["ddsperf_1000_half_round_trip_us", "p99"])?);
+    for pct in ["p50", "p99"] {
+        let (trip, half) = (us(["g1_round_trip_us", pct])?, if pct == "p50" { g_half50 } else { g_half99 });
+        let ratio = trip / (2.0 * half);
+        rows.push(Row {
+            path: format!("G1 LowCmd → LowState answer via the simulator, DDS on loopback, {pct} ({seconds:.0} s)"),
+            figure: format!("{trip:.1} µs"),
+            baseline: format!("CycloneDDS ddsperf ping/pong, 1000 B, round trip: {:.1} µs", 2.0 * half),
+            ratio: format!("{ratio:.2}×"),
+            target: format!("≤ {DDS_ROUND_TRIP_RATIO}× ddsperf"),
+            met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
+        });
+    }
     let (w50, w99) = (us(["one_way_us", "p50"])?, us(["one_way_us", "p99"])?);
     rows.push(Row {
         path: "Go2 LowCmd write (encode, CRC, rustdds) → verified at a reader, one way".into(),

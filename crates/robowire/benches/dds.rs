@@ -1,9 +1,10 @@
-//! The Go2 over DDS on loopback (a private network namespace), beside CycloneDDS's own `ddsperf`
-//! measured in the same run with a payload of the same size (812 bytes):
+//! The Go2 and the G1 over DDS on loopback (a private network namespace), beside CycloneDDS's own
+//! `ddsperf` measured in the same run with a payload of the same size (812 bytes; 1000 for the
+//! G1's 1004-byte HG LowCmd):
 //!
 //! - round trip: a LowCmd published → the LowState answer received, through the simulated Go2
-//!   (which answers each accepted LowCmd at once; its periodic stream slowed to 1 Hz, as ddsperf's
-//!   pong has none), one at a time; beside `ddsperf ping size 812`
+//!   or G1 (which answers each applied LowCmd at once; its periodic stream slowed to 1 Hz, as
+//!   ddsperf's pong has none), one at a time; beside `ddsperf ping size N`
 //!   against `ddsperf pong`, whose printed latency is half the round trip (it divides by 2), so
 //!   it is doubled here;
 //! - one way: a LowCmd written (encode, CRC, rustdds) → decoded and verified at a reader in
@@ -31,9 +32,11 @@ use std::time::{Duration, Instant};
 
 use go2::{Device, JointCommand, LowLevel, LowLevelOptions};
 use lowcmd_proto::api::motion_switcher;
-use lowcmd_proto::{LowCmd, LowState, Message};
+use lowcmd_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
+use robowire_core::cdr::CdrType;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
+use robowire_sim::g1::{G1Sim, G1SimConfig};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use serde_json::{Value, json};
 
@@ -61,17 +64,19 @@ fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
     (at(50), at(99))
 }
 
-/// `ddsperf ping size 812` against `ddsperf pong` for `seconds`: the medians of its per-second
+/// `ddsperf ping size SIZE` against `ddsperf pong` for `seconds`: the medians of its per-second
 /// p50 and p99 lines, µs (its figures: half the round trip).
-fn ddsperf(seconds: u32) -> (f64, f64) {
+fn ddsperf(seconds: u32, size: usize) -> (f64, f64) {
     let mut pong = Command::new("taskset")
         .args(["-c", &PEER_CPU.to_string(), "ddsperf", "-D", &(seconds + 3).to_string(), "pong"])
         .stdout(Stdio::null())
         .spawn()
         .expect("ddsperf (apt install cyclonedds-tools)");
     std::thread::sleep(Duration::from_millis(300));
-    let out =
-        Command::new("ddsperf").args(["-D", &seconds.to_string(), "ping", "size", "812"]).output().expect("ddsperf");
+    let out = Command::new("ddsperf")
+        .args(["-D", &seconds.to_string(), "ping", "size", &size.to_string()])
+        .output()
+        .expect("ddsperf");
     let _ = pong.kill();
     let _ = pong.wait();
     let text = String::from_utf8_lossy(&out.stdout);
@@ -80,7 +85,8 @@ fn ddsperf(seconds: u32) -> (f64, f64) {
         rest.trim_start().split("us").next()?.trim().parse::<f64>().ok()
     };
     let (mut p50s, mut p99s) = (Vec::new(), Vec::new());
-    for line in text.lines().filter(|l| l.contains("size 812") && l.contains("50%")) {
+    let size = format!("size {size}");
+    for line in text.lines().filter(|l| l.contains(&size) && l.contains("50%")) {
         if let (Some(p50), Some(p99)) = (field(line, "50%"), field(line, "99%")) {
             p50s.push(p50);
             p99s.push(p99);
@@ -90,29 +96,53 @@ fn ddsperf(seconds: u32) -> (f64, f64) {
     (percentiles(p50s).0, percentiles(p99s).0)
 }
 
+/// The simulators' settings for round trips: each applied LowCmd answered at once; the 500 Hz
+/// stream slowed to 1 Hz so that the round trip is the answer alone, as ddsperf's pong is.
+const STATE_PERIOD: Duration = Duration::from_secs(1);
+
+/// A Go2 LowCmd tagged by its `reserve` (the simulator echoes it in its answer).
 fn tagged(tag: u32) -> LowCmd {
     let mut cmd = LowCmd::default();
     cmd.reserve = tag.into();
     cmd
 }
 
-async fn round_trips(seconds: u32) -> Vec<f64> {
-    let lo = ParticipantOptions::new(0, Some("lo"));
-    // The simulator answers each LowCmd at once; its 500 Hz stream is slowed to 1 Hz so that the
-    // round trip is the answer alone, as ddsperf's pong is.
-    let config = Go2SimConfig {
-        participant: lo.clone(),
-        answer_lowcmd: true,
-        state_period: Duration::from_secs(1),
-        ..Go2SimConfig::default()
-    };
+/// Round trips through the simulated Go2.
+async fn go2_round_trips(seconds: u32) -> Vec<f64> {
+    let participant = ParticipantOptions::new(0, Some("lo"));
+    let config =
+        Go2SimConfig { participant, answer_lowcmd: true, state_period: STATE_PERIOD, ..Go2SimConfig::default() };
     let _sim = on_cpu(PEER_CPU, || Go2Sim::spawn(config).expect("simulator"));
-    let us = Participant::new(lo).expect("participant");
+    round_trips::<LowCmd, LowState>(seconds, tagged, |s| s.reserve.get()).await
+}
+
+/// Round trips through the simulated 29-dof G1 (mode_machine 5; `reserve[0]` tags).
+async fn g1_round_trips(seconds: u32) -> Vec<f64> {
+    let participant = ParticipantOptions::new(0, Some("lo"));
+    let config = G1SimConfig { participant, answer_lowcmd: true, state_period: STATE_PERIOD, ..G1SimConfig::default() };
+    let _sim = on_cpu(PEER_CPU, || G1Sim::spawn(config).expect("simulator"));
+    let tagged = |tag: u32| {
+        let mut cmd = HgLowCmd::default();
+        cmd.mode_machine = lowcmd_proto::g1::G1Variant::Dof29.mode_machine();
+        cmd.reserve[0] = tag.into();
+        cmd
+    };
+    round_trips::<HgLowCmd, HgLowState>(seconds, tagged, |s| s.reserve[0].get()).await
+}
+
+/// After ReleaseMode, `seconds` of round trips one at a time: the command `tagged(n)` published,
+/// the first state with `tag_of(state) >= n` received.
+async fn round_trips<C, S>(seconds: u32, tagged: impl Fn(u32) -> C, tag_of: impl Fn(&S) -> u32) -> Vec<f64>
+where
+    C: Message + CdrType + Send + Sync + 'static,
+    S: Message + CdrType + Send + Sync + 'static,
+{
+    let us = Participant::new(ParticipantOptions::new(0, Some("lo"))).expect("participant");
     let switcher = go2::services::ServiceClient::new(&us, motion_switcher::SERVICE).unwrap();
     let released = switcher.call(motion_switcher::RELEASE_MODE, "{}", Duration::from_secs(20)).await.unwrap();
     assert_eq!(released.code, 0);
-    let writer = us.writer::<LowCmd>(LowCmd::TOPIC, Qos::WRITER).unwrap();
-    let mut reader = us.reader::<LowState>(LowState::TOPIC, Qos::READER).unwrap();
+    let writer = us.writer::<C>(C::TOPIC, Qos::WRITER).unwrap();
+    let mut reader = us.reader::<S>(S::TOPIC, Qos::READER).unwrap();
     let mut samples = Vec::new();
     let end = Instant::now() + Duration::from_secs(u64::from(seconds));
     let mut tag = 0u32;
@@ -123,7 +153,7 @@ async fn round_trips(seconds: u32) -> Vec<f64> {
         let answered = tokio::time::timeout(Duration::from_millis(200), async {
             loop {
                 match reader.recv().await {
-                    Ok(s) if s.value.reserve.get() >= tag => return,
+                    Ok(s) if tag_of(&s.value) >= tag => return,
                     Ok(_) => {}
                     Err(e) => panic!("{e}"),
                 }
@@ -380,13 +410,20 @@ fn main() {
     }
     let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
     let meta = robowire_dds::netns::for_this_process().run(|| {
-        let (half50, half99) = ddsperf(seconds);
+        let (half50, half99) = ddsperf(seconds, 812);
+        let (hg_half50, hg_half99) = ddsperf(seconds, 1000);
         robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
-        let trips = runtime.block_on(round_trips(seconds));
+        let trips = runtime.block_on(go2_round_trips(seconds));
+        let g1_trips = runtime.block_on(g1_round_trips(seconds));
         let ways = runtime.block_on(one_way(seconds));
         let stalled = stalled_reader(seconds);
         let ((r50, r99), (w50, w99)) = (percentiles(trips.clone()), percentiles(ways.clone()));
+        let (g50, g99) = percentiles(g1_trips.clone());
+        println!(
+            "G1 round trip p50 {g50:.1} p99 {g99:.1} µs ({} samples); ddsperf 1000 B half round trip p50 {hg_half50:.1} p99 {hg_half99:.1} µs",
+            g1_trips.len()
+        );
         println!(
             "round trip p50 {r50:.1} p99 {r99:.1} µs ({} samples); one way p50 {w50:.1} p99 {w99:.1} µs; ddsperf half round trip p50 {half50:.1} p99 {half99:.1} µs",
             trips.len()
@@ -396,6 +433,8 @@ fn main() {
             "round_trip_us": {"p50": r50, "p99": r99, "count": trips.len()},
             "one_way_us": {"p50": w50, "p99": w99, "count": ways.len()},
             "ddsperf_half_round_trip_us": {"p50": half50, "p99": half99},
+            "g1_round_trip_us": {"p50": g50, "p99": g99, "count": g1_trips.len()},
+            "ddsperf_1000_half_round_trip_us": {"p50": hg_half50, "p99": hg_half99},
             "stalled_reader": stalled,
         })
     })

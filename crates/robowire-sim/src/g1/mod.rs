@@ -91,6 +91,9 @@ pub struct G1SimConfig {
     /// Where each service request taken and answer written goes
     /// (`lowcmd_proto::description::API_SERVER`).
     pub services_tap: Option<Tap>,
+    /// Answer every applied LowCmd with a LowState at once, its `reserve` the command's, besides
+    /// the 500 Hz stream (for round-trip measurements; a real G1 only streams).
+    pub answer_lowcmd: bool,
 }
 
 impl G1SimConfig {
@@ -104,6 +107,7 @@ impl G1SimConfig {
             cpu: None,
             low_level_tap: None,
             services_tap: None,
+            answer_lowcmd: false,
         }
     }
 }
@@ -261,9 +265,19 @@ impl G1Sim {
         let (arm_sdk, arm_sdk_stats) = crate::unitree::command_reader::<ArmSdkFrame>(&participant, ARM_SDK_TOPIC, tap)?;
         let services_tap = config.services_tap.clone();
         let server = |service| crate::unitree::service_server(&participant, service, services_tap.clone());
+        let answers = config
+            .answer_lowcmd
+            .then(|| {
+                let mut answers =
+                    participant.writer::<HgLowState>(HgLowState::TOPIC, robowire_dds::qos::Qos::WRITER)?;
+                answers.set_tap(tap.clone());
+                Ok::<_, robowire_dds::DdsError>(answers)
+            })
+            .transpose()?;
         let endpoints = services::Endpoints {
             lowcmd,
             arm_sdk,
+            answers,
             switcher: server(motion_switcher::SERVICE)?,
             loco: server(g1_loco::SERVICE)?,
             arm: server(g1_arm::SERVICE)?,

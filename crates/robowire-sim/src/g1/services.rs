@@ -6,25 +6,27 @@ use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 
-use lowcmd_proto::HgLowCmd;
 use lowcmd_proto::api::{self, ApiRequest, g1_arm, g1_loco, status};
 use lowcmd_proto::g1::{G1Variant, ModePr};
+use lowcmd_proto::{HgLowCmd, HgLowState};
 use robowire_core::schedule::Time;
-use robowire_dds::Reader;
+use robowire_dds::{Reader, Writer};
 use serde_json::{Value, json};
 
 use super::{ArmSdkFrame, G1Robot, has_disabled_motor};
-use crate::unitree::{Handover, Owner, Report, ServiceServer, serve};
+use crate::unitree::{Handover, Owner, Report, ServiceServer, answer_at_once, serve};
 
 /// The simulator's DDS endpoints the services thread owns.
 pub(super) struct Endpoints {
     pub(super) lowcmd: Reader<HgLowCmd>,
     pub(super) arm_sdk: Reader<ArmSdkFrame>,
+    /// Immediate answers to LowCmds, if asked for.
+    pub(super) answers: Option<Writer<HgLowState>>,
     pub(super) switcher: ServiceServer,
     pub(super) loco: ServiceServer,
     pub(super) arm: ServiceServer,
     /// `rt/lf/bmsstate`.
-    pub(super) battery: robowire_dds::Writer<lowcmd_proto::bms::HgBmsState>,
+    pub(super) battery: Writer<lowcmd_proto::bms::HgBmsState>,
 }
 
 /// What the robot checks a LowCmd against.
@@ -86,13 +88,13 @@ struct Services {
 }
 
 impl Services {
-    /// Applies one decoded LowCmd (arrived at `now`).
-    fn on_lowcmd(&mut self, cmd: &HgLowCmd, now: Time) {
+    /// Applies one decoded LowCmd (arrived at `now`): whether the robot applies it.
+    fn on_lowcmd(&mut self, cmd: &HgLowCmd, now: Time) -> bool {
         let inbox = &self.handover.inbox;
         if self.owner.owns() {
             inbox.lowcmd.ignored.add(1);
             self.owner.ignored("LowCmd");
-            return;
+            return false;
         }
         if cmd.mode_machine != self.rules.mode_machine {
             inbox.bad_mode_machine.add(1);
@@ -103,17 +105,18 @@ impl Services {
                     cmd.mode_machine, self.rules.mode_machine
                 ));
             }
-            return;
+            return false;
         }
         if ModePr::from_byte(cmd.mode_pr).is_none() {
             inbox.bad_mode_pr.add(1);
-            return;
+            return false;
         }
         if has_disabled_motor(cmd, self.rules.variant) {
             inbox.disabled_motors.add(1);
         }
         self.mode_machine_logged = false;
         inbox.lowcmd.accept(cmd, now);
+        true
     }
 
     /// Applies one `rt/arm_sdk` frame (arrived at `now`).
@@ -159,7 +162,8 @@ pub(super) async fn run(
     endpoints: Endpoints,
     rules: Rules,
 ) {
-    let Endpoints { lowcmd: mut lowcmd_reader, arm_sdk: mut arm_sdk_reader, switcher, loco, arm, battery } = endpoints;
+    let Endpoints { lowcmd: mut lowcmd_reader, arm_sdk: mut arm_sdk_reader, answers, switcher, loco, arm, battery } =
+        endpoints;
     let loco_state = Loco {
         fsm_id: super::BOOT_FSM_ID,
         balance_mode: 0,
@@ -178,7 +182,11 @@ pub(super) async fn run(
     let answered = &handover.requests_answered;
     let lowcmds = async {
         while let Ok(sample) = lowcmd_reader.recv().await {
-            services.borrow_mut().on_lowcmd(&sample.value, robowire_rt::now());
+            let cmd = &sample.value;
+            if services.borrow_mut().on_lowcmd(cmd, robowire_rt::now()) {
+                // robowire's simulator only: the command's `reserve` echoed, to match a state to it.
+                answer_at_once(&handover.state, answers.as_ref(), |state| state.reserve = cmd.reserve);
+            }
         }
     };
     let arm_sdk = async {

@@ -11,7 +11,7 @@ use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
 
 use super::{Go2Robot, head_ok};
-use crate::unitree::{Handover, Owner, Report, ServiceServer, serve};
+use crate::unitree::{Handover, Owner, Report, ServiceServer, answer_at_once, serve};
 
 /// The simulator's DDS endpoints the services thread owns.
 pub(super) struct Endpoints {
@@ -44,14 +44,6 @@ impl Services {
         inbox.lowcmd.accept(cmd, now);
         true
     }
-
-    /// The state right after `cmd` was accepted: the state the stream sent last, with the
-    /// command's `reserve` echoed (what the body reports once it follows the command).
-    fn answer(&self, cmd: &LowCmd) -> Option<LowState> {
-        let (_, mut state) = self.handover.state.read()?;
-        state.reserve = cmd.reserve;
-        Some(state)
-    }
 }
 
 /// Runs until the simulator stops.
@@ -62,13 +54,9 @@ pub(super) async fn run(handover: Arc<Handover<Go2Robot>>, report: Arc<Mutex<Rep
     let commands = async {
         while let Ok(sample) = reader.recv().await {
             let cmd = &sample.value;
-            let mut s = services.borrow_mut();
-            if s.on_lowcmd(cmd, robowire_rt::now())
-                && let Some(answers) = &answers
-                && let Some(state) = s.answer(cmd)
-            {
-                // A failed write is counted by the writer.
-                let _ = answers.write(state);
+            if services.borrow_mut().on_lowcmd(cmd, robowire_rt::now()) {
+                // What the body reports once it follows the command: its `reserve` echoed.
+                answer_at_once(&handover.state, answers.as_ref(), |state| state.reserve = cmd.reserve);
             }
         }
     };

@@ -22,7 +22,7 @@ use robowire_rt::{Latest, lock};
 use robowire_tap::Tap;
 use tokio::sync::watch;
 
-pub(crate) use services::{CommandInbox, Owner, ServiceServer, serve, service_server};
+pub(crate) use services::{CommandInbox, Owner, ServiceServer, answer_at_once, serve, service_server};
 pub(crate) use stream::{FlipSite, StreamBody, forward_to_body};
 
 use crate::handover::{Requests, StreamStats};

@@ -12,6 +12,7 @@ use std::time::Duration;
 use lowcmd_proto::api::{self, ApiRequest, ApiResponse, Response, motion_switcher, status};
 use robowire_core::schedule::Time;
 use robowire_core::timing::LatenessSummary;
+use robowire_dds::Writer;
 use robowire_dds::rpc::RpcServer;
 use robowire_rt::stats::{Counter, SharedLateness, micros};
 use robowire_rt::{Latest, lock};
@@ -201,5 +202,20 @@ impl<C: FromBytes + IntoBytes + KnownLayout + Immutable> CommandInbox<C> {
     /// |interval − period| between accepted commands as they arrive, µs.
     pub(crate) fn jitter(&self) -> LatenessSummary {
         self.jitter.summary()
+    }
+}
+
+/// Answers an accepted command at once (round-trip measurements; a real robot only streams):
+/// the state the stream sent last with `echo` applied, written on `answers` if it is there. A
+/// failed write is counted by the writer.
+pub(crate) fn answer_at_once<S>(state: &Latest<S>, answers: Option<&Writer<S>>, echo: impl FnOnce(&mut S))
+where
+    S: lowcmd_proto::Message + robowire_core::cdr::CdrType + Send + Sync,
+{
+    if let Some(answers) = answers
+        && let Some((_, mut answer)) = state.read()
+    {
+        echo(&mut answer);
+        let _ = answers.write(answer);
     }
 }
