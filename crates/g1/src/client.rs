@@ -96,7 +96,8 @@ impl G1 {
         options.validate()?;
         let low = LowLevel::<Hg>::open(options.low_level.clone())?;
         // Reliable like Unitree's, but the arm stream's writes never wait.
-        let writer = low.participant().writer::<HgLowCmd>(ARM_SDK_TOPIC, Qos::STREAM_WRITER)?;
+        let mut writer = low.participant().writer::<HgLowCmd>(ARM_SDK_TOPIC, Qos::STREAM_WRITER)?;
+        writer.set_tap(options.arm_sdk_tap.clone());
         let arm_sdk = writer.stats_handle();
         let arm_shared = Arc::new(ArmShared::default());
         let job = ArmSdkJob::new(ArmSdkStream::new(options.arm_sdk), writer, arm_shared.clone());

@@ -4,6 +4,7 @@ use std::time::Duration;
 
 use go2::{Go2Error, LowLevelOptions};
 use lowcmd_proto::g1::G1Variant;
+use robowire_tap::Tap;
 
 use crate::G1Error;
 use crate::arm_stream::{ARM_SDK_WEIGHT_RATE_MAX_PER_S, ArmSdkConfig};
@@ -20,6 +21,9 @@ pub struct G1Options {
     pub variant: Option<G1Variant>,
     /// The `rt/arm_sdk` stream: 20 ms period, 500 ms command timeout, weight rate 0.5/s.
     pub arm_sdk: ArmSdkConfig,
+    /// Where each `rt/arm_sdk` frame written goes, as its payload (a link of its own, described
+    /// by `lowcmd_proto::description::HG_LOW_LEVEL`: HG LowCmds sent).
+    pub arm_sdk_tap: Option<Tap>,
 }
 
 impl G1Options {

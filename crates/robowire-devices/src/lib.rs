@@ -248,10 +248,13 @@ fn go2_options<R: unitree::Family>(interface: Option<&str>, options: &OpenOption
     unitree_options(interface, options, R::RECORDED_AS, R::LOW_LEVEL)
 }
 
-/// A G1 client's options: the HG low level, recorded as `g1/low_level` and `g1/api`.
+/// A G1 client's options: the HG low level, recorded as `g1/low_level`, `g1/api` and
+/// `g1/arm_sdk`.
 fn g1_options(interface: Option<&str>, options: &OpenOptions) -> ::g1::G1Options {
-    let low_level = unitree_options(interface, options, "g1", &lowcmd_proto::description::HG_LOW_LEVEL);
-    ::g1::G1Options { low_level, ..::g1::G1Options::default() }
+    let hg = &lowcmd_proto::description::HG_LOW_LEVEL;
+    let low_level = unitree_options(interface, options, "g1", hg);
+    let arm_sdk_tap = options.record.as_ref().map(|r| r.link("g1/arm_sdk", hg));
+    ::g1::G1Options { low_level, arm_sdk_tap, ..::g1::G1Options::default() }
 }
 
 /// A Unitree low-level client's options: the domain, the state timeout, and with a recorder its

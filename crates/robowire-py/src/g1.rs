@@ -163,7 +163,7 @@ impl PyG1 {
     /// or `"dual_arm"` whatever the LowState's `mode_machine` says (`None`: from it).
     /// `service_timeout_s`: the longest a service call waits for its answer. `record`: a path
     /// or a `robowire.Recorder` to record the client's side of `g1/low_level` (`rt/lowcmd`,
-    /// `rt/lowstate`) and `g1/api` into.
+    /// `rt/lowstate`), `g1/api` and `g1/arm_sdk` into.
     #[new]
     #[pyo3(signature = (interface = None, domain = 0, *, variant = None, service_timeout_s = 5.0, record = None))]
     fn new(
@@ -185,6 +185,7 @@ impl PyG1 {
                 ..LowLevelOptions::on(interface, domain)
             },
             variant,
+            arm_sdk_tap: links.as_ref().map(|r| r.link("g1/arm_sdk", &lowcmd_proto::description::HG_LOW_LEVEL)),
             ..G1Options::default()
         };
         let robot = py.detach(|| G1::open(options)).map_err(raise)?;

@@ -53,8 +53,8 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
             other => panic!("{topic}: encoding {other}"),
         }
     }
-    for device in ["kmc", "dog", "go2"] {
-        assert!(channels.keys().any(|t| t.starts_with(&format!("/{device}/"))), "{device} recorded: {seen}");
+    for link in ["kmc", "dog", "go2", "g1/low_level", "g1/arm_sdk"] {
+        assert!(channels.keys().any(|t| t.starts_with(&format!("/{link}/"))), "{link} recorded: {seen}");
     }
 
     // The counts are the demo's own. A scenario reads its client's counters just before it closes

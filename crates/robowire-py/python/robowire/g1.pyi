@@ -80,7 +80,7 @@ class G1:
         service_timeout_s: float = 5.0,
         record: Union[str, PathLike[str], Recorder, None] = None,
     ) -> None:
-        """record: g1/low_level and g1/api, the client's side, into a path or a Recorder."""
+        """record: g1/low_level, g1/api and g1/arm_sdk, the client's side, into a path or a Recorder."""
     def release(self) -> int:
         """ReleaseMode calls taken (0: nothing owned the motors); raises ServiceError."""
     def mode(self) -> str:
