@@ -426,8 +426,8 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     println!("g1 domain {} {interface} dof {dof} mode_machine {mode_machine}", args.dds.domain);
     eprintln!(
         "G1 simulator ({dof} joints) on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, rt/arm_sdk, \
-         motion_switcher, sport (loco) and arm. Ctrl-C stops.",
-        args.dds.domain
+         motion_switcher, sport (loco) and arm. Try: robowire g1 --domain {} zero. Ctrl-C stops.",
+        args.dds.domain, args.dds.domain
     );
     until_ctrl_c_with_log(args.report_every_s, || sim.take_log(), || g1_report(&sim.snapshot()))?;
     let s = sim.snapshot();
