@@ -114,7 +114,7 @@ impl CdrType for HgBmsState {
         Ok(LEN)
     }
 
-    /// Exactly [`LEN`] bytes in either encoding; alignment bytes are ignored (zeroed).
+    /// Exactly 164 bytes in either encoding; alignment bytes are ignored (zeroed).
     fn decode_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<()>> {
         if body.len() != LEN {
             return Err(DecodeError::CdrLength { encoding, expected: LEN, found: body.len() });
