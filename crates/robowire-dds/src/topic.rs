@@ -112,7 +112,7 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Hands every sample this writer publishes to `tap` as its payload (encapsulation header,
     /// body), with the writer's GUID and the source timestamp it is published with.
     pub fn set_tap(&mut self, tap: Option<Tap>) {
-        let guid = self.inner.guid().to_bytes();
+        let guid = self.guid();
         self.tap = tap.map(|tap| (tap, guid));
     }
 
@@ -166,6 +166,12 @@ impl<T: CdrType + 'static> Writer<T> {
                 Err(WriteRefused::Failed)
             }
         }
+    }
+
+    /// Its RTPS GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1): the GID
+    /// ROS 2 names it by.
+    pub fn guid(&self) -> [u8; 16] {
+        self.inner.guid().to_bytes()
     }
 
     /// Readers of this topic matched so far.
@@ -331,6 +337,12 @@ impl<T: CdrType + 'static> Reader<T> {
                 }
             }
         }
+    }
+
+    /// Its RTPS GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1): the GID
+    /// ROS 2 names it by.
+    pub fn guid(&self) -> [u8; 16] {
+        self.inner.guid().to_bytes()
     }
 
     /// Why the last rejected sample was rejected (the codec's words).
