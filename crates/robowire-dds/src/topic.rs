@@ -174,6 +174,15 @@ impl<T: CdrType + 'static> Writer<T> {
         self.inner.guid().to_bytes()
     }
 
+    /// Whether every reliable reader matched has acknowledged every sample written so far;
+    /// waits until they have (or the writer is gone): bring a timeout. Best effort: at once.
+    pub async fn acknowledged(&self) -> Result<bool, DdsError> {
+        self.inner
+            .async_wait_for_acknowledgments()
+            .await
+            .map_err(|source| DdsError::Write { topic: self.topic.clone(), source })
+    }
+
     /// Readers of this topic matched so far.
     pub fn matched_readers(&self) -> usize {
         while let Some(status) = self.inner.try_recv_status() {

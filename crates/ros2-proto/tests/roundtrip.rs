@@ -40,6 +40,9 @@ fn quaternion() -> impl Strategy<Value = Quaternion> {
     (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z, w)| Quaternion { x, y, z, w })
 }
 
+/// A node: namespace, name, reader GUIDs, writer GUIDs.
+type Node = (String, String, Vec<[u8; 16]>, Vec<[u8; 16]>);
+
 fn covariance36() -> impl Strategy<Value = [f64; 36]> {
     prop::array::uniform32(-10.0..10.0f64).prop_map(|a| std::array::from_fn(|i| a[i % 32] * (i as f64 + 1.0)))
 }
@@ -116,7 +119,7 @@ proptest! {
 
     #[test]
     fn participant_entities_info(guid: [u8; 16], nodes in prop::collection::vec((text(), text(), prop::collection::vec(any::<[u8; 16]>(), 0..4), prop::collection::vec(any::<[u8; 16]>(), 0..4)), 0..4)) {
-        fn info<const N: usize>(guid: [u8; 16], nodes: &[(String, String, Vec<[u8; 16]>, Vec<[u8; 16]>)]) -> ParticipantEntitiesInfo<N> {
+        fn info<const N: usize>(guid: [u8; 16], nodes: &[Node]) -> ParticipantEntitiesInfo<N> {
             ParticipantEntitiesInfo {
                 gid: Gid::from_guid(guid),
                 node_entities_info_seq: nodes.iter().map(|(ns, name, readers, writers)| NodeEntitiesInfo {
