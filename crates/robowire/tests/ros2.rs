@@ -5,6 +5,9 @@
 //! `joint_states`, `imu`, `battery_state` and `tf` field for field, calls `stand_up` in
 //! rmw_cyclonedds' request/reply format; unarmed, the same `cmd_vel` moves nothing. A simulated
 //! G1's topics are read by that peer (Unitree's HG classes) and by robowire's own DDS readers.
+//! The bridge's nodes on `ros_discovery_info` (Jazzy's and Humble's GID sizes) are read by that
+//! peer and by robowire's own DDS, each GID matched to the GUID DDS discovery reports for the
+//! bridge's endpoint; a Humble bridge warns once of a Jazzy peer.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -453,4 +456,56 @@ fn a_humble_bridge_warns_once_of_a_jazzy_peer() {
         assert_eq!(log.matches("ros_discovery_info with 16-byte GIDs").count(), 1, "once: {log}");
         assert!(log.contains("--ros-distro jazzy"), "{log}");
     });
+}
+
+/// A CycloneDDS peer started after the bridge reads its nodes on `ros_discovery_info` (transient
+/// local: the sample comes late) in the `distro` layout, and finds every GID equal to the key
+/// CycloneDDS's own discovery (DCPSPublication / DCPSSubscription) reports for the bridge's
+/// endpoint of that node's topic.
+fn a_cyclonedds_peer_reads_the_bridges_nodes(distro: &str, gid_len: usize) {
+    let Some(python) = interop_python() else { return };
+    with_loopback_multicast(|| {
+        let bridge = Bridge::start(&["--device", "sim:kmc", "--device", "sim:zsl1", "--ros-distro", distro]);
+        let seen = peer(&python, &format!("graph_{distro}"), "");
+        let hex = |v: &Value| v.as_str().unwrap_or_else(|| panic!("not a string: {v}")).to_owned();
+        let gid = hex(&seen["gid"]);
+        assert_eq!(gid.len(), 2 * gid_len, "{seen}");
+        assert!(gid[24..32] == *"000001c1" && gid[32..].bytes().all(|b| b == b'0'), "the participant's GID: {seen}");
+        let nodes = seen["nodes"].as_array().unwrap();
+        let names: Vec<(&str, &str)> =
+            nodes.iter().map(|n| (n["namespace"].as_str().unwrap(), n["name"].as_str().unwrap())).collect();
+        assert_eq!(names, [("/kmc0", "robowire"), ("/zsl1_0", "robowire")], "{seen}");
+        for (node, (namespace, writers, readers)) in nodes.iter().zip(NODE_TOPICS) {
+            for (key, kind, expected) in [("writers", "writer", writers), ("readers", "reader", readers)] {
+                let mut topics = Vec::new();
+                for e in node[key].as_array().unwrap() {
+                    let g = hex(&e["gid"]);
+                    assert_eq!(g.len(), 2 * gid_len, "{e}");
+                    assert!(g[32..].bytes().all(|b| b == b'0'), "zero-padded: {e}");
+                    assert_eq!(e["kind"], kind, "the GID is the key of the bridge's {kind}: {e}");
+                    assert_eq!(e["participant"].as_str().map(|p| &p[..24]), Some(&gid[..24]), "{e}");
+                    let topic = e["topic"].as_str().unwrap();
+                    assert!(
+                        ["rt", "rq", "rr"].iter().any(|p| topic.starts_with(&format!("{p}{namespace}/"))),
+                        "{namespace}: {e}"
+                    );
+                    topics.push(topic.to_owned());
+                }
+                for t in expected {
+                    assert!(topics.iter().any(|s| s == t), "{namespace} lists its {kind} of {t}: {topics:?}");
+                }
+            }
+        }
+        bridge.stop();
+    });
+}
+
+#[test]
+fn a_cyclonedds_peer_reads_the_bridges_nodes_jazzy() {
+    a_cyclonedds_peer_reads_the_bridges_nodes("jazzy", 16);
+}
+
+#[test]
+fn a_cyclonedds_peer_reads_the_bridges_nodes_humble() {
+    a_cyclonedds_peer_reads_the_bridges_nodes("humble", 24);
 }
