@@ -44,6 +44,14 @@ impl RosDistro {
         }
     }
 
+    /// The distribution of the other layout.
+    pub fn other(self) -> Self {
+        match self {
+            Self::Humble => Self::Jazzy,
+            Self::Jazzy => Self::Humble,
+        }
+    }
+
     /// `humble` or `jazzy`.
     pub fn name(self) -> &'static str {
         match self {
@@ -131,8 +139,9 @@ impl RosGraph {
         Ok(Self { distro, participant: participant.guid(), writer, nodes: Mutex::default() })
     }
 
-    /// A node in `namespace` (`""` or `/ns`, at most [`NAME_BOUND`](ros2_proto::rmw_dds_common::NAME_BOUND) bytes: peers refuse a
-    /// sample with a longer one), listed once it has an endpoint.
+    /// A node in `namespace` (`""` or `/ns`, at most
+    /// [`NAME_BOUND`](ros2_proto::rmw_dds_common::NAME_BOUND) bytes: peers refuse a sample with a
+    /// longer one), listed once it has an endpoint.
     pub(crate) fn add_node(&self, namespace: &str) -> NodeId {
         let namespace = if namespace.is_empty() { "/".to_owned() } else { namespace.to_owned() };
         let mut nodes = robowire_rt::lock(&self.nodes);
@@ -142,12 +151,12 @@ impl RosGraph {
 
     /// Lists the reader `guid` under `node` and writes the graph.
     pub(crate) fn add_reader(&self, node: NodeId, guid: [u8; 16]) -> Result<(), DdsError> {
-        self.change(|nodes| nodes[node.0].readers.push(guid))
+        self.change(|nodes| nodes.get_mut(node.0).into_iter().for_each(|n| n.readers.push(guid)))
     }
 
     /// Lists the writer `guid` under `node` and writes the graph.
     pub(crate) fn add_writer(&self, node: NodeId, guid: [u8; 16]) -> Result<(), DdsError> {
-        self.change(|nodes| nodes[node.0].writers.push(guid))
+        self.change(|nodes| nodes.get_mut(node.0).into_iter().for_each(|n| n.writers.push(guid)))
     }
 
     /// Removes every node and writes the graph (no node left), waiting at most `wait` for the
@@ -198,27 +207,24 @@ impl RosGraph {
             tokio::select! {
                 () = &mut stop => return Ok(()),
                 sample = reader.recv() => {
-                    let sample = sample?;
+                    // The reader gone: nothing more to look at (the bridge goes on).
+                    let Ok(sample) = sample else { break };
                     if sample.writer[..12] != self.participant[..12] && other_layout(self.distro, &sample.value) {
-                        let other = match self.distro {
-                            RosDistro::Humble => RosDistro::Jazzy,
-                            RosDistro::Jazzy => RosDistro::Humble,
-                        };
-                        let gid_len = |d: RosDistro| d.gid_len();
+                        let (own, other) = (self.distro, self.distro.other());
                         eprintln!(
-                            "ros2: a participant ({}) writes ros_discovery_info with {}-byte GIDs ({other}); this bridge writes {}-byte GIDs ({}): \
-                             ROS 2 tools there will not see its nodes (--ros-distro {other})",
+                            "ros2: a participant ({}) writes ros_discovery_info with {}-byte GIDs ({other}); this bridge writes \
+                             {}-byte GIDs ({own}): ROS 2 tools there will not see this bridge's nodes (--ros-distro {other})",
                             hex(&sample.writer[..12]),
-                            gid_len(other),
-                            self.distro.gid_len(),
-                            self.distro
+                            other.gid_len(),
+                            own.gid_len(),
                         );
-                        stop.await;
-                        return Ok(());
+                        break;
                     }
                 }
             }
         }
+        stop.await;
+        Ok(())
     }
 }
 
