@@ -209,15 +209,16 @@ pub async fn run(
         .collect();
     runs.push(Box::pin(graph.warn_on_other_layout(&participant, stopped(stop.clone()))));
     let outcome = futures::future::try_join_all(runs).await;
-    if let Err(e) = graph.stop(GRAPH_GOODBYE).await {
-        eprintln!("ros2: removing the nodes from the ROS graph: {e}");
-    }
-    // Each device's safe action (the chassis's stop burst, the dog's stop, damping) on close.
+    // Each device's safe action (the chassis's stop burst, the dog's stop, damping) on close,
+    // first; then the nodes leave the graph.
     for device in opened {
         let address = device.address().clone();
         if let Err(e) = device.close() {
             eprintln!("{address}: closing: {}", robowire_devices::error_chain(&e));
         }
+    }
+    if let Err(e) = graph.stop(GRAPH_GOODBYE).await {
+        eprintln!("ros2: removing the nodes from the ROS graph: {e}");
     }
     outcome.map(|_| devices)
 }
