@@ -14,5 +14,5 @@ mod topic;
 #[doc(hidden)]
 pub use adapter::fuzz_check_sample;
 pub use error::DdsError;
-pub use participant::{DiscoveredTopic, Participant, ParticipantOptions};
+pub use participant::{DiscoveredEndpoint, DiscoveredTopic, Participant, ParticipantOptions};
 pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, WriteRefused, Writer};

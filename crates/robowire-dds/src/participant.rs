@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::net::{IpAddr, Ipv4Addr};
 
 use robowire_core::cdr::CdrType;
-use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, Subscriber, TopicKind};
+use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, RTPSEntity, Subscriber, TopicKind};
 
 use crate::DdsError;
 use crate::adapter::CdrAdapter;
@@ -40,6 +40,19 @@ pub struct DiscoveredTopic {
     pub writers: usize,
     /// Remote readers.
     pub readers: usize,
+}
+
+/// An endpoint of another participant, as DDS discovery (SEDP) reports it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DiscoveredEndpoint {
+    /// Its RTPS GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1).
+    pub guid: [u8; 16],
+    /// A writer (else a reader).
+    pub writer: bool,
+    /// Topic name.
+    pub topic: String,
+    /// DDS type name.
+    pub type_name: String,
 }
 
 /// A domain participant; see the [crate docs](crate).
@@ -86,6 +99,12 @@ impl Participant {
     /// Where it lives.
     pub fn options(&self) -> &ParticipantOptions {
         &self.options
+    }
+
+    /// Its RTPS GUID in wire order: the GUID prefix every endpoint of it shares, and the
+    /// participant's entity id `00 00 01 c1`.
+    pub fn guid(&self) -> [u8; 16] {
+        self.inner.guid().to_bytes()
     }
 
     fn topic(&self, name: &str, type_name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
@@ -141,16 +160,33 @@ impl Participant {
         Ok(Reader::new(inner, name, usize::try_from(qos.depth).unwrap_or(1)))
     }
 
+    /// Other participants' writers and readers seen so far, writers first.
+    pub fn discovered_endpoints(&self) -> Vec<DiscoveredEndpoint> {
+        let writers = self.inner.discovered_writers().into_iter().map(|w| DiscoveredEndpoint {
+            guid: w.writer_proxy.remote_writer_guid.to_bytes(),
+            writer: true,
+            topic: w.publication_topic_data.topic_name,
+            type_name: w.publication_topic_data.type_name,
+        });
+        let readers = self.inner.discovered_readers().into_iter().map(|r| DiscoveredEndpoint {
+            guid: r.reader_proxy.remote_reader_guid.to_bytes(),
+            writer: false,
+            topic: r.subscription_topic_data.topic_name().clone(),
+            type_name: r.subscription_topic_data.type_name().clone(),
+        });
+        writers.chain(readers).collect()
+    }
+
     /// Topics seen from other participants' writers and readers, by name.
     pub fn discovered_topics(&self) -> Vec<DiscoveredTopic> {
         let mut topics: BTreeMap<(String, String), (usize, usize)> = BTreeMap::new();
-        for w in self.inner.discovered_writers() {
-            let data = &w.publication_topic_data;
-            topics.entry((data.topic_name.clone(), data.type_name.clone())).or_default().0 += 1;
-        }
-        for r in self.inner.discovered_readers() {
-            let data = &r.subscription_topic_data;
-            topics.entry((data.topic_name().clone(), data.type_name().clone())).or_default().1 += 1;
+        for e in self.discovered_endpoints() {
+            let counts = topics.entry((e.topic, e.type_name)).or_default();
+            if e.writer {
+                counts.0 += 1;
+            } else {
+                counts.1 += 1;
+            }
         }
         topics
             .into_iter()

@@ -112,7 +112,7 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Hands every sample this writer publishes to `tap` as its payload (encapsulation header,
     /// body), with the writer's GUID and the source timestamp it is published with.
     pub fn set_tap(&mut self, tap: Option<Tap>) {
-        let guid = self.inner.guid().to_bytes();
+        let guid = self.guid();
         self.tap = tap.map(|tap| (tap, guid));
     }
 
@@ -166,6 +166,21 @@ impl<T: CdrType + 'static> Writer<T> {
                 Err(WriteRefused::Failed)
             }
         }
+    }
+
+    /// Its RTPS GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1): the GID
+    /// ROS 2 names it by.
+    pub fn guid(&self) -> [u8; 16] {
+        self.inner.guid().to_bytes()
+    }
+
+    /// Whether every reliable reader matched has acknowledged every sample written so far;
+    /// waits until they have (or the writer is gone): bring a timeout. Best effort: at once.
+    pub async fn acknowledged(&self) -> Result<bool, DdsError> {
+        self.inner
+            .async_wait_for_acknowledgments()
+            .await
+            .map_err(|source| DdsError::Write { topic: self.topic.clone(), source })
     }
 
     /// Readers of this topic matched so far.
@@ -331,6 +346,12 @@ impl<T: CdrType + 'static> Reader<T> {
                 }
             }
         }
+    }
+
+    /// Its RTPS GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1): the GID
+    /// ROS 2 names it by.
+    pub fn guid(&self) -> [u8; 16] {
+        self.inner.guid().to_bytes()
     }
 
     /// Why the last rejected sample was rejected (the codec's words).

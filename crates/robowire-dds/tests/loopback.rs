@@ -47,13 +47,37 @@ fn lowcmd_and_lowstate_between_two_participants_and_a_call() {
                 loop {
                     writer.write(cmd).unwrap();
                     if let Ok(Ok(sample)) = tokio::time::timeout(Duration::from_millis(50), commands.recv()).await {
-                        break sample.value;
+                        break sample;
                     }
                 }
             })
             .await
             .expect("a LowCmd crossed");
-            assert_eq!(received, cmd.sealed(), "decoded, CRC verified, as sent (sealed)");
+            assert_eq!(received.value, cmd.sealed(), "decoded, CRC verified, as sent (sealed)");
+
+            // GUIDs: the writer's on its samples and in the other side's discovery, under its
+            // participant's prefix.
+            assert_eq!(received.writer, writer.guid());
+            assert_eq!(client.guid()[12..], [0, 0, 1, 0xc1], "the participant entity");
+            assert_eq!(writer.guid()[..12], client.guid()[..12]);
+            assert_eq!(commands.guid()[..12], robot.guid()[..12]);
+            assert_ne!(writer.guid(), client.guid());
+            let seen = |by: &Participant, guid: [u8; 16], is_writer: bool| {
+                by.discovered_endpoints().into_iter().any(|e| {
+                    e.guid == guid
+                        && e.writer == is_writer
+                        && e.topic == LowCmd::TOPIC
+                        && e.type_name == <LowCmd as robowire_core::cdr::CdrType>::TYPE_NAME
+                })
+            };
+            assert!(seen(&robot, writer.guid(), true), "{:?}", robot.discovered_endpoints());
+            tokio::time::timeout(WAIT, async {
+                while !seen(&client, commands.guid(), false) {
+                    tokio::time::sleep(Duration::from_millis(20)).await;
+                }
+            })
+            .await
+            .expect("the client discovers the robot's reader");
             assert!(writer.matched_readers() >= 1);
             assert!(commands.stats().samples >= 1 && commands.stats().checksum_errors == 0);
 

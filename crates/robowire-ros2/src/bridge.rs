@@ -10,6 +10,9 @@ use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, OpenOptions};
 use robowire_record::RecordLinks;
 use tokio::sync::watch;
 
+use ros2_proto::rmw_dds_common::NAME_BOUND;
+
+use crate::graph::{RosDistro, RosGraph};
 use crate::node::{Node, NodeOptions};
 use crate::report::{DeviceCounters, DeviceReport};
 
@@ -36,6 +39,9 @@ pub struct BridgeOptions {
     /// Record every device's own links with this recorder, under the device's namespace
     /// (`kmc0/kmc/serial`).
     pub record_devices: Option<RecordLinks>,
+    /// The layout of `ros_discovery_info` (the nodes in the ROS graph): Humble's 24-byte GIDs
+    /// or Jazzy's 16-byte ones. Default Jazzy.
+    pub ros_distro: RosDistro,
 }
 
 impl BridgeOptions {
@@ -51,6 +57,7 @@ impl BridgeOptions {
             rate_cap_hz: None,
             record: None,
             record_devices: None,
+            ros_distro: RosDistro::default(),
         }
     }
 }
@@ -121,8 +128,13 @@ pub fn namespaces(devices: &[DeviceAddress], namespace: Option<&str>) -> Vec<Str
         .collect()
 }
 
+/// How long the bridge waits at its stop for `ros_discovery_info`'s readers to acknowledge that
+/// its nodes are gone.
+const GRAPH_GOODBYE: Duration = Duration::from_secs(1);
+
 /// Runs the bridge until `stop` is set, then stops every device (chassis stop burst, dog
-/// stop) before returning. `started` receives the devices once every one is open.
+/// stop) and removes its nodes from the ROS graph before returning. `started` receives the
+/// devices once every one is open.
 pub async fn run(
     options: BridgeOptions,
     stop: watch::Receiver<bool>,
@@ -141,6 +153,10 @@ pub async fn run(
     }
     let participant = Participant::new(ParticipantOptions::new(options.domain, options.interface.as_deref()))?;
     let spaces = namespaces(&options.devices, options.namespace.as_deref());
+    if let Some(long) = spaces.iter().find(|ns| ns.len() > NAME_BOUND) {
+        return Err(BridgeError::Option(format!("namespace {long:?} is longer than ROS 2's {NAME_BOUND} bytes")));
+    }
+    let graph = RosGraph::new(&participant, options.ros_distro)?;
     let devices: Vec<BridgedDevice> = options
         .devices
         .iter()
@@ -164,13 +180,20 @@ pub async fn run(
         };
         opened.push(robowire_devices::open(&device.address, &open_options).map_err(failed)?);
     }
+    let ids: Vec<_> = devices.iter().map(|d| graph.add_node(&d.namespace)).collect();
     started(&devices);
-    let runs: Vec<DeviceFuture<'_>> = devices
+    let stopped = |mut stop: watch::Receiver<bool>| async move {
+        let _ = stop.wait_for(|s| *s).await;
+    };
+    let mut runs: Vec<DeviceFuture<'_>> = devices
         .iter()
         .zip(&opened)
-        .map(|(device, open)| {
+        .zip(ids)
+        .map(|((device, open), id)| {
             let node = Node {
                 participant: &participant,
+                graph: &graph,
+                id,
                 options: NodeOptions {
                     namespace: device.namespace.clone(),
                     armed: options.armed,
@@ -179,22 +202,23 @@ pub async fn run(
                     record: options.record.clone(),
                 },
             };
-            let mut stop = stop.clone();
-            let stopped = async move {
-                let _ = stop.wait_for(|s| *s).await;
-            };
             let report = &*device.report;
-            let run: DeviceFuture<'_> = Box::pin(crate::device::run(node, open, report, stopped));
+            let run: DeviceFuture<'_> = Box::pin(crate::device::run(node, open, report, stopped(stop.clone())));
             run
         })
         .collect();
+    runs.push(Box::pin(graph.warn_on_other_layout(&participant, stopped(stop.clone()))));
     let outcome = futures::future::try_join_all(runs).await;
-    // Each device's safe action (the chassis's stop burst, the dog's stop, damping) on close.
+    // Each device's safe action (the chassis's stop burst, the dog's stop, damping) on close,
+    // first; then the nodes leave the graph.
     for device in opened {
         let address = device.address().clone();
         if let Err(e) = device.close() {
             eprintln!("{address}: closing: {}", robowire_devices::error_chain(&e));
         }
+    }
+    if let Err(e) = graph.stop(GRAPH_GOODBYE).await {
+        eprintln!("ros2: removing the nodes from the ROS graph: {e}");
     }
     outcome.map(|_| devices)
 }

@@ -92,11 +92,8 @@ pub(crate) async fn run(
         None
     };
     let ns = node.options.namespace.clone();
-    let mut services: Vec<TriggerService> = device
-        .services()
-        .iter()
-        .map(|name| TriggerService::new(node.participant, &ns, name))
-        .collect::<Result<_, _>>()?;
+    let mut services: Vec<TriggerService> =
+        device.services().iter().map(|name| TriggerService::new(&node, name)).collect::<Result<_, _>>()?;
     let mut guard = CmdVel::new(&node.options);
     let mut observations = device.observations();
     tokio::pin!(stop);
@@ -188,11 +185,11 @@ fn publish(node: &Node<'_>, topics: &mut Topics, observation: &Observation, stam
         let (writer, limiter) = match &mut topics.passthrough {
             Some(made) => made,
             none => none.insert((
-                node.participant.raw_writer(
+                node.listed_writer(node.participant.raw_writer(
                     &ros2_proto::topic(&node.options.namespace, raw.topic),
                     raw.type_name,
                     Qos::ROS_SENSOR_DATA,
-                )?,
+                )?)?,
                 node.limiter(),
             )),
         };

@@ -8,6 +8,7 @@ use robowire_dds::Sample;
 use robowire_record::{RecordLinks, Tap};
 use ros2_proto::geometry::Twist;
 
+use crate::graph::{NodeId, RosGraph};
 use crate::guard::{CmdVelGuard, Verdict};
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, Participant, Reader, Writer};
@@ -28,9 +29,12 @@ pub(crate) struct NodeOptions {
     pub record: Option<RecordLinks>,
 }
 
-/// One device's node: topics in its namespace on the shared participant.
+/// One device's node: topics in its namespace on the shared participant, each endpoint listed
+/// under the node in the ROS graph.
 pub(crate) struct Node<'a> {
     pub(crate) participant: &'a Participant,
+    pub(crate) graph: &'a RosGraph,
+    pub(crate) id: NodeId,
     pub(crate) options: NodeOptions,
 }
 
@@ -39,13 +43,25 @@ impl Node<'_> {
     pub(crate) fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
         let mut writer = self.participant.writer(&ros2_proto::topic(&self.options.namespace, name), qos)?;
         writer.set_tap(self.tap::<T>(name));
-        Ok(writer)
+        self.listed_writer(writer)
     }
 
     /// A reader of the ROS topic `name` in the namespace (recorded if the bridge records).
     pub(crate) fn reader<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Reader<T>, DdsError> {
         let mut reader = self.participant.reader(&ros2_proto::topic(&self.options.namespace, name), qos)?;
         reader.set_tap(self.tap::<T>(name));
+        self.listed_reader(reader)
+    }
+
+    /// `writer`, listed under this node in the ROS graph.
+    pub(crate) fn listed_writer<T: CdrType + 'static>(&self, writer: Writer<T>) -> Result<Writer<T>, DdsError> {
+        self.graph.add_writer(self.id, writer.guid())?;
+        Ok(writer)
+    }
+
+    /// `reader`, listed under this node in the ROS graph.
+    pub(crate) fn listed_reader<T: CdrType + 'static>(&self, reader: Reader<T>) -> Result<Reader<T>, DdsError> {
+        self.graph.add_reader(self.id, reader.guid())?;
         Ok(reader)
     }
 

@@ -1,8 +1,10 @@
 //! `std_srvs/Trigger` services in rmw_cyclonedds' request/reply format.
 
 use robowire_dds::qos::Qos;
-use robowire_dds::{DdsError, Participant, Reader, Writer};
+use robowire_dds::{DdsError, Reader, Writer};
 use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+
+use crate::node::Node;
 
 /// One Trigger service: requests on `rq/NS/NAMERequest`, replies on `rr/NS/NAMEReply`.
 pub(crate) struct TriggerService {
@@ -13,11 +15,15 @@ pub(crate) struct TriggerService {
 }
 
 impl TriggerService {
-    pub(crate) fn new(participant: &Participant, namespace: &str, name: &'static str) -> Result<Self, DdsError> {
+    /// The service `name` of `node`, its request reader and reply writer listed under the node.
+    pub(crate) fn new(node: &Node<'_>, name: &'static str) -> Result<Self, DdsError> {
+        let (participant, namespace) = (node.participant, &node.options.namespace);
         Ok(Self {
             name,
-            requests: participant.reader(&ros2_proto::request_topic(namespace, name), Qos::ROS_DEFAULT)?,
-            replies: participant.writer(&ros2_proto::reply_topic(namespace, name), Qos::ROS_DEFAULT)?,
+            requests: node
+                .listed_reader(participant.reader(&ros2_proto::request_topic(namespace, name), Qos::ROS_DEFAULT)?)?,
+            replies: node
+                .listed_writer(participant.writer(&ros2_proto::reply_topic(namespace, name), Qos::ROS_DEFAULT)?)?,
             last: LastAnswer::default(),
         })
     }

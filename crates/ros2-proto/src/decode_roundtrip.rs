@@ -22,14 +22,16 @@ use crate::builtin::Header;
 use crate::diagnostic::DiagnosticArray;
 use crate::geometry::{TransformStamped, Twist};
 use crate::nav::Odometry;
+use crate::rmw_dds_common::{GID_LEN_HUMBLE, GID_LEN_JAZZY, ParticipantEntitiesInfo};
 use crate::sensor::{BatteryState, Imu, JointState};
 use crate::srv::{TriggerRequest, TriggerResponse};
 use crate::tf::TfMessage;
 
-/// The messages by selector: their DDS type names, and the check of each.
+/// The messages by selector: their Rust type names (two layouts may share a DDS type name), and
+/// the check of each.
 macro_rules! messages {
     ($($ty:ty),* $(,)?) => {
-        const TYPE_NAMES: &[&str] = &[$(<$ty as CdrType>::TYPE_NAME),*];
+        const TYPE_NAMES: &[fn() -> &'static str] = &[$(core::any::type_name::<$ty>),*];
         const CHECKS: &[fn(CdrEncoding, &[u8])] = &[$(check::<$ty>),*];
     };
 }
@@ -46,6 +48,8 @@ messages!(
     DiagnosticArray,
     TriggerRequest,
     TriggerResponse,
+    ParticipantEntitiesInfo<GID_LEN_JAZZY>,
+    ParticipantEntitiesInfo<GID_LEN_HUMBLE>,
 );
 
 /// Top bit of the selector: the body is said to be XCDR2.
@@ -60,7 +64,8 @@ pub fn message_decode(data: &[u8]) {
 
 /// The input that selects `message`'s type, with its XCDR1 body (a seed).
 pub fn input<T: CdrType>(message: &T) -> Vec<u8> {
-    let selector = TYPE_NAMES.iter().position(|name| *name == T::TYPE_NAME).expect("a message of this crate");
+    let selector =
+        TYPE_NAMES.iter().position(|name| name() == core::any::type_name::<T>()).expect("a message of this crate");
     let mut input = vec![selector as u8];
     input.extend(encode(message));
     input
@@ -97,7 +102,10 @@ mod tests {
         assert_eq!(TYPE_NAMES.len(), CHECKS.len());
         let joints = JointState { name: vec!["FR_hip".into()], position: vec![f64::NAN], ..JointState::default() };
         let seed = input(&joints);
-        assert_eq!(usize::from(seed[0]), TYPE_NAMES.iter().position(|n| *n == JointState::TYPE_NAME).unwrap());
+        assert_eq!(
+            usize::from(seed[0]),
+            TYPE_NAMES.iter().position(|n| n() == core::any::type_name::<JointState>()).unwrap()
+        );
         message_decode(&seed);
         let mut xcdr2 = seed;
         xcdr2[0] |= XCDR2;

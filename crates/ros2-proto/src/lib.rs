@@ -22,6 +22,7 @@ pub mod description;
 pub mod diagnostic;
 pub mod geometry;
 pub mod nav;
+pub mod rmw_dds_common;
 pub mod sensor;
 pub mod srv;
 pub mod tf;

@@ -8,6 +8,7 @@ use ros2_proto::geometry::{
     Point, Pose, PoseWithCovariance, Quaternion, Transform, TransformStamped, Twist, TwistWithCovariance, Vector3,
 };
 use ros2_proto::nav::Odometry;
+use ros2_proto::rmw_dds_common::{Gid, NodeEntitiesInfo, ParticipantEntitiesInfo};
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
 use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
 use ros2_proto::tf::TfMessage;
@@ -38,6 +39,9 @@ fn vector3() -> impl Strategy<Value = Vector3> {
 fn quaternion() -> impl Strategy<Value = Quaternion> {
     (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z, w)| Quaternion { x, y, z, w })
 }
+
+/// A node: namespace, name, reader GUIDs, writer GUIDs.
+type Node = (String, String, Vec<[u8; 16]>, Vec<[u8; 16]>);
 
 fn covariance36() -> impl Strategy<Value = [f64; 36]> {
     prop::array::uniform32(-10.0..10.0f64).prop_map(|a| std::array::from_fn(|i| a[i % 32] * (i as f64 + 1.0)))
@@ -114,12 +118,34 @@ proptest! {
     }
 
     #[test]
+    fn participant_entities_info(guid: [u8; 16], nodes in prop::collection::vec((text(), text(), prop::collection::vec(any::<[u8; 16]>(), 0..4), prop::collection::vec(any::<[u8; 16]>(), 0..4)), 0..4)) {
+        fn info<const N: usize>(guid: [u8; 16], nodes: &[Node]) -> ParticipantEntitiesInfo<N> {
+            ParticipantEntitiesInfo {
+                gid: Gid::from_guid(guid),
+                node_entities_info_seq: nodes.iter().map(|(ns, name, readers, writers)| NodeEntitiesInfo {
+                    node_namespace: ns.clone(),
+                    node_name: name.clone(),
+                    reader_gid_seq: readers.iter().copied().map(Gid::from_guid).collect(),
+                    writer_gid_seq: writers.iter().copied().map(Gid::from_guid).collect(),
+                }).collect(),
+            }
+        }
+        let jazzy = round_trip(&info::<16>(guid, &nodes));
+        let humble = round_trip(&info::<24>(guid, &nodes));
+        // GIDs are 16 or 24 bytes, both multiples of every alignment in the body: 8 more bytes each.
+        let gids = 1 + nodes.iter().map(|n| n.2.len() + n.3.len()).sum::<usize>();
+        prop_assert_eq!(humble.len(), jazzy.len() + 8 * gids);
+    }
+
+    #[test]
     fn arbitrary_bytes_never_panic(body in prop::collection::vec(any::<u8>(), 0..256)) {
         let _ = Odometry::decode_body(CdrEncoding::Xcdr1, &body);
         let _ = JointState::decode_body(CdrEncoding::Xcdr1, &body);
         let _ = TfMessage::decode_body(CdrEncoding::Xcdr1, &body);
         let _ = DiagnosticArray::decode_body(CdrEncoding::Xcdr1, &body);
         let _ = BatteryState::decode_body(CdrEncoding::Xcdr1, &body);
+        let _ = ParticipantEntitiesInfo::<16>::decode_body(CdrEncoding::Xcdr1, &body);
+        let _ = ParticipantEntitiesInfo::<24>::decode_body(CdrEncoding::Xcdr1, &body);
     }
 }
 

@@ -12,6 +12,7 @@ use ros2_proto::geometry::{
     Point, Pose, PoseWithCovariance, Quaternion, Transform, TransformStamped, Twist, TwistWithCovariance, Vector3,
 };
 use ros2_proto::nav::Odometry;
+use ros2_proto::rmw_dds_common::{Gid, NodeEntitiesInfo, ParticipantEntitiesInfo};
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
 use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
 use ros2_proto::tf::TfMessage;
@@ -92,6 +93,23 @@ pub(super) fn ros2_seeds() -> Vec<Seed> {
     };
     let id = RequestId { guid: 0x0110_3f5a_0000_0107, seq: 1 };
     let refused = TriggerResponse { id, success: false, message: "refused: the guard holds the robot".into() };
+    // The bridge's graph: one node with a reader and a writer (GUIDs of a rustdds participant).
+    fn guid(entity: [u8; 4]) -> [u8; 16] {
+        let mut g = [0x01, 0x0f, 0x3a, 0x5b, 0, 0, 0, 7, 0, 0, 0, 1, 0, 0, 0, 0];
+        g[12..].copy_from_slice(&entity);
+        g
+    }
+    fn graph<const N: usize>(namespace: &str) -> ParticipantEntitiesInfo<N> {
+        ParticipantEntitiesInfo {
+            gid: Gid::from_guid(guid([0, 0, 1, 0xc1])),
+            node_entities_info_seq: vec![NodeEntitiesInfo {
+                node_namespace: namespace.into(),
+                node_name: "robowire".into(),
+                reader_gid_seq: vec![Gid::from_guid(guid([0, 0, 1, 4]))],
+                writer_gid_seq: vec![Gid::from_guid(guid([0, 0, 2, 3]))],
+            }],
+        }
+    }
     let seeds = [
         ("header-default", input(&Header::default())),
         ("header", input(&header("odom"))),
@@ -116,6 +134,8 @@ pub(super) fn ros2_seeds() -> Vec<Seed> {
         ("trigger-request", input(&TriggerRequest { id, structure_needs_at_least_one_member: 0 })),
         ("trigger-response-default", input(&TriggerResponse::default())),
         ("trigger-response", input(&refused)),
+        ("participant-entities-jazzy", input(&graph::<16>("/kmc0"))),
+        ("participant-entities-humble", input(&graph::<24>("/"))),
     ];
     seeds.into_iter().map(|(name, input)| (format!("seed-{name}"), input)).collect()
 }

@@ -52,6 +52,16 @@ pub enum CdrError {
     /// A representation the message's codec does not read.
     #[error("{0:?} is not read for this type")]
     Encoding(CdrEncoding),
+    /// A bounded string (`string<N>`) longer than its bound.
+    #[error("string {field} is {len} bytes long, longer than its bound {bound}")]
+    Bound {
+        /// The field.
+        field: &'static str,
+        /// Its length in bytes, without the NUL.
+        len: usize,
+        /// The bound, bytes.
+        bound: usize,
+    },
     /// Bytes left after the last field beyond alignment padding.
     #[error("{extra} bytes after the last field")]
     Trailing {
@@ -299,6 +309,12 @@ impl<'a> CdrReader<'a> {
         core::str::from_utf8(text).map_err(|_| CdrError::NotUtf8 { field })
     }
 
+    /// A `string<bound>`: as [`string`](Self::string), at most `bound` bytes before the NUL.
+    pub fn bounded_string(&mut self, field: &'static str, bound: usize) -> Result<&'a str, CdrError> {
+        let s = self.string(field)?;
+        if s.len() > bound { Err(CdrError::Bound { field, len: s.len(), bound }) } else { Ok(s) }
+    }
+
     /// A sequence's element count, checked against what is left: each element takes at least
     /// `min_element_len` bytes (so that a corrupt count never sizes an allocation).
     pub fn count(&mut self, field: &'static str, min_element_len: usize) -> Result<usize, CdrError> {
@@ -360,5 +376,9 @@ mod tests {
         let mut r = CdrReader::new(CdrEncoding::Xcdr1, &[1, 2, 3]);
         assert_eq!(r.f64("x"), Err(CdrError::Truncated { field: "x", needed: 8, found: 3 }));
         assert_eq!(CdrReader::new(CdrEncoding::Xcdr1, &[0; 8]).finish(), Err(CdrError::Trailing { extra: 8 }));
+        let abc = [4, 0, 0, 0, b'a', b'b', b'c', 0];
+        assert_eq!(CdrReader::new(CdrEncoding::Xcdr1, &abc).bounded_string("ns", 3), Ok("abc"));
+        let bound = CdrReader::new(CdrEncoding::Xcdr1, &abc).bounded_string("ns", 2);
+        assert_eq!(bound, Err(CdrError::Bound { field: "ns", len: 3, bound: 2 }));
     }
 }

@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
-use robowire_ros2::{BridgeOptions, DeviceAddress};
+use robowire_ros2::{BridgeOptions, DeviceAddress, RosDistro};
 use serde::Serialize;
 
 #[derive(Debug, Args)]
@@ -35,6 +35,10 @@ pub(crate) struct Ros2Args {
     /// Stop after this many seconds (default: at Ctrl-C or SIGTERM).
     #[arg(long)]
     duration: Option<f64>,
+    /// ROS 2 distribution of the peers: humble (24-byte GIDs in ros_discovery_info) or jazzy
+    /// (16-byte GIDs: Iron and later). Default: $ROS_DISTRO, else jazzy.
+    #[arg(long, value_name = "humble|jazzy")]
+    ros_distro: Option<String>,
     /// At the end, print each device's counters as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -43,6 +47,15 @@ pub(crate) struct Ros2Args {
     /// device's own links beside it, into FILE-devices.mcap.
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
+}
+
+/// `--ros-distro`, else `$ROS_DISTRO`, else Jazzy.
+fn ros_distro(flag: Option<&str>, env: Option<&str>) -> anyhow::Result<RosDistro> {
+    match (flag, env) {
+        (Some(name), _) => name.parse().context("--ros-distro"),
+        (None, Some(name)) => name.parse().context("ROS_DISTRO (or give --ros-distro)"),
+        (None, None) => Ok(RosDistro::default()),
+    }
 }
 
 #[derive(Serialize)]
@@ -64,6 +77,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         Some(s) => anyhow::bail!("--duration must be 0–1e6 s, got {s}"),
         None => None,
     };
+    let ros_distro = ros_distro(args.ros_distro.as_deref(), std::env::var("ROS_DISTRO").ok().as_deref())?;
     let recorder = args.record.start_ros2("robowire ros2")?;
     let devices_recorder = args.record.beside("devices").start("robowire ros2")?;
     let options = BridgeOptions {
@@ -75,6 +89,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         rate_cap_hz: args.rate,
         record: recorder.as_ref().map(robowire_record::Recorder::links),
         record_devices: devices_recorder.as_ref().map(robowire_record::Recorder::links),
+        ros_distro,
         ..BridgeOptions::new(args.devices.clone())
     };
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
@@ -100,9 +115,15 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         let devices = robowire_ros2::run(options, stop, |devices| {
             for d in devices {
                 let ns = if d.namespace.is_empty() { "/" } else { &d.namespace };
-                eprintln!("ros2: {} as {ns} on domain {}", d.address, args.domain);
+                eprintln!(
+                    "ros2: {} as {ns} on domain {} (node {}/{})",
+                    d.address,
+                    args.domain,
+                    ns.trim_end_matches('/'),
+                    robowire_ros2::NODE_NAME
+                );
             }
-            eprintln!("ros2: ready ({armed})");
+            eprintln!("ros2: ready ({armed}; ros_discovery_info for {ros_distro})");
         })
         .await
         .context("the ROS 2 bridge")?;
@@ -136,4 +157,19 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string(&report)?);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_flag_wins_then_ros_distro_then_jazzy() {
+        assert_eq!(ros_distro(Some("humble"), Some("jazzy")).unwrap(), RosDistro::Humble);
+        assert_eq!(ros_distro(None, Some("humble")).unwrap(), RosDistro::Humble);
+        assert_eq!(ros_distro(None, None).unwrap(), RosDistro::Jazzy);
+        let unknown = ros_distro(None, Some("rolling")).unwrap_err();
+        assert!(format!("{unknown:#}").contains("ROS_DISTRO") && format!("{unknown:#}").contains("\"rolling\""));
+        assert!(ros_distro(Some("foxy"), Some("humble")).is_err());
+    }
 }

@@ -15,6 +15,10 @@ Scenarios:
 - sense_go2: rt/NS/joint_states and rt/NS/imu of a Go2, and rt/NS/lowstate with Unitree's class.
 - sense_g1: rt/NS/joint_states and rt/NS/battery_state of a G1, and rt/NS/lowstate with Unitree's
   HG class.
+- graph_jazzy, graph_humble (NAMESPACE unused): reads ros_discovery_info as rmw does (reliable,
+  transient local, keep all; 16- or 24-byte GIDs) and DDS discovery's DCPSPublication and
+  DCPSSubscription, until the other participant's sample lists every endpoint discovery shows of
+  it; prints its nodes with each GID and the endpoint whose discovery key it equals.
 """
 
 import json
@@ -22,6 +26,7 @@ import sys
 import time
 from dataclasses import asdict
 
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
 from cyclonedds.core import Policy, Qos
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.pub import DataWriter
@@ -29,7 +34,7 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from ros2_types import BatteryState, DiagnosticArray, Imu, JointState, Odometry, TFMessage, TriggerRequest, TriggerResponse, Twist, Vector3
+from ros2_types import BatteryState, DiagnosticArray, Imu, JointState, Odometry, TFMessage, TriggerRequest, TriggerResponse, Twist, Vector3, graph_types
 
 RELIABLE = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.History.KeepLast(10))
 SENSOR = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(5))
@@ -189,6 +194,62 @@ def stand_up(dp, ns):
     return {"guid_matches": reply.guid == guid, "seq": reply.seq, "success": reply.success, "message": reply.message}
 
 
+def graph(dp, gid_len):
+    Gid, NodeEntitiesInfo, ParticipantEntitiesInfo = graph_types(gid_len)
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)),
+        Policy.Durability.TransientLocal,
+        Policy.History.KeepAll,
+    )
+    infos = DataReader(dp, Topic(dp, "ros_discovery_info", ParticipantEntitiesInfo), qos=qos)
+    publications = BuiltinDataReader(dp, BuiltinTopicDcpsPublication)
+    subscriptions = BuiltinDataReader(dp, BuiltinTopicDcpsSubscription)
+    endpoints = {}  # discovery key (GUID bytes) -> endpoint
+    latest = None
+    deadline = time.monotonic() + 20.0
+    while True:
+        for info in infos.take(N=100):
+            latest = info
+        for kind, reader in (("writer", publications), ("reader", subscriptions)):
+            for e in reader.take(N=100):
+                endpoints[e.key.bytes] = {
+                    "kind": kind,
+                    "topic": e.topic_name,
+                    "type": e.type_name,
+                    "participant": e.participant_key.bytes.hex(),
+                }
+        if latest is not None and graph_complete(latest, endpoints):
+            break
+        if time.monotonic() > deadline:
+            raise SystemExit(f"no complete ros_discovery_info within 20 s: {latest} {endpoints}")
+        time.sleep(0.02)
+
+    def resolved(gids):
+        return [{"gid": bytes(g.data).hex(), **endpoints.get(bytes(g.data)[:16], {})} for g in gids]
+
+    return {
+        "gid": bytes(latest.gid.data).hex(),
+        "nodes": [
+            {
+                "namespace": n.node_namespace,
+                "name": n.node_name,
+                "writers": resolved(n.writer_gid_seq),
+                "readers": resolved(n.reader_gid_seq),
+            }
+            for n in latest.node_entities_info_seq
+        ],
+    }
+
+
+def graph_complete(info, endpoints):
+    """Whether every GID of `info` is a discovered endpoint's key and every endpoint discovered of
+    its participant (but ros_discovery_info's) is listed."""
+    gid = bytes(info.gid.data)[:16]
+    listed = [bytes(g.data)[:16] for n in info.node_entities_info_seq for g in n.reader_gid_seq + n.writer_gid_seq]
+    theirs = [k for k, e in endpoints.items() if k[:12] == gid[:12] and e["topic"] != "ros_discovery_info"]
+    return bool(listed) and all(k in endpoints for k in listed) and sorted(listed) == sorted(theirs)
+
+
 def no_nan(value):
     """JSON has no NaN: ROS's "not measured" becomes null."""
     if isinstance(value, float) and value != value:
@@ -211,6 +272,8 @@ def main():
         "sense_g1": sense_g1,
         "sense_chassis": sense_chassis,
         "stand_up": stand_up,
+        "graph_jazzy": lambda dp, _ns: graph(dp, 16),
+        "graph_humble": lambda dp, _ns: graph(dp, 24),
     }
     result = scenarios[scenario](dp, ns)
     print(json.dumps(no_nan(result), allow_nan=False))

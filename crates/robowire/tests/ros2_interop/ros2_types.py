@@ -6,7 +6,7 @@ payloads."""
 from dataclasses import dataclass, field
 
 from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.types import array, float32, float64, int32, int64, sequence, uint8, uint32, uint64
+from cyclonedds.idl.types import array, bounded_str, float32, float64, int32, int64, sequence, uint8, uint32, uint64
 
 
 @dataclass
@@ -171,3 +171,26 @@ class TriggerResponse(IdlStruct, typename="std_srvs::srv::dds_::Trigger_Response
     seq: int64 = 0
     success: bool = False
     message: str = ""
+
+
+def graph_types(gid_len):
+    """rmw_dds_common's Gid, NodeEntitiesInfo and ParticipantEntitiesInfo with `gid_len`-byte
+    GIDs (16 from Iron on, 24 in Humble): one layout per process, both under one type name."""
+
+    @dataclass
+    class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
+        data: array[uint8, gid_len] = field(default_factory=lambda: [0] * gid_len)
+
+    @dataclass
+    class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):
+        node_namespace: bounded_str[256] = ""
+        node_name: bounded_str[256] = ""
+        reader_gid_seq: sequence[Gid] = field(default_factory=list)
+        writer_gid_seq: sequence[Gid] = field(default_factory=list)
+
+    @dataclass
+    class ParticipantEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"):
+        gid: Gid = field(default_factory=Gid)
+        node_entities_info_seq: sequence[NodeEntitiesInfo] = field(default_factory=list)
+
+    return Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
