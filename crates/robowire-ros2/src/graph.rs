@@ -52,6 +52,15 @@ impl RosDistro {
         }
     }
 
+    /// The layout of a distribution as `$ROS_DISTRO` names it: `humble`, or one of Iron and later
+    /// (`iron`, `jazzy`, `kilted`, `rolling`: 16-byte GIDs, Jazzy's layout).
+    pub fn of_environment(ros_distro: &str) -> Result<Self, UnknownDistro> {
+        match ros_distro {
+            "iron" | "kilted" | "rolling" => Ok(Self::Jazzy),
+            other => other.parse(),
+        }
+    }
+
     /// `humble` or `jazzy`.
     pub fn name(self) -> &'static str {
         match self {

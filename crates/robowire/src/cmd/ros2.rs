@@ -36,7 +36,8 @@ pub(crate) struct Ros2Args {
     #[arg(long)]
     duration: Option<f64>,
     /// ROS 2 distribution of the peers: humble (24-byte GIDs in ros_discovery_info) or jazzy
-    /// (16-byte GIDs: Iron and later). Default: $ROS_DISTRO, else jazzy.
+    /// (16-byte GIDs: Iron and later). Default: $ROS_DISTRO (humble; iron, jazzy, kilted or
+    /// rolling as jazzy), else jazzy.
     #[arg(long, value_name = "humble|jazzy")]
     ros_distro: Option<String>,
     /// At the end, print each device's counters as JSON on stdout.
@@ -53,7 +54,7 @@ pub(crate) struct Ros2Args {
 fn ros_distro(flag: Option<&str>, env: Option<&str>) -> anyhow::Result<RosDistro> {
     match (flag, env) {
         (Some(name), _) => name.parse().context("--ros-distro"),
-        (None, Some(name)) => name.parse().context("ROS_DISTRO (or give --ros-distro)"),
+        (None, Some(name)) => RosDistro::of_environment(name).context("ROS_DISTRO (or give --ros-distro)"),
         (None, None) => Ok(RosDistro::default()),
     }
 }
@@ -168,8 +169,11 @@ mod tests {
         assert_eq!(ros_distro(Some("humble"), Some("jazzy")).unwrap(), RosDistro::Humble);
         assert_eq!(ros_distro(None, Some("humble")).unwrap(), RosDistro::Humble);
         assert_eq!(ros_distro(None, None).unwrap(), RosDistro::Jazzy);
-        let unknown = ros_distro(None, Some("rolling")).unwrap_err();
-        assert!(format!("{unknown:#}").contains("ROS_DISTRO") && format!("{unknown:#}").contains("\"rolling\""));
+        assert_eq!(ros_distro(None, Some("rolling")).unwrap(), RosDistro::Jazzy, "Iron and later: 16-byte GIDs");
+        assert_eq!(ros_distro(None, Some("iron")).unwrap(), RosDistro::Jazzy);
+        assert!(ros_distro(Some("rolling"), None).is_err(), "the flag names the layout: humble or jazzy");
+        let unknown = ros_distro(None, Some("foxy")).unwrap_err();
+        assert!(format!("{unknown:#}").contains("ROS_DISTRO") && format!("{unknown:#}").contains("\"foxy\""));
         assert!(ros_distro(Some("foxy"), Some("humble")).is_err());
     }
 }
