@@ -15,4 +15,4 @@ mod topic;
 pub use adapter::fuzz_check_sample;
 pub use error::DdsError;
 pub use participant::{DiscoveredEndpoint, DiscoveredTopic, Participant, ParticipantOptions};
-pub use topic::{RawSample, Reader, Sample, StatsHandle, TopicStats, WriteRefused, Writer};
+pub use topic::{RawSample, Reader, Sample, SampleIdentity, StatsHandle, TopicStats, WriteRefused, Writer};

@@ -11,7 +11,7 @@ use std::marker::PhantomData;
 use robowire_core::cdr::CdrType;
 use robowire_tap::{Direction, SLOT_BYTES, SampleOrigin, Tap};
 use rustdds::no_key::{DataWriter, SimpleDataReader};
-use rustdds::{DataWriterStatus, RTPSEntity, StatusEvented, Timestamp};
+use rustdds::{DataWriterStatus, GUID, RTPSEntity, SequenceNumber, StatusEvented, Timestamp, WriteOptionsBuilder};
 
 use crate::DdsError;
 use crate::adapter::{CdrAdapter, Decoded, TakenPayload, TapDecoder};
@@ -116,17 +116,21 @@ impl<T: CdrType + 'static> Writer<T> {
         self.tap = tap.map(|tap| (tap, guid));
     }
 
-    /// Publishes `sample`, its payload first handed to the tap if there is one: the payload as
-    /// rustdds will send it, encoded on the stack (no allocation), and the source timestamp
-    /// given to rustdds so that the tap's and the wire's agree.
-    fn publish(&self, sample: T) -> Result<(), rustdds::dds::WriteError<T>> {
-        let Some((tap, guid)) = &self.tap else { return self.inner.write(sample, None) };
+    /// Publishes `sample` (with `related` as its related sample identity, if any), its payload
+    /// first handed to the tap if there is one: the payload as rustdds will send it, encoded on
+    /// the stack (no allocation), and the source timestamp given to rustdds so that the tap's and
+    /// the wire's agree.
+    fn publish(&self, sample: T, related: Option<SampleIdentity>) -> Result<(), rustdds::dds::WriteError<T>> {
+        let options = WriteOptionsBuilder::new().related_sample_identity_opt(related.map(SampleIdentity::to_rustdds));
+        let Some((tap, guid)) = &self.tap else {
+            return self.inner.write_with_options(sample, options.build()).map(drop);
+        };
         let source = Timestamp::now();
         let mut payload = [0u8; SLOT_BYTES];
         let [a, b] = <CdrAdapter<T> as rustdds::no_key::SerializerAdapter<T>>::output_encoding().to_bytes();
         payload[..4].copy_from_slice(&[a, b, 0, 0]);
         let body = sample.encode_body(&mut payload[4..]).ok();
-        self.inner.write(sample, Some(source))?;
+        self.inner.write_with_options(sample, options.source_timestamp(source).build())?;
         let origin = SampleOrigin { writer: Some(*guid), source_unix_ns: Some(unix_ns(source)) };
         match body {
             Some(n) => tap.record_parts(Direction::Sent, &[&payload[..4 + n]], origin),
@@ -137,7 +141,18 @@ impl<T: CdrType + 'static> Writer<T> {
 
     /// Encodes `sample` with its codec and publishes it.
     pub fn write(&self, sample: T) -> Result<(), DdsError> {
-        match self.publish(sample) {
+        self.write_with(sample, None)
+    }
+
+    /// Publishes `sample` with `related` as its related sample identity (sent as inline QoS
+    /// under both PID 0x0083 and eProsima's 0x800f): a reply naming the request it answers, as
+    /// rmw_fastrtps' services do.
+    pub fn write_related(&self, sample: T, related: SampleIdentity) -> Result<(), DdsError> {
+        self.write_with(sample, Some(related))
+    }
+
+    fn write_with(&self, sample: T, related: Option<SampleIdentity>) -> Result<(), DdsError> {
+        match self.publish(sample, related) {
             Ok(()) => {
                 Counters::bump(&self.counters.samples);
                 Ok(())
@@ -152,7 +167,7 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Publishes `sample` without ever waiting (with [`Qos::STREAM_WRITER`](crate::qos::Qos::STREAM_WRITER)):
     /// a full send window drops it. No allocation on a refusal. For stream threads.
     pub fn try_write(&self, sample: T) -> Result<(), WriteRefused> {
-        match self.publish(sample) {
+        match self.publish(sample, None) {
             Ok(()) => {
                 Counters::bump(&self.counters.samples);
                 Ok(())
@@ -216,6 +231,44 @@ pub struct Sample<T> {
     pub value: T,
     /// The GUID of the writer that sent it (tells two publishers on one topic apart).
     pub writer: [u8; 16],
+    /// Its RTPS sequence number at that writer (from 1).
+    pub sequence: i64,
+    /// The related sample identity its writer sent with it (inline QoS PID 0x0083 or 0x800f),
+    /// if any: for a request of rmw_fastrtps, where the reply goes.
+    pub related: Option<SampleIdentity>,
+}
+
+/// A sample's identity: its writer's GUID and its sequence number there (DDS-RPC's
+/// `SampleIdentity`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SampleIdentity {
+    /// The writer's GUID in wire order (prefix 12 bytes, entity key 3, entity kind 1); all zero:
+    /// unknown.
+    pub writer: [u8; 16],
+    /// The sequence number; [`SampleIdentity::SEQUENCE_UNKNOWN`]: unknown.
+    pub sequence: i64,
+}
+
+impl SampleIdentity {
+    /// RTPS's unknown sequence number (high −1, low 0), what rmw_fastrtps' clients send in
+    /// their requests' related sample identity.
+    pub const SEQUENCE_UNKNOWN: i64 = -1 << 32;
+
+    /// Whether the writer GUID is known (not all zero).
+    pub fn writer_known(&self) -> bool {
+        self.writer != [0; 16]
+    }
+
+    fn to_rustdds(self) -> rustdds::rpc::SampleIdentity {
+        rustdds::rpc::SampleIdentity {
+            writer_guid: GUID::from_bytes(self.writer),
+            sequence_number: SequenceNumber::from(self.sequence),
+        }
+    }
+
+    fn of_rustdds(identity: rustdds::rpc::SampleIdentity) -> Self {
+        Self { writer: identity.writer_guid.to_bytes(), sequence: identity.sequence_number.into() }
+    }
 }
 
 /// Samples a reader takes between two drains of rustdds's notification socketpair.
@@ -327,7 +380,12 @@ impl<T: CdrType + 'static> Reader<T> {
                         if self.kept.len() == self.depth {
                             self.kept.pop_front();
                         }
-                        self.kept.push_back(Sample { value, writer: change.writer_guid.to_bytes() });
+                        self.kept.push_back(Sample {
+                            value,
+                            writer: change.writer_guid.to_bytes(),
+                            sequence: change.sequence_number.into(),
+                            related: change.write_options.related_sample_identity().map(SampleIdentity::of_rustdds),
+                        });
                     }
                     Err(failure) => {
                         let counter = if failure.checksum {

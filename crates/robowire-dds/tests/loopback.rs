@@ -177,3 +177,48 @@ fn a_reader_delivers_the_newest_depth_samples_oldest_first() {
         })
     });
 }
+
+/// A sample's RTPS sequence number and its related sample identity cross the wire: a plain write
+/// carries none, `write_related` the one given (as an rmw_fastrtps reply names its request),
+/// an unknown sequence number included.
+#[test]
+fn a_related_sample_identity_and_the_sequence_number_cross() {
+    use robowire_dds::SampleIdentity;
+    with_loopback_multicast(|| {
+        runtime().block_on(async {
+            let options = ParticipantOptions::new(0, Some("lo"));
+            let robot = Participant::new(options.clone()).unwrap();
+            let client = Participant::new(options).unwrap();
+            let reliable = Qos { reliable: true, depth: 16, ..Qos::READER };
+            let mut reader = robot.reader::<LowCmd>(LowCmd::TOPIC, reliable).unwrap();
+            let writer = client.writer::<LowCmd>(LowCmd::TOPIC, Qos { reliable: true, ..Qos::WRITER }).unwrap();
+            let first = tokio::time::timeout(WAIT, async {
+                loop {
+                    writer.write(tagged(0)).unwrap();
+                    if let Ok(Ok(sample)) = tokio::time::timeout(Duration::from_millis(50), reader.recv()).await {
+                        break sample;
+                    }
+                }
+            })
+            .await
+            .expect("the reader matched");
+            assert_eq!(first.related, None, "a plain write names no other sample");
+            assert!(first.sequence >= 1, "{first:?}");
+            let related = SampleIdentity { writer: reader.guid(), sequence: 42 };
+            let unknown = SampleIdentity { writer: reader.guid(), sequence: SampleIdentity::SEQUENCE_UNKNOWN };
+            writer.write_related(tagged(1), related).unwrap();
+            writer.write_related(tagged(2), unknown).unwrap();
+            let mut seen = Vec::new();
+            while seen.len() < 2 {
+                let sample = tokio::time::timeout(WAIT, reader.recv()).await.expect("the related samples").unwrap();
+                if sample.value.reserve.get() != 0 {
+                    seen.push(sample);
+                }
+            }
+            assert_eq!((seen[0].related, seen[1].related), (Some(related), Some(unknown)));
+            assert_eq!(seen[1].sequence, seen[0].sequence + 1, "consecutive sequence numbers");
+            assert!(seen[0].sequence > first.sequence);
+            assert!(unknown.writer_known() && !SampleIdentity { writer: [0; 16], sequence: 1 }.writer_known());
+        })
+    });
+}
