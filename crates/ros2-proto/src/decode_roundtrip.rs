@@ -24,7 +24,7 @@ use crate::geometry::{TransformStamped, Twist};
 use crate::nav::Odometry;
 use crate::rmw_dds_common::{GID_LEN_HUMBLE, GID_LEN_JAZZY, ParticipantEntitiesInfo};
 use crate::sensor::{BatteryState, Imu, JointState};
-use crate::srv::{TriggerRequest, TriggerResponse};
+use crate::srv::{AnyTriggerRequest, TriggerRequest, TriggerRequestBody, TriggerResponse, TriggerResponseBody};
 use crate::tf::TfMessage;
 
 /// The messages by selector: their Rust type names (two layouts may share a DDS type name), and
@@ -50,6 +50,9 @@ messages!(
     TriggerResponse,
     ParticipantEntitiesInfo<GID_LEN_JAZZY>,
     ParticipantEntitiesInfo<GID_LEN_HUMBLE>,
+    TriggerRequestBody,
+    TriggerResponseBody,
+    AnyTriggerRequest,
 );
 
 /// Top bit of the selector: the body is said to be XCDR2.

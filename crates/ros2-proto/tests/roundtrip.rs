@@ -10,7 +10,9 @@ use ros2_proto::geometry::{
 use ros2_proto::nav::Odometry;
 use ros2_proto::rmw_dds_common::{Gid, NodeEntitiesInfo, ParticipantEntitiesInfo};
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
-use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+use ros2_proto::srv::{
+    AnyTriggerRequest, RequestId, TriggerRequest, TriggerRequestBody, TriggerResponse, TriggerResponseBody,
+};
 use ros2_proto::tf::TfMessage;
 
 fn round_trip<T: CdrType + PartialEq + std::fmt::Debug>(message: &T) -> Vec<u8> {
@@ -114,7 +116,10 @@ proptest! {
     fn trigger(guid: u64, seq: i64, success: bool, message in text()) {
         let id = RequestId { guid, seq };
         prop_assert_eq!(round_trip(&TriggerRequest { id, structure_needs_at_least_one_member: 0 }).len(), 17);
-        round_trip(&TriggerResponse { id, success, message });
+        let with_header = round_trip(&TriggerResponse { id, success, message: message.clone() });
+        prop_assert_eq!(round_trip(&TriggerRequestBody::default()).len(), 1, "rmw_fastrtps' bare request");
+        let bare = round_trip(&TriggerResponseBody { success, message });
+        prop_assert_eq!(&with_header[16..], &bare[..], "the two mappings differ by the 16-byte header only");
     }
 
     #[test]
@@ -185,4 +190,26 @@ fn xcdr2_and_lying_counts_are_refused() {
     let mut body = round_trip(&TriggerResponse::default());
     body[16] = 7;
     assert!(matches!(TriggerResponse::decode_body(CdrEncoding::Xcdr1, &body), Err(CdrError::Bool { value: 7, .. })));
+}
+
+/// A Trigger request's mapping is told by its length: rmw_cyclonedds' header and struct (17
+/// bytes, padded to 24 by some writers), rmw_fastrtps' bare struct (1 byte, padded up to 8);
+/// anything between or shorter is refused.
+#[test]
+fn a_trigger_requests_mapping_is_told_by_its_length() {
+    let id = RequestId { guid: 0x0110_3f5a_0000_0107, seq: 3 };
+    let mut with_header = round_trip(&TriggerRequest { id, structure_needs_at_least_one_member: 0 });
+    let decode = |body: &[u8]| AnyTriggerRequest::decode_body(CdrEncoding::Xcdr1, body);
+    let expected = AnyTriggerRequest::WithHeader(TriggerRequest { id, structure_needs_at_least_one_member: 0 });
+    assert_eq!(decode(&with_header), Ok(expected.clone()));
+    with_header.resize(24, 0);
+    assert_eq!(decode(&with_header), Ok(expected));
+    let bare = AnyTriggerRequest::Bare(TriggerRequestBody::default());
+    assert_eq!(decode(&[0]), Ok(bare.clone()));
+    assert_eq!(decode(&[0; 8]), Ok(bare));
+    for len in [0, 9, 12, 16] {
+        assert!(decode(&vec![0; len]).is_err(), "{len} bytes: neither shape");
+    }
+    assert!(decode(&with_header[..20]).is_ok(), "17 to 24 bytes: the header's shape");
+    assert!(AnyTriggerRequest::decode_body(CdrEncoding::Xcdr2, &[0]).is_err());
 }

@@ -14,7 +14,7 @@ use ros2_proto::geometry::{
 use ros2_proto::nav::Odometry;
 use ros2_proto::rmw_dds_common::{Gid, NodeEntitiesInfo, ParticipantEntitiesInfo};
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
-use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+use ros2_proto::srv::{RequestId, TriggerRequest, TriggerRequestBody, TriggerResponse, TriggerResponseBody};
 use ros2_proto::tf::TfMessage;
 
 /// A named seed input.
@@ -136,6 +136,8 @@ pub(super) fn ros2_seeds() -> Vec<Seed> {
         ("trigger-response", input(&refused)),
         ("participant-entities-jazzy", input(&graph::<16>("/kmc0"))),
         ("participant-entities-humble", input(&graph::<24>("/"))),
+        ("trigger-request-body", input(&TriggerRequestBody::default())),
+        ("trigger-response-body", input(&TriggerResponseBody { success: refused.success, message: refused.message })),
     ];
     seeds.into_iter().map(|(name, input)| (format!("seed-{name}"), input)).collect()
 }
