@@ -21,7 +21,7 @@ use ros2_proto::tf::TfMessage;
 use crate::bridge::BridgeError;
 use crate::node::{CmdVel, Node, RateLimiter, stamp_now};
 use crate::report::DeviceReport;
-use crate::service::TriggerService;
+use crate::service::{Caller, TriggerService};
 
 /// A topic's writer, made when the device first reports what it carries, and its rate cap.
 struct Topic<T: robowire_core::cdr::CdrType + 'static> {
@@ -94,6 +94,9 @@ pub(crate) async fn run(
     let ns = node.options.namespace.clone();
     let mut services: Vec<TriggerService> =
         device.services().iter().map(|name| TriggerService::new(&node, name)).collect::<Result<_, _>>()?;
+    for service in &services {
+        report.watch_requests(service.requests_stats());
+    }
     let mut guard = CmdVel::new(&node.options);
     let mut observations = device.observations();
     tokio::pin!(stop);
@@ -124,16 +127,16 @@ pub(crate) async fn run(
                 report.set_guard(guard.guard.counters());
             }
             (i, request) = next_request(&mut services), if !services.is_empty() => {
-                let request = request?.value;
+                let caller = Caller::of(&request?);
                 let service = &mut services[i];
-                if let Some(sent) = service.answer_again(&request) {
+                if let Some(sent) = service.answer_again(caller) {
                     sent?;
                 } else {
                     let (success, message) = match device.call(service.name) {
                         Ok(said) => (true, said),
                         Err(e) => (false, robowire_devices::error_chain(&e)),
                     };
-                    service.reply(&request, success, message)?;
+                    service.reply(caller, success, message)?;
                     report.service_call();
                 }
             }
@@ -144,7 +147,7 @@ pub(crate) async fn run(
 /// The first request of any of the services (at least one).
 async fn next_request(
     services: &mut [TriggerService],
-) -> (usize, Result<robowire_dds::Sample<ros2_proto::srv::TriggerRequest>, DdsError>) {
+) -> (usize, Result<robowire_dds::Sample<ros2_proto::srv::AnyTriggerRequest>, DdsError>) {
     let waits = services.iter_mut().map(|s| Box::pin(s.requests.recv()));
     let (result, i, _) = futures::future::select_all(waits).await;
     (i, result)

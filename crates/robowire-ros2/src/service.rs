@@ -1,16 +1,50 @@
-//! `std_srvs/Trigger` services in rmw_cyclonedds' request/reply format.
+//! `std_srvs/Trigger` services that answer clients of both ROS 2 middlewares, the mapping chosen
+//! per request.
+//!
+//! What decides is the request itself: a body longer than rmw_cyclonedds' 16-byte header is
+//! rmw_cyclonedds' mapping (the header is echoed in the reply's body); a bare request (1 byte,
+//! padded up to 8) is rmw_fastrtps' (the reply carries the request's identity as its related
+//! sample identity: the reader the client named in the request's related sample identity, else
+//! the request's writer, with the request's sequence number). rmw_cyclonedds' clients also announce
+//! `clientid=` in their writers' USER_DATA, which rustdds 0.15 does not reliably hand over, so
+//! it is not used. A request of neither shape is counted by the request reader as a decode error
+//! and not answered.
 
 use robowire_dds::qos::Qos;
-use robowire_dds::{DdsError, Reader, Writer};
-use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+use robowire_dds::{DdsError, Reader, Sample, SampleIdentity, StatsHandle, Writer};
+use ros2_proto::srv::{AnyTriggerRequest, AnyTriggerResponse, RequestId, TriggerResponse, TriggerResponseBody};
 
 use crate::node::Node;
+
+/// Who asked, in which mapping: what names the request in the reply.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Caller {
+    /// rmw_cyclonedds: the request's header, echoed in the reply's body.
+    Cyclone(RequestId),
+    /// rmw_fastrtps: the reply's related sample identity.
+    FastRtps(SampleIdentity),
+}
+
+impl Caller {
+    /// The caller of `request` and what its reply must name.
+    pub(crate) fn of(request: &Sample<AnyTriggerRequest>) -> Self {
+        match &request.value {
+            AnyTriggerRequest::WithHeader(r) => Self::Cyclone(r.id),
+            AnyTriggerRequest::Bare(_) => {
+                // rmw_fastrtps' client names its reply reader (with an unknown sequence number);
+                // without a known writer GUID there, the request's own writer.
+                let writer = request.related.filter(SampleIdentity::writer_known).map_or(request.writer, |r| r.writer);
+                Self::FastRtps(SampleIdentity { writer, sequence: request.sequence })
+            }
+        }
+    }
+}
 
 /// One Trigger service: requests on `rq/NS/NAMERequest`, replies on `rr/NS/NAMEReply`.
 pub(crate) struct TriggerService {
     pub(crate) name: &'static str,
-    pub(crate) requests: Reader<TriggerRequest>,
-    replies: Writer<TriggerResponse>,
+    pub(crate) requests: Reader<AnyTriggerRequest>,
+    replies: Writer<AnyTriggerResponse>,
     last: LastAnswer,
 }
 
@@ -28,44 +62,93 @@ impl TriggerService {
         })
     }
 
-    /// The answer already given to `request` if it is the last one answered, sent again: a
-    /// client that did not see the reply yet asks again with the same id, and the robot must not
-    /// act twice. `None`: a new request, for the device.
-    pub(crate) fn answer_again(&self, request: &TriggerRequest) -> Option<Result<(), DdsError>> {
-        let (success, message) = self.last.to(request.id)?;
-        Some(self.replies.write(TriggerResponse { id: request.id, success, message: message.to_owned() }))
+    /// The request reader's counters (requests of neither shape are its decode errors).
+    pub(crate) fn requests_stats(&self) -> StatsHandle {
+        self.requests.stats_handle()
     }
 
-    /// Answers `request`.
-    pub(crate) fn reply(&mut self, request: &TriggerRequest, success: bool, message: String) -> Result<(), DdsError> {
-        self.last = LastAnswer(Some((request.id, success, message.clone())));
-        self.replies.write(TriggerResponse { id: request.id, success, message })
+    /// The answer already given to `caller` if it is the last one answered, sent again: a
+    /// client that did not see the reply yet asks again with the same id, and the robot must not
+    /// act twice. `None`: a new request, for the device.
+    pub(crate) fn answer_again(&self, caller: Caller) -> Option<Result<(), DdsError>> {
+        let (success, message) = self.last.to(caller)?;
+        Some(self.send(caller, success, message.to_owned()))
+    }
+
+    /// Answers `caller`.
+    pub(crate) fn reply(&mut self, caller: Caller, success: bool, message: String) -> Result<(), DdsError> {
+        self.last = LastAnswer(Some((caller, success, message.clone())));
+        self.send(caller, success, message)
+    }
+
+    /// The reply in `caller`'s mapping.
+    fn send(&self, caller: Caller, success: bool, message: String) -> Result<(), DdsError> {
+        match caller {
+            Caller::Cyclone(id) => {
+                self.replies.write(AnyTriggerResponse::WithHeader(TriggerResponse { id, success, message }))
+            }
+            Caller::FastRtps(request) => {
+                self.replies.write_related(AnyTriggerResponse::Bare(TriggerResponseBody { success, message }), request)
+            }
+        }
     }
 }
 
 /// The last request a service answered, and its answer.
 #[derive(Debug, Default)]
-struct LastAnswer(Option<(RequestId, bool, String)>);
+struct LastAnswer(Option<(Caller, bool, String)>);
 
 impl LastAnswer {
-    /// The answer to `id`, if it was the last one answered.
-    fn to(&self, id: RequestId) -> Option<(bool, &str)> {
-        self.0.as_ref().filter(|(last, ..)| *last == id).map(|(_, success, message)| (*success, message.as_str()))
+    /// The answer to `caller`, if it was the last one answered.
+    fn to(&self, caller: Caller) -> Option<(bool, &str)> {
+        self.0.as_ref().filter(|(last, ..)| *last == caller).map(|(_, success, message)| (*success, message.as_str()))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ros2_proto::srv::{TriggerRequest, TriggerRequestBody};
 
     #[test]
     fn only_the_last_request_answered_is_answered_again() {
-        let first = RequestId { guid: 7, seq: 1 };
+        let first = Caller::Cyclone(RequestId { guid: 7, seq: 1 });
         let mut last = LastAnswer::default();
         assert_eq!(last.to(first), None);
         last = LastAnswer(Some((first, true, "standing".into())));
         assert_eq!(last.to(first), Some((true, "standing")));
-        assert_eq!(last.to(RequestId { seq: 2, ..first }), None, "the client's next request is new");
-        assert_eq!(last.to(RequestId { guid: 8, ..first }), None, "another client's is new");
+        assert_eq!(last.to(Caller::Cyclone(RequestId { guid: 7, seq: 2 })), None, "the client's next request is new");
+        assert_eq!(last.to(Caller::Cyclone(RequestId { guid: 8, seq: 1 })), None, "another client's is new");
+        let fast = Caller::FastRtps(SampleIdentity { writer: [7; 16], sequence: 1 });
+        assert_eq!(last.to(fast), None, "the other mapping's is new");
+    }
+
+    const WRITER: [u8; 16] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 0, 0, 1, 3];
+    const REPLY_READER: [u8; 16] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 0, 0, 2, 4];
+
+    fn sample(value: AnyTriggerRequest, related: Option<SampleIdentity>) -> Sample<AnyTriggerRequest> {
+        Sample { value, writer: WRITER, sequence: 5, related }
+    }
+
+    #[test]
+    fn the_request_tells_the_mapping_and_what_the_reply_names() {
+        let id = RequestId { guid: 0x0110_3f5a_0000_0107, seq: 3 };
+        let cyclone = AnyTriggerRequest::WithHeader(TriggerRequest { id, structure_needs_at_least_one_member: 0 });
+        assert_eq!(Caller::of(&sample(cyclone.clone(), None)), Caller::Cyclone(id));
+        // ros2-client's Cyclone mapping sends a related identity too: the header decides.
+        let named = Some(SampleIdentity { writer: REPLY_READER, sequence: 9 });
+        assert_eq!(Caller::of(&sample(cyclone, named)), Caller::Cyclone(id));
+
+        let bare = AnyTriggerRequest::Bare(TriggerRequestBody::default());
+        let fast_dds = Some(SampleIdentity { writer: REPLY_READER, sequence: SampleIdentity::SEQUENCE_UNKNOWN });
+        assert_eq!(
+            Caller::of(&sample(bare.clone(), fast_dds)),
+            Caller::FastRtps(SampleIdentity { writer: REPLY_READER, sequence: 5 }),
+            "Fast DDS: its reply reader, the request's sequence number"
+        );
+        let unknown_writer = Some(SampleIdentity { writer: [0; 16], sequence: SampleIdentity::SEQUENCE_UNKNOWN });
+        let own = Caller::FastRtps(SampleIdentity { writer: WRITER, sequence: 5 });
+        assert_eq!(Caller::of(&sample(bare.clone(), unknown_writer)), own, "an unknown GUID: the request's writer");
+        assert_eq!(Caller::of(&sample(bare, None)), own, "no related identity: the request's own identity");
     }
 }

@@ -138,10 +138,11 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
     for d in &report {
         let c = &d.counters;
         eprintln!(
-            "ros2: {} published {} samples, answered {} service calls; cmd_vel: {} received, {} applied, {} unarmed, {} invalid, {} refused, {} deadman stops, {} publishers",
+            "ros2: {} published {} samples, answered {} service calls ({} malformed requests not answered); cmd_vel: {} received, {} applied, {} unarmed, {} invalid, {} refused, {} deadman stops, {} publishers",
             d.device,
             c.published,
             c.service_calls,
+            c.malformed_requests,
             c.cmd_vel.received,
             c.cmd_vel.applied,
             c.cmd_vel.unarmed,
