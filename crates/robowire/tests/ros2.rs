@@ -7,7 +7,9 @@
 //! G1's topics are read by that peer (Unitree's HG classes) and by robowire's own DDS readers.
 //! The bridge's nodes on `ros_discovery_info` (Jazzy's and Humble's GID sizes) are read by that
 //! peer and by robowire's own DDS, each GID matched to the GUID DDS discovery reports for the
-//! bridge's endpoint; a Humble bridge warns once of a Jazzy peer.
+//! bridge's endpoint; a Humble bridge warns once of a Jazzy peer. ros2-client (an independent
+//! ROS 2 client library, no Python) calls `stand_up` in rmw_fastrtps' and rmw_cyclonedds'
+//! service mappings; a request of neither shape is counted and not answered.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -508,4 +510,117 @@ fn a_cyclonedds_peer_reads_the_bridges_nodes_jazzy() {
 #[test]
 fn a_cyclonedds_peer_reads_the_bridges_nodes_humble() {
     a_cyclonedds_peer_reads_the_bridges_nodes("humble", 24);
+}
+
+/// `std_srvs/Trigger` as ros2-client (an independent ROS 2 client library on rustdds) declares it.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct TriggerRequest {
+    structure_needs_at_least_one_member: u8,
+}
+impl ros2_client::Message for TriggerRequest {}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct TriggerResponse {
+    success: bool,
+    message: String,
+}
+impl ros2_client::Message for TriggerResponse {}
+
+/// ros2-client calls a simulated dog's `stand_up` (one device: the root namespace) in rmw_fastrtps'
+/// mapping (its `Enhanced`: the bare request, the reply named by its related sample identity) and
+/// in rmw_cyclonedds' (the 16-byte header before the request, echoed): the bridge answers both.
+/// A bridge per mapping: rustdds hands a new reply reader the replies written before it, and
+/// ros2-client fails a call on a reply of the other mapping's shape instead of skipping it.
+#[test]
+fn a_ros2_client_calls_stand_up_in_both_middlewares_mappings() {
+    use ros2_client::{Context, Name, NodeName, NodeOptions, QosProfile, ServiceMapping, ServiceTypeName};
+    use std::net::{IpAddr, Ipv4Addr};
+
+    with_loopback_multicast(|| {
+        for (middleware, mapping) in
+            [("rmw_fastrtps", ServiceMapping::Enhanced), ("rmw_cyclonedds", ServiceMapping::Cyclone)]
+        {
+            let bridge = Bridge::start(&["--device", "sim:zsl1", "--interface", "lo"]);
+            let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+            let reply = runtime.block_on(async {
+                let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(0)
+                    .with_only_networks([IpAddr::V4(Ipv4Addr::LOCALHOST)])
+                    .build()
+                    .unwrap();
+                let context = Context::from_domain_participant(participant).unwrap();
+                let mut node =
+                    context.new_node(NodeName::new("/", "trigger_caller").unwrap(), NodeOptions::new()).unwrap();
+                // Reliable, as the bridge's request reader (ros2-client's default QoS is best effort).
+                let qos = QosProfile::publisher_default();
+                let (name, type_name) =
+                    (Name::new("/", "stand_up").unwrap(), ServiceTypeName::new("std_srvs", "Trigger"));
+                let client = node
+                    .create_client::<TriggerRequest, TriggerResponse>(mapping, &name, &type_name, qos.clone(), qos)
+                    .unwrap();
+                tokio::spawn(node.spinner().unwrap().spin());
+                let found = tokio::time::timeout(GRAPH_WAIT, client.wait_for_service(&node)).await;
+                assert!(found.is_ok(), "{middleware}: the service's reader and writer matched");
+                let call = client.async_call_service(TriggerRequest { structure_needs_at_least_one_member: 0 });
+                tokio::time::timeout(GRAPH_WAIT, call)
+                    .await
+                    .unwrap_or_else(|_| panic!("{middleware}: no answer: {}", bridge.log()))
+                    .unwrap_or_else(|e| panic!("{middleware}: {e:?}"))
+            });
+            assert!(reply.success, "{middleware}: {reply:?}");
+            assert!(reply.message.starts_with("stand_up sent"), "{middleware}: {reply:?}");
+            let counters = bridge.stop();
+            assert_eq!(counters[0]["service_calls"], 1, "{middleware}: {:?}", counters[0]);
+            assert_eq!(counters[0]["malformed_requests"], 0, "{middleware}");
+        }
+    });
+}
+
+/// A Trigger request of neither mapping's shape (too long for the bare request, too short for
+/// rmw_cyclonedds' header and request) is counted and not answered; the bridge answers the next.
+#[test]
+fn a_request_of_neither_shape_is_counted_and_not_answered() {
+    use robowire_core::cdr::{CdrEncoding, CdrType};
+    use robowire_dds::{Participant, ParticipantOptions, RawSample};
+    use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+
+    with_loopback_multicast(|| {
+        let bridge = Bridge::start(&["--device", "sim:zsl1", "--interface", "lo"]);
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        runtime.block_on(async {
+            let participant = Participant::new(ParticipantOptions::new(0, Some("lo"))).unwrap();
+            let qos = robowire_dds::qos::Qos::ROS_DEFAULT;
+            let requests = participant.raw_writer("rq/stand_upRequest", TriggerRequest::TYPE_NAME, qos).unwrap();
+            let matched = tokio::time::timeout(GRAPH_WAIT, async {
+                while requests.matched_readers() == 0 {
+                    tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+                }
+            })
+            .await;
+            assert!(matched.is_ok(), "the bridge's request reader matched");
+            for len in [12, 0] {
+                requests.write(RawSample { encoding: CdrEncoding::Xcdr1, body: vec![0; len] }).unwrap();
+            }
+            // Then a good request (rmw_cyclonedds' shape), asked again until its answer comes
+            // (the same id: answered again, acted on once): taken after the two bad ones.
+            let mut replies = participant.reader::<TriggerResponse>("rr/stand_upReply", qos).unwrap();
+            let id = RequestId { guid: 7, seq: 1 };
+            let mut good = vec![0; 17];
+            TriggerRequest { id, structure_needs_at_least_one_member: 0 }.encode_body(&mut good).unwrap();
+            let answered = tokio::time::timeout(GRAPH_WAIT, async {
+                loop {
+                    requests.write(RawSample { encoding: CdrEncoding::Xcdr1, body: good.clone() }).unwrap();
+                    let reply = tokio::time::timeout(std::time::Duration::from_millis(200), replies.recv()).await;
+                    if let Ok(reply) = reply {
+                        break reply.unwrap().value;
+                    }
+                }
+            })
+            .await
+            .expect("the good request is answered");
+            assert!(answered.id == id && answered.success, "{answered:?}");
+        });
+        let counters = bridge.stop();
+        assert_eq!(counters[0]["malformed_requests"], 2, "{:?}", counters[0]);
+        assert_eq!(counters[0]["service_calls"], 1);
+    });
 }
