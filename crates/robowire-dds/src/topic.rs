@@ -119,43 +119,48 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Publishes `sample` (with `related` as its related sample identity, if any), its payload
     /// first handed to the tap if there is one: the payload as rustdds will send it, encoded on
     /// the stack (no allocation), and the source timestamp given to rustdds so that the tap's and
-    /// the wire's agree.
-    fn publish(&self, sample: T, related: Option<SampleIdentity>) -> Result<(), rustdds::dds::WriteError<T>> {
+    /// the wire's agree. The written sample's own identity.
+    fn publish(
+        &self,
+        sample: T,
+        related: Option<SampleIdentity>,
+    ) -> Result<SampleIdentity, rustdds::dds::WriteError<T>> {
         let options = WriteOptionsBuilder::new().related_sample_identity_opt(related.map(SampleIdentity::to_rustdds));
         let Some((tap, guid)) = &self.tap else {
-            return self.inner.write_with_options(sample, options.build()).map(drop);
+            return self.inner.write_with_options(sample, options.build()).map(SampleIdentity::of_rustdds);
         };
         let source = Timestamp::now();
         let mut payload = [0u8; SLOT_BYTES];
         let [a, b] = <CdrAdapter<T> as rustdds::no_key::SerializerAdapter<T>>::output_encoding().to_bytes();
         payload[..4].copy_from_slice(&[a, b, 0, 0]);
         let body = sample.encode_body(&mut payload[4..]).ok();
-        self.inner.write_with_options(sample, options.source_timestamp(source).build())?;
+        let written = self.inner.write_with_options(sample, options.source_timestamp(source).build())?;
         let origin = SampleOrigin { writer: Some(*guid), source_unix_ns: Some(unix_ns(source)) };
         match body {
             Some(n) => tap.record_parts(Direction::Sent, &[&payload[..4 + n]], origin),
             None => tap.count_oversize(),
         }
-        Ok(())
+        Ok(SampleIdentity::of_rustdds(written))
     }
 
     /// Encodes `sample` with its codec and publishes it.
     pub fn write(&self, sample: T) -> Result<(), DdsError> {
-        self.write_with(sample, None)
+        self.write_with(sample, None).map(drop)
     }
 
     /// Publishes `sample` with `related` as its related sample identity (sent as inline QoS
     /// under both PID 0x0083 and eProsima's 0x800f): a reply naming the request it answers, as
-    /// rmw_fastrtps' services do.
-    pub fn write_related(&self, sample: T, related: SampleIdentity) -> Result<(), DdsError> {
+    /// rmw_fastrtps' services do. The written sample's own identity (this writer's GUID, its
+    /// sequence number): what an answer to it names.
+    pub fn write_related(&self, sample: T, related: SampleIdentity) -> Result<SampleIdentity, DdsError> {
         self.write_with(sample, Some(related))
     }
 
-    fn write_with(&self, sample: T, related: Option<SampleIdentity>) -> Result<(), DdsError> {
+    fn write_with(&self, sample: T, related: Option<SampleIdentity>) -> Result<SampleIdentity, DdsError> {
         match self.publish(sample, related) {
-            Ok(()) => {
+            Ok(written) => {
                 Counters::bump(&self.counters.samples);
-                Ok(())
+                Ok(written)
             }
             Err(e) => {
                 Counters::bump(&self.counters.write_errors);
@@ -168,7 +173,7 @@ impl<T: CdrType + 'static> Writer<T> {
     /// a full send window drops it. No allocation on a refusal. For stream threads.
     pub fn try_write(&self, sample: T) -> Result<(), WriteRefused> {
         match self.publish(sample, None) {
-            Ok(()) => {
+            Ok(_) => {
                 Counters::bump(&self.counters.samples);
                 Ok(())
             }

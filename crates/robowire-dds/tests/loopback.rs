@@ -206,8 +206,13 @@ fn a_related_sample_identity_and_the_sequence_number_cross() {
             assert!(first.sequence >= 1, "{first:?}");
             let related = SampleIdentity { writer: reader.guid(), sequence: 42 };
             let unknown = SampleIdentity { writer: reader.guid(), sequence: SampleIdentity::SEQUENCE_UNKNOWN };
-            writer.write_related(tagged(1), related).unwrap();
-            writer.write_related(tagged(2), unknown).unwrap();
+            let one = writer.write_related(tagged(1), related).unwrap();
+            let two = writer.write_related(tagged(2), unknown).unwrap();
+            assert_eq!(
+                (one.writer, two.sequence),
+                (writer.guid(), one.sequence + 1),
+                "the written samples' identities"
+            );
             let mut seen = Vec::new();
             while seen.len() < 2 {
                 let sample = tokio::time::timeout(WAIT, reader.recv()).await.expect("the related samples").unwrap();
@@ -216,7 +221,7 @@ fn a_related_sample_identity_and_the_sequence_number_cross() {
                 }
             }
             assert_eq!((seen[0].related, seen[1].related), (Some(related), Some(unknown)));
-            assert_eq!(seen[1].sequence, seen[0].sequence + 1, "consecutive sequence numbers");
+            assert_eq!((seen[0].sequence, seen[1].sequence), (one.sequence, two.sequence), "as written");
             assert!(seen[0].sequence > first.sequence);
             assert!(unknown.writer_known() && !SampleIdentity { writer: [0; 16], sequence: 1 }.writer_known());
         })

@@ -88,7 +88,8 @@ impl TriggerService {
                 self.replies.write(AnyTriggerResponse::WithHeader(TriggerResponse { id, success, message }))
             }
             Caller::FastRtps(request) => {
-                self.replies.write_related(AnyTriggerResponse::Bare(TriggerResponseBody { success, message }), request)
+                let reply = AnyTriggerResponse::Bare(TriggerResponseBody { success, message });
+                self.replies.write_related(reply, request).map(drop)
             }
         }
     }
