@@ -576,12 +576,14 @@ fn a_ros2_client_calls_stand_up_in_both_middlewares_mappings() {
 }
 
 /// A Trigger request of neither mapping's shape (too long for the bare request, too short for
-/// rmw_cyclonedds' header and request) is counted and not answered; the bridge answers the next.
+/// rmw_cyclonedds' header and request) is counted and not answered; then a request as Fast DDS
+/// sends it (bare, its related sample identity naming the client's reply reader with an unknown
+/// sequence number) is answered with a reply naming that reader and the request's sequence number.
 #[test]
-fn a_request_of_neither_shape_is_counted_and_not_answered() {
+fn a_request_of_neither_shape_is_counted_and_a_fast_dds_request_answered() {
     use robowire_core::cdr::{CdrEncoding, CdrType};
-    use robowire_dds::{Participant, ParticipantOptions, RawSample};
-    use ros2_proto::srv::{RequestId, TriggerRequest, TriggerResponse};
+    use robowire_dds::{Participant, ParticipantOptions, RawSample, SampleIdentity};
+    use ros2_proto::srv::{TriggerRequest, TriggerRequestBody, TriggerResponseBody};
 
     with_loopback_multicast(|| {
         let bridge = Bridge::start(&["--device", "sim:zsl1", "--interface", "lo"]);
@@ -589,38 +591,45 @@ fn a_request_of_neither_shape_is_counted_and_not_answered() {
         runtime.block_on(async {
             let participant = Participant::new(ParticipantOptions::new(0, Some("lo"))).unwrap();
             let qos = robowire_dds::qos::Qos::ROS_DEFAULT;
-            let requests = participant.raw_writer("rq/stand_upRequest", TriggerRequest::TYPE_NAME, qos).unwrap();
+            let bad = participant.raw_writer("rq/stand_upRequest", TriggerRequest::TYPE_NAME, qos).unwrap();
+            let requests = participant.writer::<TriggerRequestBody>("rq/stand_upRequest", qos).unwrap();
+            let mut replies = participant.reader::<TriggerResponseBody>("rr/stand_upReply", qos).unwrap();
             let matched = tokio::time::timeout(GRAPH_WAIT, async {
-                while requests.matched_readers() == 0 {
+                while bad.matched_readers() == 0 || requests.matched_readers() == 0 {
                     tokio::time::sleep(std::time::Duration::from_millis(20)).await;
                 }
             })
             .await;
             assert!(matched.is_ok(), "the bridge's request reader matched");
             for len in [12, 0] {
-                requests.write(RawSample { encoding: CdrEncoding::Xcdr1, body: vec![0; len] }).unwrap();
+                bad.write(RawSample { encoding: CdrEncoding::Xcdr1, body: vec![0; len] }).unwrap();
             }
-            // Then a good request (rmw_cyclonedds' shape), asked again until its answer comes
-            // (the same id: answered again, acted on once): taken after the two bad ones.
-            let mut replies = participant.reader::<TriggerResponse>("rr/stand_upReply", qos).unwrap();
-            let id = RequestId { guid: 7, seq: 1 };
-            let mut good = vec![0; 17];
-            TriggerRequest { id, structure_needs_at_least_one_member: 0 }.encode_body(&mut good).unwrap();
-            let answered = tokio::time::timeout(GRAPH_WAIT, async {
+            let acknowledged = tokio::time::timeout(GRAPH_WAIT, bad.acknowledged()).await;
+            assert!(matches!(acknowledged, Ok(Ok(true))), "the bridge has both bad requests");
+            // Asked again (a new request each time) until the reply writer has matched the reader.
+            let reply_to = SampleIdentity { writer: replies.guid(), sequence: SampleIdentity::SEQUENCE_UNKNOWN };
+            let mut sent = Vec::new();
+            let reply = tokio::time::timeout(GRAPH_WAIT, async {
                 loop {
-                    requests.write(RawSample { encoding: CdrEncoding::Xcdr1, body: good.clone() }).unwrap();
+                    sent.push(requests.write_related(TriggerRequestBody::default(), reply_to).unwrap());
                     let reply = tokio::time::timeout(std::time::Duration::from_millis(200), replies.recv()).await;
                     if let Ok(reply) = reply {
-                        break reply.unwrap().value;
+                        break reply.unwrap();
                     }
                 }
             })
             .await
-            .expect("the good request is answered");
-            assert!(answered.id == id && answered.success, "{answered:?}");
+            .expect("the Fast DDS request is answered");
+            assert!(reply.value.success && reply.value.message.starts_with("stand_up sent"), "{reply:?}");
+            let named = reply.related.expect("the reply names its request");
+            assert_eq!(named.writer, replies.guid(), "the client's reply reader");
+            assert!(
+                sent.iter().any(|s| s.sequence == named.sequence),
+                "a request's sequence number: {named:?} {sent:?}"
+            );
         });
         let counters = bridge.stop();
         assert_eq!(counters[0]["malformed_requests"], 2, "{:?}", counters[0]);
-        assert_eq!(counters[0]["service_calls"], 1);
+        assert!(counters[0]["service_calls"].as_u64().unwrap() >= 1);
     });
 }
