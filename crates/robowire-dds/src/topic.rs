@@ -1,8 +1,8 @@
 //! Typed writers and readers with their counters.
 
 use std::collections::VecDeque;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll};
 
 use std::cell::RefCell;
@@ -94,6 +94,9 @@ pub struct Writer<T: CdrType + 'static> {
     counters: Arc<Counters>,
     /// Matched readers, from the last publication-matched status seen.
     matched: AtomicI64,
+    /// The matched readers' GUIDs, from the publication-matched statuses seen (taken only by
+    /// the `matched`/`reader_matched` queries, never by a write).
+    matched_guids: Mutex<Vec<[u8; 16]>>,
     /// Where each sample written goes as its payload, with this writer's GUID.
     tap: Option<(Tap, [u8; 16])>,
 }
@@ -106,7 +109,14 @@ impl<T: CdrType + 'static> std::fmt::Debug for Writer<T> {
 
 impl<T: CdrType + 'static> Writer<T> {
     pub(crate) fn new(inner: DataWriter<T, CdrAdapter<T>>, topic: &str) -> Self {
-        Self { inner, topic: topic.into(), counters: Arc::default(), matched: AtomicI64::new(0), tap: None }
+        Self {
+            inner,
+            topic: topic.into(),
+            counters: Arc::default(),
+            matched: AtomicI64::new(0),
+            matched_guids: Mutex::default(),
+            tap: None,
+        }
     }
 
     /// Hands every sample this writer publishes to `tap` as its payload (encapsulation header,
@@ -205,12 +215,30 @@ impl<T: CdrType + 'static> Writer<T> {
 
     /// Readers of this topic matched so far.
     pub fn matched_readers(&self) -> usize {
+        self.take_statuses();
+        usize::try_from(self.matched.load(Ordering::Relaxed)).unwrap_or(0)
+    }
+
+    /// Whether the reader whose GUID (wire order) is `reader` is matched now: a reply to it
+    /// written before would be lost (volatile).
+    pub fn reader_matched(&self, reader: [u8; 16]) -> bool {
+        self.take_statuses();
+        robowire_rt::lock(&self.matched_guids).contains(&reader)
+    }
+
+    /// The publication-matched statuses since the last look, into the count and the GUIDs.
+    fn take_statuses(&self) {
         while let Some(status) = self.inner.try_recv_status() {
-            if let DataWriterStatus::PublicationMatched { current, .. } = status {
+            if let DataWriterStatus::PublicationMatched { current, reader, .. } = status {
                 self.matched.store(i64::from(current.count()), Ordering::Relaxed);
+                let mut guids = robowire_rt::lock(&self.matched_guids);
+                let reader = reader.to_bytes();
+                guids.retain(|g| *g != reader);
+                if current.count_change() > 0 {
+                    guids.push(reader);
+                }
             }
         }
-        usize::try_from(self.matched.load(Ordering::Relaxed)).unwrap_or(0)
     }
 
     /// The topic.

@@ -203,6 +203,14 @@ fn a_related_sample_identity_and_the_sequence_number_cross() {
             .await
             .expect("the reader matched");
             assert_eq!(first.related, None, "a plain write names no other sample");
+            let matched = tokio::time::timeout(WAIT, async {
+                while !writer.reader_matched(reader.guid()) {
+                    tokio::time::sleep(Duration::from_millis(10)).await;
+                }
+            })
+            .await;
+            assert!(matched.is_ok(), "the writer names its matched reader");
+            assert!(!writer.reader_matched(writer.guid()), "not a reader of it");
             assert!(first.sequence >= 1, "{first:?}");
             let related = SampleIdentity { writer: reader.guid(), sequence: 42 };
             let unknown = SampleIdentity { writer: reader.guid(), sequence: SampleIdentity::SEQUENCE_UNKNOWN };

@@ -130,13 +130,13 @@ pub(crate) async fn run(
                 let caller = Caller::of(&request?);
                 let service = &mut services[i];
                 if let Some(sent) = service.answer_again(caller) {
-                    sent?;
+                    sent.await?;
                 } else {
                     let (success, message) = match device.call(service.name) {
                         Ok(said) => (true, said),
                         Err(e) => (false, robowire_devices::error_chain(&e)),
                     };
-                    service.reply(caller, success, message)?;
+                    service.reply(caller, success, message).await?;
                     report.service_call();
                 }
             }

@@ -5,10 +5,13 @@
 //! rmw_cyclonedds' mapping (the header is echoed in the reply's body); a bare request (1 byte,
 //! padded up to 8) is rmw_fastrtps' (the reply carries the request's identity as its related
 //! sample identity: the reader the client named in the request's related sample identity, else
-//! the request's writer, with the request's sequence number). rmw_cyclonedds' clients also announce
+//! the request's writer, with the request's sequence number; a reply to a named reader waits up
+//! to 100 ms for that reader to be matched, as rmw_fastrtps does). rmw_cyclonedds' clients also announce
 //! `clientid=` in their writers' USER_DATA, which rustdds 0.15 does not reliably hand over, so
 //! it is not used. A request of neither shape is counted by the request reader as a decode error
 //! and not answered.
+
+use std::time::Duration;
 
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, Reader, Sample, SampleIdentity, StatsHandle, Writer};
@@ -40,6 +43,13 @@ impl Caller {
     }
 }
 
+/// How long a reply waits for the reader an rmw_fastrtps client named to be matched (as
+/// rmw_fastrtps and rmw_cyclonedds wait, 100 ms): a volatile reply written before is lost.
+const REPLY_READER_WAIT: Duration = Duration::from_millis(100);
+
+/// How often the reply writer's matches are looked at meanwhile.
+const REPLY_READER_POLL: Duration = Duration::from_millis(10);
+
 /// One Trigger service: requests on `rq/NS/NAMERequest`, replies on `rr/NS/NAMEReply`.
 pub(crate) struct TriggerService {
     pub(crate) name: &'static str,
@@ -70,27 +80,45 @@ impl TriggerService {
     /// The answer already given to `caller` if it is the last one answered, sent again: a
     /// client that did not see the reply yet asks again with the same id, and the robot must not
     /// act twice. `None`: a new request, for the device.
-    pub(crate) fn answer_again(&self, caller: Caller) -> Option<Result<(), DdsError>> {
+    pub(crate) fn answer_again(&self, caller: Caller) -> Option<impl Future<Output = Result<(), DdsError>> + '_> {
         let (success, message) = self.last.to(caller)?;
-        Some(self.send(caller, success, message.to_owned()))
+        Some(send(&self.replies, caller, success, message.to_owned()))
     }
 
     /// Answers `caller`.
-    pub(crate) fn reply(&mut self, caller: Caller, success: bool, message: String) -> Result<(), DdsError> {
+    pub(crate) fn reply(
+        &mut self,
+        caller: Caller,
+        success: bool,
+        message: String,
+    ) -> impl Future<Output = Result<(), DdsError>> + '_ {
         self.last = LastAnswer(Some((caller, success, message.clone())));
-        self.send(caller, success, message)
+        send(&self.replies, caller, success, message)
     }
+}
 
-    /// The reply in `caller`'s mapping.
-    fn send(&self, caller: Caller, success: bool, message: String) -> Result<(), DdsError> {
-        match caller {
-            Caller::Cyclone(id) => {
-                self.replies.write(AnyTriggerResponse::WithHeader(TriggerResponse { id, success, message }))
+/// The reply in `caller`'s mapping on `replies`; to a reader an rmw_fastrtps client named, once
+/// that reader is matched or after [`REPLY_READER_WAIT`] (then sent anyway).
+async fn send(
+    replies: &Writer<AnyTriggerResponse>,
+    caller: Caller,
+    success: bool,
+    message: String,
+) -> Result<(), DdsError> {
+    match caller {
+        Caller::Cyclone(id) => replies.write(AnyTriggerResponse::WithHeader(TriggerResponse { id, success, message })),
+        Caller::FastRtps(request) => {
+            // A GUID whose entity kind has the reader bit (0x04): the client's reply reader.
+            if request.writer[15] & 0x04 != 0 {
+                let matched = async {
+                    while !replies.reader_matched(request.writer) {
+                        tokio::time::sleep(REPLY_READER_POLL).await;
+                    }
+                };
+                let _ = tokio::time::timeout(REPLY_READER_WAIT, matched).await;
             }
-            Caller::FastRtps(request) => {
-                let reply = AnyTriggerResponse::Bare(TriggerResponseBody { success, message });
-                self.replies.write_related(reply, request).map(drop)
-            }
+            let reply = AnyTriggerResponse::Bare(TriggerResponseBody { success, message });
+            replies.write_related(reply, request).map(drop)
         }
     }
 }

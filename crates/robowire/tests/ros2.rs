@@ -606,7 +606,8 @@ fn a_request_of_neither_shape_is_counted_and_a_fast_dds_request_answered() {
             }
             let acknowledged = tokio::time::timeout(GRAPH_WAIT, bad.acknowledged()).await;
             assert!(matches!(acknowledged, Ok(Ok(true))), "the bridge has both bad requests");
-            // Asked again (a new request each time) until the reply writer has matched the reader.
+            // Asked again (a new request each time) if no reply comes (the bridge waits at most
+            // 100 ms for its reply writer to match the reader named).
             let reply_to = SampleIdentity { writer: replies.guid(), sequence: SampleIdentity::SEQUENCE_UNKNOWN };
             let mut sent = Vec::new();
             let reply = tokio::time::timeout(GRAPH_WAIT, async {
