@@ -5,6 +5,7 @@
 pub mod architecture;
 pub mod bench;
 mod bench_apps;
+mod bench_lowcmd;
 pub mod fuzz;
 pub mod golden;
 pub mod python;

@@ -46,11 +46,6 @@ fn open(record: Option<&RecordLinks>) -> anyhow::Result<robowire_devices::AnyDev
     super::open_simulated(robowire_devices::SimKind::G1, &options)
 }
 
-/// Every joint held at `q` with the example's gains (PR mode).
-fn hold(robot: &G1, q: &[f32; JOINTS]) -> Result<(), G1Error> {
-    robot.hold(q)
-}
-
 /// A command that holds `q` with the ankles' pitch and roll given as A and B motor angles (AB
 /// mode).
 fn hold_ab(mode_machine: u8, q: &[f32; JOINTS]) -> HgLowCmd {
@@ -187,7 +182,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
 
         // 2. Release: before it the robot ignores LowCmds.
         let start = robot.joint_positions().context("no state")?;
-        hold(robot, &start)?;
+        robot.hold(&start)?;
         let ignored = until(Duration::from_secs(5), || sim.snapshot().lowcmd.ignored_mode > 0).await;
         let ignored = if ignored { sim.snapshot().lowcmd.ignored_mode } else { 0 };
         let released = robot.release().await.context("releasing the controller")?;
@@ -203,10 +198,10 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         let from = robot.joint_positions().context("no state")?;
         stream(sim, phase, &mut progress, "zero", robot, |t| {
             let ratio = (t / phase.as_secs_f32()).clamp(0.0, 1.0);
-            hold(robot, &std::array::from_fn(|i| (1.0 - ratio) * from[i]))
+            robot.hold(&std::array::from_fn(|i| (1.0 - ratio) * from[i]))
         })
         .await?;
-        stream(sim, Duration::from_millis(300), &mut progress, "hold", robot, |_| hold(robot, &[0.0; JOINTS])).await?;
+        stream(sim, Duration::from_millis(300), &mut progress, "hold", robot, |_| robot.hold(&[0.0; JOINTS])).await?;
         let zero_error = sim.snapshot().joints_rad.iter().fold(0.0f32, |m, q| m.max(q.abs()));
         out.line(format_args!(
             "  zero     every joint from where it stood to 0 rad over {:.1} s: largest |q| {zero_error:.4} rad",
@@ -214,7 +209,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         ));
 
         // 4. The ankles swing at 1 Hz, first as pitch/roll joints (PR), then as their A/B motors.
-        let pr = stream(sim, phase, &mut progress, "swing PR", robot, |t| hold(robot, &swing(t))).await?;
+        let pr = stream(sim, phase, &mut progress, "swing PR", robot, |t| robot.hold(&swing(t))).await?;
         let ab = stream(sim, phase, &mut progress, "swing AB", robot, |t| {
             robot.set_command(hold_ab(mode_machine, &swing(t)))
         })
@@ -223,7 +218,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
             "  ankles   ±{SWING_PITCH_RAD} rad pitch at 1 Hz: PR {:+.3}..{:+.3} rad, AB (motors A/B) {:+.3}..{:+.3} rad",
             pr.min, pr.max, ab.min, ab.max
         ));
-        stream(sim, Duration::from_millis(200), &mut progress, "hold", robot, |_| hold(robot, &[0.0; JOINTS])).await?;
+        stream(sim, Duration::from_millis(200), &mut progress, "hold", robot, |_| robot.hold(&[0.0; JOINTS])).await?;
 
         // 5. The two frames the robot accepts and ignores: refused by the client; sent anyway.
         let mut wrong_machine = rules::hold(&[0.0; JOINTS], mode_machine, rules::G1Variant::Dof29);
@@ -242,10 +237,10 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         let raw = robot.low_level().participant().writer::<HgLowCmd>(HgLowCmd::TOPIC, Qos::WRITER)?;
         let _ = until(Duration::from_secs(5), || raw.matched_readers() > 0).await;
         for _ in 0..RAW_FRAMES {
-            hold(robot, &[0.0; JOINTS])?;
+            robot.hold(&[0.0; JOINTS])?;
             raw.write(wrong_machine)?;
             tokio::time::sleep(Duration::from_millis(10)).await;
-            hold(robot, &[0.0; JOINTS])?;
+            robot.hold(&[0.0; JOINTS])?;
             raw.write(disabled)?;
             tokio::time::sleep(Duration::from_millis(10)).await;
         }
