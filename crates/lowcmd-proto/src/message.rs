@@ -7,7 +7,7 @@ use crate::cdr::CdrEncoding;
 use crate::crc::crc32_words_in_place;
 use crate::field::{FieldError, FieldPlace, FieldValue};
 use crate::layout::{PadRange, StructLayout, padding_count, padding_mask, padding_ranges};
-use crate::plan::{CdrPlan, PlanError, header_count, plan_body_len, plan_headers, plan_runs, run_count};
+use crate::plan::{CdrPlan, cdr_plan};
 use crate::{DecodeError, go2, hg};
 
 /// Largest struct image (HG `LowState_`).
@@ -172,10 +172,7 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
     /// Writes the CDR body of the sealed message (no encapsulation header: for a DDS library
     /// that writes the header itself) into `out`; returns its length.
     fn encode_cdr_body(&self, encoding: CdrEncoding, out: &mut [u8]) -> Result<usize, BufferTooSmall> {
-        let (needed, available) = (Self::cdr_plan(encoding).body_len, out.len());
-        let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
-        Self::cdr_plan(encoding).encode(self.sealed().as_bytes(), dst);
-        Ok(needed)
+        Self::cdr_plan(encoding).encode_into(self.sealed().as_bytes(), out)
     }
 
     /// Decodes a CDR payload (XCDR1 or XCDR2) without verifying the CRC.
@@ -198,14 +195,8 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
     /// The zero-padded image a CDR body in `encoding` describes, CRC not checked.
     #[inline]
     fn image_of_cdr_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, DecodeError<Self>> {
-        let plan = Self::cdr_plan(encoding);
-        if body.len() != plan.body_len {
-            return Err(DecodeError::CdrLength { encoding, expected: plan.body_len, found: body.len() });
-        }
         let mut message = Self::new_zeroed();
-        plan.decode(body, message.as_mut_bytes()).map_err(|e| match e {
-            PlanError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
-        })?;
+        Self::cdr_plan(encoding).decode_from(encoding, body, message.as_mut_bytes())?;
         // Alignment bytes of the body landed on the image's padding: zero it.
         message.zero_padding();
         Ok(message)
@@ -284,16 +275,8 @@ macro_rules! message {
             const TOPIC: &'static str = $topic;
             const PADDING: &'static [PadRange] = &padding_ranges::<{ padding_count(&$layout) }>(&$layout);
             const PADDING_MASK: &'static [u8] = &padding_mask::<$len, { padding_count(&$layout) }>(&$layout);
-            const XCDR1: CdrPlan = CdrPlan {
-                runs: &plan_runs::<{ run_count(&$layout, false) }>(&$layout, false),
-                headers: &plan_headers::<{ header_count(&$layout, false) }>(&$layout, false),
-                body_len: plan_body_len(&$layout, false),
-            };
-            const XCDR2: CdrPlan = CdrPlan {
-                runs: &plan_runs::<{ run_count(&$layout, true) }>(&$layout, true),
-                headers: &plan_headers::<{ header_count(&$layout, true) }>(&$layout, true),
-                body_len: plan_body_len(&$layout, true),
-            };
+            const XCDR1: CdrPlan = cdr_plan!($layout, false);
+            const XCDR2: CdrPlan = cdr_plan!($layout, true);
         }
         impl $ty {
             #[doc = concat!("The sealed ", stringify!($len), "-byte struct image (zero padding, CRC).")]

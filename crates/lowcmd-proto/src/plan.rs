@@ -8,6 +8,10 @@
 //! in XCDR2, two copies and the array's DHEADER. Decoding copies the same runs the other way, then
 //! zeroes the image's padding (a body may carry anything in its alignment bytes).
 
+use robowire_core::BufferTooSmall;
+
+use crate::cdr::CdrEncoding;
+use crate::error::DecodeError;
 use crate::layout::{Shape, StructLayout};
 
 /// One block copy: `len` bytes between body offset `body` and image offset `image`.
@@ -164,6 +168,19 @@ pub const fn plan_headers<const H: usize>(layout: &StructLayout, xcdr2: bool) ->
     Walk::<0, H>::run(layout, xcdr2).headers
 }
 
+/// The [`CdrPlan`] of the layout constant `$layout` in XCDR1 (`false`) or XCDR2 (`true`), built at
+/// compile time.
+macro_rules! cdr_plan {
+    ($layout:expr, $xcdr2:literal) => {
+        $crate::plan::CdrPlan {
+            runs: &$crate::plan::plan_runs::<{ $crate::plan::run_count(&$layout, $xcdr2) }>(&$layout, $xcdr2),
+            headers: &$crate::plan::plan_headers::<{ $crate::plan::header_count(&$layout, $xcdr2) }>(&$layout, $xcdr2),
+            body_len: $crate::plan::plan_body_len(&$layout, $xcdr2),
+        }
+    };
+}
+pub(crate) use cdr_plan;
+
 /// Why a body does not fit a plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum PlanError {
@@ -186,6 +203,33 @@ impl CdrPlan {
         for header in self.headers {
             body[header.at..header.at + 4].copy_from_slice(&header.len.to_le_bytes());
         }
+    }
+
+    /// Image → body at the start of `out`: [`encode`](Self::encode) after checking room; the
+    /// body's length.
+    #[inline]
+    pub(crate) fn encode_into(&self, image: &[u8], out: &mut [u8]) -> Result<usize, BufferTooSmall> {
+        let (needed, available) = (self.body_len, out.len());
+        let dst = out.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
+        self.encode(image, dst);
+        Ok(needed)
+    }
+
+    /// Body (in `encoding`, this plan's) → image: [`decode`](Self::decode) after checking the
+    /// body's length, with the crate's typed errors. The caller zeroes the image's padding.
+    #[inline]
+    pub(crate) fn decode_from<M>(
+        &self,
+        encoding: CdrEncoding,
+        body: &[u8],
+        image: &mut [u8],
+    ) -> Result<(), DecodeError<M>> {
+        if body.len() != self.body_len {
+            return Err(DecodeError::CdrLength { encoding, expected: self.body_len, found: body.len() });
+        }
+        self.decode(body, image).map_err(|e| match e {
+            PlanError::ArrayHeader { field, expected, found } => DecodeError::ArrayHeader { field, expected, found },
+        })
     }
 
     /// Body → image (then zero the image's padding). `body` is exactly `body_len` long.
