@@ -7,7 +7,7 @@
 //! Every struct is `@final`, as Unitree's IDL declares them: the vendor publishes XCDR1
 //! (`00 01`), and in XCDR2 (`00 07`, PLAIN_CDR2) a final struct has no DHEADER or member
 //! headers of its own. Field order, types and array lengths are those of Unitree's IDL and of
-//! this crate's codecs ([`crate::go2`], [`crate::hg`], [`crate::api`]).
+//! this crate's codecs ([`crate::go2`], [`crate::hg`], [`crate::sport_state`], [`crate::api`]).
 //!
 //! ```
 //! use lowcmd_proto::idl::{self, schema_of_type};
@@ -155,7 +155,7 @@ pub const GO2_LOW_STATE: IdlSchema = IdlSchema {
 };
 
 /// `unitree_go::msg::dds_::SportModeState_` (Go2 `rt/sportmodestate`), with `TimeSpec_`,
-/// `IMUState_` and `PathPoint_`. This crate has no codec for it; the layout is Unitree's IDL.
+/// `IMUState_` and `PathPoint_`; its codec is [`crate::sport_state::SportModeState`].
 pub const GO2_SPORT_MODE_STATE: IdlSchema = IdlSchema {
     name: "unitree_go::msg::dds_::SportModeState_",
     text: modules!(
@@ -351,6 +351,7 @@ pub fn schema_of_type(dds_type_name: &str) -> Option<&'static IdlSchema> {
 mod tests {
     use super::*;
     use crate::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME};
+    use crate::sport_state::SportModeState;
     use crate::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 
     #[test]
@@ -360,13 +361,13 @@ mod tests {
             (LowState::DDS_TYPE_NAME, &GO2_LOW_STATE),
             (HgLowCmd::DDS_TYPE_NAME, &HG_LOW_CMD),
             (HgLowState::DDS_TYPE_NAME, &HG_LOW_STATE),
+            (SportModeState::DDS_TYPE_NAME, &GO2_SPORT_MODE_STATE),
             (REQUEST_TYPE_NAME, &API_REQUEST),
             (RESPONSE_TYPE_NAME, &API_RESPONSE),
         ];
         for (name, schema) in types {
             assert_eq!(schema_of_type(name), Some(schema), "{name}");
         }
-        assert_eq!(schema_of_type("unitree_go::msg::dds_::SportModeState_"), Some(&GO2_SPORT_MODE_STATE));
         assert_eq!(schema_of_type("unitree_go.msg.dds_.LowCmd_"), None);
     }
 

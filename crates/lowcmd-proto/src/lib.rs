@@ -23,6 +23,7 @@ pub mod plan;
 pub mod robot;
 #[cfg(feature = "serde")]
 mod serde_impl;
+pub mod sport_state;
 pub mod stream;
 
 pub use cdr::CdrEncoding;

@@ -1,14 +1,16 @@
-//! Layouts, CRC, image and CDR round trips, errors.
+//! Layouts, CRC, image and CDR round trips, errors (the CRC'd messages, and `SportModeState_`).
 
 #[path = "../benches/oracle.rs"]
 mod oracle;
 
 use lowcmd_proto::crc::{crc32_words, crc32_words_table};
 use lowcmd_proto::layout::{Shape, StructLayout};
+use lowcmd_proto::sport_state::SportModeState;
 use lowcmd_proto::{
     CdrEncoding, DecodeError, FromZeros, HgLowCmd, HgLowState, IntoBytes, LowCmd, LowState, Message, go2,
 };
 use proptest::prelude::*;
+use robowire_core::cdr::CdrType;
 
 /// `true` for every image byte a field covers, `false` for padding.
 fn field_mask(layout: &StructLayout, mask: &mut [bool], base: usize) {
@@ -220,6 +222,65 @@ proptest! {
         let oracle = oracle::crc32_bitwise(&bytes);
         prop_assert_eq!(crc32_words(&bytes), Some(oracle));
         prop_assert_eq!(crc32_words_table(&bytes), Some(oracle));
+    }
+}
+
+/// XCDR1 alignment bytes of a `SportModeState_` body: after `mode` (65) and `gait_type` (72).
+const SPORT_MODE_STATE_ALIGNMENT: [usize; 5] = [66, 67, 73, 74, 75];
+
+/// Bytes of any length, often exactly a `SportModeState_` body's.
+fn sport_mode_state_bodies() -> impl Strategy<Value = Vec<u8>> {
+    prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..600),
+        prop::collection::vec(any::<u8>(), 512),
+        prop::collection::vec(any::<u8>(), 516),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Any 512 bytes are an XCDR1 body (no DHEADER, no CRC); the state re-encodes to them, alignment
+    /// bytes zeroed, and round-trips through both encodings.
+    #[test]
+    fn sport_mode_state_xcdr1_and_xcdr2_identity(body in prop::collection::vec(any::<u8>(), 512)) {
+        let state = SportModeState::decode_body(CdrEncoding::Xcdr1, &body).unwrap();
+        let mut expected = body.clone();
+        SPORT_MODE_STATE_ALIGNMENT.iter().for_each(|&i| expected[i] = 0);
+        let mut out = [0xAAu8; 516];
+        prop_assert_eq!(state.encode_body(&mut out), Ok(512));
+        prop_assert_eq!(&out[..512], &expected[..]);
+        for (encoding, len) in [(CdrEncoding::Xcdr1, 512), (CdrEncoding::Xcdr2, 516)] {
+            prop_assert_eq!(state.encode_cdr_body(encoding, &mut out), Ok(len));
+            prop_assert_eq!(SportModeState::decode_body(encoding, &out[..len]), Ok(state));
+        }
+    }
+
+    /// Any bytes decode or give a typed error: the wrong length, or (XCDR2) a DHEADER that is not
+    /// `path_point`'s 280.
+    #[test]
+    fn sport_mode_state_any_bytes_decode_or_give_a_typed_error(
+        mut body in sport_mode_state_bodies(),
+        xcdr2 in any::<bool>(),
+        right_dheader in any::<bool>(),
+    ) {
+        let (encoding, len) = if xcdr2 { (CdrEncoding::Xcdr2, 516) } else { (CdrEncoding::Xcdr1, 512) };
+        if xcdr2 && right_dheader && body.len() == len {
+            body[232..236].copy_from_slice(&280u32.to_le_bytes());
+        }
+        match SportModeState::decode_body(encoding, &body) {
+            Ok(_) => prop_assert!(body.len() == len && (!xcdr2 || body[232..236] == 280u32.to_le_bytes())),
+            Err(DecodeError::CdrLength { encoding: e, expected, found }) => {
+                prop_assert_eq!((e, expected, found), (encoding, len, body.len()));
+                prop_assert_ne!(found, len);
+            }
+            Err(DecodeError::ArrayHeader { field: "path_point", expected: 280, found }) => {
+                prop_assert!(xcdr2 && body.len() == len);
+                prop_assert_eq!(&found.to_le_bytes()[..], &body[232..236]);
+                prop_assert_ne!(found, 280);
+            }
+            Err(other) => prop_assert!(false, "{:?}", other),
+        }
     }
 }
 

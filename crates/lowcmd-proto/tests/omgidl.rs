@@ -348,46 +348,8 @@ fn golden_payloads_decode_to_the_vendors_fields() {
     assert!(xcdr1 >= 6, "{xcdr1} XCDR1 golden payloads");
 }
 
-/// Unitree's SDK serializes a `SportModeState_` (no codec of this crate has it) with a distinct
-/// value in every field; its fields, and its XCDR1 and XCDR2 payloads (cyclonedds), as JSON.
-const SPORT_MODE_STATE_PY: &str = r#"
-import dataclasses, json
-import numpy as np
-from unitree_sdk2py.idl.unitree_go.msg.dds_ import IMUState_, PathPoint_, SportModeState_, TimeSpec_
-
-n = 0
-def f32s(count):
-    global n
-    values = [float(np.float32((n + i + 1) * 0.731 - 97.25)) for i in range(count)]
-    n += count
-    return values
-
-m = SportModeState_(
-    stamp=TimeSpec_(sec=-123456, nanosec=987654321),
-    error_code=0xDEADBEEF,
-    imu_state=IMUState_(quaternion=f32s(4), gyroscope=f32s(3), accelerometer=f32s(3), rpy=f32s(3), temperature=201),
-    mode=7,
-    progress=f32s(1)[0],
-    gait_type=3,
-    foot_raise_height=f32s(1)[0],
-    position=f32s(3),
-    body_height=f32s(1)[0],
-    velocity=f32s(3),
-    yaw_speed=f32s(1)[0],
-    range_obstacle=f32s(4),
-    foot_force=[-1, 300, -32768, 32767],
-    foot_position_body=f32s(12),
-    foot_speed_body=f32s(12),
-    path_point=[PathPoint_(*f32s(7)) for _ in range(10)],
-)
-print(json.dumps({
-    "fields": dataclasses.asdict(m),
-    "xcdr1": m.serialize().hex(),
-    "xcdr2": m.serialize(use_version_2=True).hex(),
-}))
-"#;
-
-/// `SportModeState_` as Unitree's SDK serializes it, decoded by Foxglove with
+/// `SportModeState_` as Unitree's SDK serializes it (`tests/interop/sport_mode_state.py`: a
+/// distinct value in every field, in XCDR1 and XCDR2; also `tests/sport_mode_state.rs`'s), decoded by Foxglove with
 /// [`idl::GO2_SPORT_MODE_STATE`]: XCDR1 exactly; XCDR2 with the array-of-structs gap
 /// (`path_point`).
 #[test]
@@ -396,8 +358,11 @@ fn sport_mode_state_from_the_vendors_serializer() {
     let Some(python) = interop::require_part("Unitree's Python SDK", robowire_fixtures::peers::unitree_python()) else {
         return;
     };
-    let out = run("Unitree's SDK serializing SportModeState_", Command::new(python).args(["-c", SPORT_MODE_STATE_PY]))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let out = run(
+        "Unitree's SDK serializing SportModeState_",
+        Command::new(python).arg(project().join("../interop/sport_mode_state.py")),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let vendor: Value = serde_json::from_str(&out).unwrap();
     let payload = |k: &str| robowire_fixtures::hex_bytes(vendor[k].as_str().unwrap()).unwrap();
     let (xcdr1, xcdr2) = (payload("xcdr1"), payload("xcdr2"));
