@@ -37,6 +37,12 @@ pub fn lie_pose() -> [f32; 12] {
     std::array::from_fn(|i| LIE_POSE_RAD[i % 3])
 }
 
+/// `q` (motor order) with each joint clamped to the Go2's range.
+fn within_range(q: [f32; 12]) -> [f32; 12] {
+    let limits = &lowcmd_proto::robot::GO2_JOINT_LIMITS;
+    std::array::from_fn(|m| q[m].clamp(limits[m].q_min, limits[m].q_max))
+}
+
 /// A linear move of the 12 leg joints from `from` to `to` over `duration`, then a hold at `to`,
 /// with gains `kp`, `kd`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,14 +60,17 @@ impl JointTrajectory {
         Self { from, to, duration, kp, kd }
     }
 
-    /// Unitree's stand-up: from `from` to the stand pose over `duration` at kp 60, kd 5.
+    /// Unitree's stand-up: from `from` to the stand pose over `duration` at kp 60, kd 5. A
+    /// start a hair past a joint's range (a joint pressed against its stop, as a lying robot's
+    /// calves are) starts at the range's end, so that every target is within the Go2's ranges.
     pub fn stand_up(from: [f32; 12], duration: Duration) -> Self {
-        Self::new(from, stand_pose(), duration, STAND_KP, STAND_KD)
+        Self::new(within_range(from), stand_pose(), duration, STAND_KP, STAND_KD)
     }
 
-    /// Unitree's stand-down: from `from` to the lying pose over `duration` at kp 60, kd 5.
+    /// Unitree's stand-down: from `from` (as [`JointTrajectory::stand_up`] takes it) to the
+    /// lying pose over `duration` at kp 60, kd 5.
     pub fn lie_down(from: [f32; 12], duration: Duration) -> Self {
-        Self::new(from, lie_pose(), duration, STAND_KP, STAND_KD)
+        Self::new(within_range(from), lie_pose(), duration, STAND_KP, STAND_KD)
     }
 
     /// How far along the move is at `elapsed`: 0 at the start, 1 from `duration` on.
@@ -104,6 +113,15 @@ impl JointTrajectory {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stand_up_from_past_a_stop_starts_at_the_stop() {
+        let mut lying = lie_pose();
+        lying[2] = -2.7231; // a calf pressed a hair past its stop at −2.7227
+        let stand = JointTrajectory::stand_up(lying, Duration::from_secs(1));
+        assert_eq!(stand.positions_at(Duration::ZERO)[2], -2.7227);
+        assert_eq!(stand.positions_at(Duration::ZERO)[1], lying[1]);
+    }
 
     #[test]
     fn a_linear_move_then_a_hold() {

@@ -13,6 +13,10 @@ mod handover;
 mod joints;
 #[cfg(feature = "kmc")]
 pub mod kmc;
+#[cfg(feature = "mujoco")]
+pub mod physics;
+#[cfg(any(feature = "go2", feature = "g1"))]
+mod plant;
 #[cfg(any(feature = "replay", feature = "replay-serial", feature = "replay-dds"))]
 pub mod replay;
 #[cfg(feature = "zsl")]

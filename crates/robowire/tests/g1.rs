@@ -6,9 +6,9 @@
 
 mod support;
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::BufReader;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Stdio};
 
 use robowire_dds::netns::with_loopback_multicast;
 use serde_json::Value;
@@ -26,36 +26,7 @@ fn start_sim() -> Running {
 
 /// The observer on `lo` in `mode`, once it saw a first state.
 fn start_observer(python: &Path, mode: &str) -> (Child, BufReader<std::process::ChildStdout>) {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/g1_interop/observe_lowstate.py");
-    let mut child = Command::new(python)
-        .arg(script)
-        .args(["lo", mode])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    let mut line = String::new();
-    stdout.read_line(&mut line).unwrap();
-    if line.trim() != "ready" {
-        let _ = child.kill();
-        let mut err = String::new();
-        child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
-        panic!("the observer saw no state: {line:?}\nits stderr: {err}");
-    }
-    (child, stdout)
-}
-
-/// The observer's summary (its last line) once it ended.
-fn summary(mut observer: Child, mut stdout: BufReader<std::process::ChildStdout>) -> Value {
-    let mut out = String::new();
-    stdout.read_to_string(&mut out).unwrap();
-    let status = observer.wait().unwrap();
-    let mut err = String::new();
-    observer.stderr.take().unwrap().read_to_string(&mut err).unwrap();
-    assert!(status.success(), "observer: {status}\n{out}\n{err}");
-    serde_json::from_str(out.lines().last().unwrap_or_default()).unwrap_or_else(|e| panic!("{e}: {out}\n{err}"))
+    support::start_observer(python, "tests/g1_interop/observe_lowstate.py", &["lo", mode])
 }
 
 fn f64s(value: &Value) -> Vec<f64> {
@@ -81,7 +52,7 @@ fn unitree_g1_low_level_example_runs_unchanged_against_the_simulator() {
         let mut example = start_example(python, &examples.join("low_level"), "g1_low_level_example.py");
         // The observer ends once the example's third (AB) stage swung the ankle; the example
         // itself never ends.
-        let seen = summary(observer, observed);
+        let seen = support::observer_summary(observer, observed);
         let _ = example.kill();
         let out = example.wait_with_output().unwrap();
         let context = format!("{seen}\nexample: {}", String::from_utf8_lossy(&out.stderr));
@@ -148,7 +119,7 @@ fn unitree_g1_arm_sdk_example_lifts_the_arms_on_the_simulator() {
         let stdout = String::from_utf8_lossy(&out.stdout);
         assert!(stdout.contains("Done!"), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
         drop(observer.stdin.take());
-        let seen = summary(observer, observed);
+        let seen = support::observer_summary(observer, observed);
         assert_eq!((seen["timed_out"].as_bool(), seen["bad_crc"].as_u64()), (Some(false), Some(0)), "{seen}");
         // Stage 2: the left shoulder roll and both elbows to π/2, the right shoulder roll to −π/2.
         let all = &seen["all"];

@@ -107,8 +107,12 @@ class Go2(_UnitreeSimulator):
         interface: Optional[str] = None,
         state_period_s: float = 0.002,
         record: Union[str, PathLike[str], Recorder, None] = None,
+        physics: bool = False,
+        model: Union[str, PathLike[str], None] = None,
     ) -> None:
-        """record: go2/low_level and go2/api, the robot's side."""
+        """record: go2/low_level and go2/api, the robot's side; physics: the body in MuJoCo (a wheel
+        built with the `mujoco` feature), lying on its floor; model: a user's MJCF instead of
+        robowire's model of the Go2 (its joints named FR_hip_joint, ...)."""
 
 class G1(_UnitreeSimulator):
     """A Unitree G1 humanoid on DDS (motors 0..29); boots standing, the mode "ai" owning the motors."""
@@ -121,8 +125,13 @@ class G1(_UnitreeSimulator):
         mode_machine: Optional[int] = None,
         state_period_s: float = 0.002,
         record: Union[str, PathLike[str], Recorder, None] = None,
+        physics: bool = False,
+        model: Union[str, PathLike[str], None] = None,
+        free_base: bool = False,
     ) -> None:
-        """mode_machine None: the variant's (5 for 29 dof, 4 for 23); record: g1/low_level and g1/api, the robot's side."""
+        """mode_machine None: the variant's (5 for 29 dof, 4 for 23); record: g1/low_level and g1/api, the robot's side;
+        physics: the body in MuJoCo (a wheel built with the `mujoco` feature), its pelvis held (hanging) unless
+        free_base; model: a user's MJCF instead of robowire's model of the G1."""
     @property
     def variant(self) -> Literal["29dof", "23dof", "29dof_waist_locked", "dual_arm"]: ...
     @property

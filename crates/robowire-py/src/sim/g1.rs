@@ -39,9 +39,12 @@ impl G1 {
     /// its LowState says and its LowCmds must carry, 0..=255 (`None`: the variant's, 5 for the
     /// 29-dof G1, 4 for the 23-dof one). `state_period_s`: the `rt/lowstate` period (at least
     /// 0.0001 s). `record`: a path or a `robowire.Recorder` to record the robot's side of
-    /// `g1/low_level` (`rt/lowstate`, `rt/lowcmd`, `rt/arm_sdk`) and `g1/api` into.
+    /// `g1/low_level` (`rt/lowstate`, `rt/lowcmd`, `rt/arm_sdk`) and `g1/api` into. `physics`:
+    /// the body in MuJoCo (a wheel built with the `mujoco` feature), its pelvis held (hanging)
+    /// unless `free_base`; `model`: a user's MJCF instead of robowire's model of the G1.
     #[new]
-    #[pyo3(signature = (interface = Some("lo"), domain = 0, *, dof = 29, mode_machine = None, state_period_s = 0.002, record = None))]
+    #[pyo3(signature = (interface = Some("lo"), domain = 0, *, dof = 29, mode_machine = None, state_period_s = 0.002, record = None, physics = false, model = None, free_base = false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         interface: Option<&str>,
@@ -50,7 +53,12 @@ impl G1 {
         mode_machine: Option<u8>,
         state_period_s: f64,
         record: Option<&Bound<'_, PyAny>>,
+        physics: bool,
+        model: Option<std::path::PathBuf>,
+        free_base: bool,
     ) -> PyResult<Self> {
+        #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
+        let physics = super::unitree::physics_arg(physics, model, !free_base)?;
         let variant = variant_of_dof(dof)?;
         let state_period = seconds("state_period_s", state_period_s)?;
         if state_period.as_micros() < 100 {
@@ -64,6 +72,8 @@ impl G1 {
             state_period,
             low_level_tap: links.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
             services_tap: links.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_SERVER)),
+            #[cfg(feature = "mujoco")]
+            physics,
             ..defaults
         };
         let mode_machine = config.mode_machine;
@@ -95,7 +105,8 @@ impl G1 {
     /// `bad_mode_machine`, `bad_mode_pr`, `disabled_motors` (a `mode` 0 motor with a target, gain
     /// or torque), `bad_crc`, `malformed`; `arm_sdk`: `accepted`, `ignored_released`, `unsealed`,
     /// `malformed`, `weight` 0..=1), the LowState writer, corrupted states, requests answered,
-    /// timing (µs).
+    /// timing (µs), the body (`base`: the pelvis's `position_m`, `velocity_mps`, `rpy_rad` with
+    /// physics, else `None`; `sim_time_s`, `wall_time_s`).
     fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.sim.with(|s| s.snapshot())?;
         let (c, a) = (&s.lowcmd, &s.arm_sdk);
@@ -124,6 +135,7 @@ impl G1 {
             "requests" => s.stream.requests,
             "state_lateness_us" => lateness(py, &s.stream.state_lateness)?,
             "command_jitter_us" => lateness(py, &s.command_jitter)?,
+            "body" => super::unitree::body(py, s.base, s.stream.sim_time_s, s.stream.wall_time_s)?,
         }))
     }
 

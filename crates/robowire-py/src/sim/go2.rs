@@ -37,16 +37,22 @@ pub(crate) fn topic<'py>(py: Python<'py>, t: &TopicStats) -> PyResult<Bound<'py,
 impl Go2 {
     /// Joins DDS domain `domain` on `interface` (`None`: the library's choice) and boots lying
     /// down with its sport mode owning the motors. `record`: a path or a `robowire.Recorder`
-    /// to record the robot's side of `go2/low_level` and `go2/api` into.
+    /// to record the robot's side of `go2/low_level` and `go2/api` into. `physics`: the body in
+    /// MuJoCo (a wheel built with the `mujoco` feature), lying on its floor; `model`: a user's
+    /// MJCF instead of robowire's model of the Go2.
     #[new]
-    #[pyo3(signature = (*, domain = 0, interface = None, state_period_s = 0.002, record = None))]
+    #[pyo3(signature = (*, domain = 0, interface = None, state_period_s = 0.002, record = None, physics = false, model = None))]
     fn new(
         py: Python<'_>,
         domain: u16,
         interface: Option<&str>,
         state_period_s: f64,
         record: Option<&Bound<'_, PyAny>>,
+        physics: bool,
+        model: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
+        #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
+        let physics = super::unitree::physics_arg(physics, model, false)?;
         let state_period = seconds("state_period_s", state_period_s)?;
         if state_period.as_micros() < 100 {
             return Err(error(Kind::Argument, "state_period_s must be at least 0.0001"));
@@ -57,6 +63,8 @@ impl Go2 {
             state_period,
             low_level_tap: links.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
             services_tap: links.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
+            #[cfg(feature = "mujoco")]
+            physics,
             ..Go2SimConfig::default()
         };
         let sim = py.detach(|| Go2Sim::spawn(config)).map_err(|e| error(Kind::Error, chain(&e)))?;
@@ -69,7 +77,9 @@ impl Go2 {
         self.domain
     }
 
-    /// Sport mode, joint positions, LowCmd and LowState counters, timing.
+    /// Sport mode, joint positions, LowCmd and LowState counters, timing, the body (`base`: the
+    /// base's `position_m`, `velocity_mps`, `rpy_rad` with physics, else `None`; `sim_time_s`,
+    /// `wall_time_s`).
     fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.sim.with(|s| s.snapshot())?;
         let c = &s.lowcmd;
@@ -88,6 +98,7 @@ impl Go2 {
             "requests" => s.requests,
             "state_lateness_us" => lateness(py, &s.state_lateness)?,
             "command_jitter_us" => lateness(py, &s.command_jitter)?,
+            "body" => super::unitree::body(py, s.base, s.sim_time_s, s.wall_time_s)?,
         }))
     }
 

@@ -50,3 +50,55 @@ macro_rules! faults {
 }
 
 pub(crate) use faults;
+
+/// The physics a simulator's `physics`/`model` arguments ask for (`hanging`: the base held).
+#[cfg(feature = "mujoco")]
+pub(crate) fn physics_arg(
+    physics: bool,
+    model: Option<std::path::PathBuf>,
+    hanging: bool,
+) -> pyo3::PyResult<Option<robowire_sim::physics::PhysicsOptions>> {
+    if model.is_some() && !physics {
+        return Err(crate::errors::error(crate::errors::Kind::Argument, "model needs physics=True"));
+    }
+    Ok(physics.then_some(robowire_sim::physics::PhysicsOptions { model, hanging }))
+}
+
+/// A wheel without MuJoCo refuses `physics=True`.
+#[cfg(not(feature = "mujoco"))]
+pub(crate) fn physics_arg(
+    physics: bool,
+    model: Option<std::path::PathBuf>,
+    _hanging: bool,
+) -> pyo3::PyResult<Option<()>> {
+    if physics || model.is_some() {
+        return Err(crate::errors::error(
+            crate::errors::Kind::Error,
+            "this robowire wheel was built without physics (MuJoCo): build it with the cargo feature `mujoco`",
+        ));
+    }
+    Ok(None)
+}
+
+/// The `base`, `sim_time_s` and `wall_time_s` entries of a snapshot.
+pub(crate) fn body<'py>(
+    py: pyo3::Python<'py>,
+    base: Option<robowire_sim::go2::BasePose>,
+    sim_time_s: f64,
+    wall_time_s: f64,
+) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyDict>> {
+    use pyo3::types::PyDictMethods;
+    let out = pyo3::types::PyDict::new(py);
+    let base = match base {
+        Some(b) => Some(crate::stats::dict!(py, {
+            "position_m" => b.position_m.to_vec(),
+            "velocity_mps" => b.velocity_mps.to_vec(),
+            "rpy_rad" => b.rpy_rad.to_vec(),
+        })),
+        None => None,
+    };
+    out.set_item("base", base)?;
+    out.set_item("sim_time_s", sim_time_s)?;
+    out.set_item("wall_time_s", wall_time_s)?;
+    Ok(out)
+}

@@ -59,7 +59,10 @@ use robowire_dds::{ParticipantOptions, StatsHandle};
 use robowire_rt::stats::Counter;
 use robowire_tap::Tap;
 
-pub use crate::unitree::{COMMAND_HOLD_S, Fault as G1Fault, SimError as G1SimError, StreamCounters};
+pub use crate::unitree::{
+    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as G1Fault, MAX_SPEED, SimClock, SimError as G1SimError,
+    StreamCounters,
+};
 pub use model::{CONTROLLER_GAINS, G1Body, JOINTS, STAND_POSE_RAD, SUPPLY_V, has_disabled_motor};
 
 use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};
@@ -71,7 +74,7 @@ pub const BOOT_MODE: &str = "ai";
 pub const BOOT_FSM_ID: i64 = g1_loco::fsm::START;
 
 /// Simulator settings.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct G1SimConfig {
     /// Domain and interface (default: domain 0, the library's choice of interface).
     pub participant: ParticipantOptions,
@@ -94,6 +97,13 @@ pub struct G1SimConfig {
     /// Answer every applied LowCmd with a LowState at once, its `reserve` the command's, besides
     /// the 500 Hz stream (for round-trip measurements; a real G1 only streams).
     pub answer_lowcmd: bool,
+    /// Real time (default, at speed 1) or lock-step.
+    pub clock: SimClock,
+    /// MuJoCo physics instead of the kinematic joint model (`hanging`: the pelvis held, as on
+    /// Unitree's elastic band; the robot's balance controller is not modelled, so a free G1
+    /// stands only as long as its joints' PD holds it up).
+    #[cfg(feature = "mujoco")]
+    pub physics: Option<crate::physics::PhysicsOptions>,
 }
 
 impl G1SimConfig {
@@ -108,6 +118,9 @@ impl G1SimConfig {
             low_level_tap: None,
             services_tap: None,
             answer_lowcmd: false,
+            clock: SimClock::default(),
+            #[cfg(feature = "mujoco")]
+            physics: None,
         }
     }
 }
@@ -171,6 +184,8 @@ pub struct G1Snapshot {
     pub stream: StreamCounters,
     /// |interval − 2 ms| between accepted LowCmds as they arrive, µs.
     pub command_jitter: LatenessSummary,
+    /// Where the pelvis is (physics only).
+    pub base: Option<BasePose>,
 }
 
 /// What the G1's services thread hands its state stream, and counts.
@@ -259,6 +274,13 @@ impl G1Sim {
     /// Joins the domain, starts the services, the `rt/lowcmd` and `rt/arm_sdk` readers and the
     /// 500 Hz state stream.
     pub fn spawn(config: G1SimConfig) -> Result<Self, G1SimError> {
+        #[cfg(feature = "mujoco")]
+        let body = match &config.physics {
+            Some(physics) => G1Body::physics(config.variant, config.mode_machine, physics)?,
+            None => G1Body::new(config.variant, config.mode_machine),
+        };
+        #[cfg(not(feature = "mujoco"))]
+        let body = G1Body::new(config.variant, config.mode_machine);
         let participant = crate::unitree::join(&config.participant)?;
         let tap = &config.low_level_tap;
         let (lowcmd, lowcmd_stats) = crate::unitree::command_reader::<HgLowCmd>(&participant, HgLowCmd::TOPIC, tap)?;
@@ -300,10 +322,14 @@ impl G1Sim {
                 config.variant, config.mode_machine
             ),
         );
-        let options =
-            StreamOptions { period: config.state_period, cpu: config.cpu, tap: config.low_level_tap, name: "g1-sim" };
-        let robot =
-            G1Robot { body: G1Body::new(config.variant, config.mode_machine), seen_lowcmd: None, seen_arm_sdk: None };
+        let options = StreamOptions {
+            period: config.state_period,
+            cpu: config.cpu,
+            tap: config.low_level_tap,
+            name: "g1-sim",
+            clock: config.clock,
+        };
+        let robot = G1Robot { body, seen_lowcmd: None, seen_arm_sdk: None };
         let robot_rules = services::Rules { variant: config.variant, mode_machine: config.mode_machine };
         let sim = Sim::spawn(participant, options, robot, inbox, report, |handover, report| {
             move || services::run(handover, report, endpoints, robot_rules)
@@ -340,6 +366,7 @@ impl G1Sim {
             },
             stream: self.sim.counters(),
             command_jitter: inbox.lowcmd.jitter(),
+            base: self.sim.base(),
         }
     }
 }

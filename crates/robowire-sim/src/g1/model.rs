@@ -1,5 +1,6 @@
-//! The G1's body without I/O: 29 joint slots on the shared PD joint model (each joint with its
-//! torque and range from [`lowcmd_proto::g1::JOINT_LIMITS`]), the robot's own controller
+//! The G1's body without I/O: 29 joint slots on a [`Plant`] (the shared PD joint model, each
+//! joint with its torque and range from [`lowcmd_proto::g1::JOINT_LIMITS`], or physics with the
+//! `mujoco` feature), the robot's own controller
 //! holding the stand pose with `rt/arm_sdk` blended in, `rt/lowcmd` once released, and the HG
 //! `LowState` it reports.
 
@@ -9,6 +10,7 @@ use lowcmd_proto::g1::{
 use lowcmd_proto::{HgLowCmd, HgLowState, HgMotorCmd};
 
 use crate::joints::{JointStops, Joints, PdTarget};
+use crate::plant::{BaseReading, Plant, SlotJoints};
 use crate::unitree::COMMAND_HOLD_S;
 
 /// Joint slots of the G1 (0..29).
@@ -84,12 +86,21 @@ const STOPS: [JointStops; JOINTS] = {
     stops
 };
 
+/// Where the pelvis starts above the floor in physics, m (hanging: where it is held).
+#[cfg(feature = "mujoco")]
+const PELVIS_HEIGHT_M: f64 = 0.95;
+
+/// [`STAND_POSE_RAD`], the slots `variant` does not drive at 0.
+fn start_pose(variant: G1Variant) -> [f32; JOINTS] {
+    core::array::from_fn(|s| if variant.drives(s) { STAND_POSE_RAD[s] } else { 0.0 })
+}
+
 /// The body.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct G1Body {
     variant: G1Variant,
     mode_machine: u8,
-    joints: Joints<JOINTS>,
+    plant: Box<dyn Plant>,
     /// The robot's controller owns the motors.
     controller: bool,
     lowcmd: Option<HgLowCmd>,
@@ -127,13 +138,40 @@ fn ab_values_to_pr(mut values: [f32; JOINTS]) -> [f32; JOINTS] {
 
 impl G1Body {
     /// Standing at [`STAND_POSE_RAD`] (the slots `variant` does not drive at 0), at rest, held
-    /// by the robot's controller; the state says `mode_machine`.
+    /// by the robot's controller; the state says `mode_machine`. On the kinematic joint model.
     pub fn new(variant: G1Variant, mode_machine: u8) -> Self {
-        let pose = core::array::from_fn(|s| if variant.drives(s) { STAND_POSE_RAD[s] } else { 0.0 });
+        Self::on(Box::new(SlotJoints::new(Joints::at(start_pose(variant), STOPS))), variant, mode_machine)
+    }
+
+    /// As [`G1Body::new`], in MuJoCo: robowire's model of the G1 or the user's MJCF of
+    /// `options` (hanging, its pelvis held, when `options.hanging`).
+    #[cfg(feature = "mujoco")]
+    pub fn physics(
+        variant: G1Variant,
+        mode_machine: u8,
+        options: &crate::physics::PhysicsOptions,
+    ) -> Result<Self, crate::physics::PhysicsError> {
+        let rig = crate::physics::Rig {
+            robot: "G1",
+            mjcf: include_str!("../../models/g1.xml"),
+            joints: (0..JOINTS).map(|s| variant.drives(s).then_some(g1::JOINT_NAMES[s])).collect(),
+            tau_max_nm: g1::JOINT_LIMITS.iter().map(|l| l.tau_max).collect(),
+            start_pose_rad: start_pose(variant).to_vec(),
+            base_height_m: PELVIS_HEIGHT_M,
+            feet: vec![slot::LEFT_ANKLE_ROLL, slot::RIGHT_ANKLE_ROLL],
+        };
+        let mut physics = crate::physics::Physics::load(&rig, options)?;
+        if !options.hanging {
+            physics.settle(0.5);
+        }
+        Ok(Self::on(Box::new(physics), variant, mode_machine))
+    }
+
+    fn on(plant: Box<dyn Plant>, variant: G1Variant, mode_machine: u8) -> Self {
         Self {
             variant,
             mode_machine,
-            joints: Joints::at(pose, STOPS),
+            plant,
             controller: true,
             lowcmd: None,
             lowcmd_age_s: 0.0,
@@ -211,7 +249,23 @@ impl G1Body {
 
     /// Joint positions, rad, by slot (pitch and roll for the parallel joints).
     pub fn joint_positions(&self) -> [f32; JOINTS] {
-        self.joints.q_rad
+        core::array::from_fn(|s| self.plant.joint(s).q_rad)
+    }
+
+    /// The base (pelvis) when the body is simulated physics; `None` on the kinematic model.
+    pub(crate) fn base(&self) -> Option<BaseReading> {
+        self.plant.base()
+    }
+
+    /// Simulated time stepped so far, s.
+    pub fn time_s(&self) -> f64 {
+        self.plant.time_s()
+    }
+
+    /// What `rt/sportmodestate` says (physics only; Unitree's simulator publishes the Go2's
+    /// message for the G1 too): the pelvis's place and the 2 feet's forces (left, right).
+    pub fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+        crate::plant::sport_mode_state(&*self.plant, 2)
     }
 
     /// Advances the `tick` counter by `ms` (the state stream: its period per slot, skipped slots
@@ -283,7 +337,7 @@ impl G1Body {
             self.arm_weight = (self.arm_weight - ARM_SDK_WEIGHT_RATE_PER_S * dt_s).max(0.0);
         }
         let targets = self.targets();
-        self.joints.step(dt_s, |j| targets[j]);
+        self.plant.step(dt_s, &targets);
     }
 
     /// The state the robot reports now (the CRC is written by the encoder). In AB mode (the
@@ -294,10 +348,14 @@ impl G1Body {
         state.mode_pr = self.mode_pr as u8;
         state.mode_machine = self.mode_machine;
         state.tick = self.tick_ms.into();
-        state.imu_state.quaternion = [1.0, 0.0, 0.0, 0.0].map(Into::into);
-        state.imu_state.accelerometer = [0.0, 0.0, 9.81].map(Into::into);
+        let base = self.plant.base().unwrap_or(BaseReading::at_rest(0.0));
+        state.imu_state.quaternion = base.quaternion.map(Into::into);
+        state.imu_state.gyroscope = base.gyro_radps.map(Into::into);
+        state.imu_state.accelerometer = base.accelerometer_mps2.map(Into::into);
+        state.imu_state.rpy = base.rpy_rad.map(Into::into);
         state.imu_state.temperature = 40.into();
-        let (mut q, mut dq, mut tau) = (self.joints.q_rad, self.joints.qd_radps, self.joints.tau_nm);
+        let joints: [_; JOINTS] = core::array::from_fn(|s| self.plant.joint(s));
+        let (mut q, mut dq, mut tau) = (joints.map(|j| j.q_rad), joints.map(|j| j.qd_radps), joints.map(|j| j.tau_nm));
         if self.mode_pr == ModePr::Ab {
             for (pitch, roll) in PARALLEL_PAIRS {
                 for v in [&mut q, &mut dq, &mut tau] {
@@ -308,7 +366,7 @@ impl G1Body {
         }
         for slot in (0..JOINTS).filter(|&s| self.variant.drives(s)) {
             let s = &mut state.motor_state[slot];
-            let load = self.joints.tau_nm[slot].abs();
+            let load = joints[slot].tau_nm.abs();
             s.mode = u8::from(!self.faulted[slot]);
             s.q = q[slot].into();
             s.dq = dq[slot].into();

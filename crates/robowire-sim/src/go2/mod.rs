@@ -27,7 +27,9 @@ use robowire_dds::{DdsError, ParticipantOptions, StatsHandle, TopicStats};
 use robowire_rt::stats::Counter;
 use robowire_tap::Tap;
 
-pub use crate::unitree::{COMMAND_HOLD_S, Fault as Go2Fault, SimError as Go2SimError};
+pub use crate::unitree::{
+    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as Go2Fault, MAX_SPEED, SimClock, SimError as Go2SimError,
+};
 pub use model::{Go2Body, JOINTS, LYING_POSE_RAD, STAND_POSE_RAD};
 
 use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};
@@ -36,7 +38,7 @@ use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOpti
 pub const BOOT_SPORT_MODE: &str = "normal";
 
 /// Simulator settings.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Go2SimConfig {
     /// Domain and interface (default: domain 0, the library's choice of interface).
     pub participant: ParticipantOptions,
@@ -53,6 +55,11 @@ pub struct Go2SimConfig {
     /// Where each service request taken and answer written goes
     /// (`lowcmd_proto::description::API_SERVER`).
     pub services_tap: Option<Tap>,
+    /// Real time (default, at speed 1) or lock-step.
+    pub clock: SimClock,
+    /// MuJoCo physics instead of the kinematic joint model: the Go2 lying on its floor.
+    #[cfg(feature = "mujoco")]
+    pub physics: Option<crate::physics::PhysicsOptions>,
 }
 
 impl Default for Go2SimConfig {
@@ -64,6 +71,9 @@ impl Default for Go2SimConfig {
             answer_lowcmd: false,
             low_level_tap: None,
             services_tap: None,
+            clock: SimClock::default(),
+            #[cfg(feature = "mujoco")]
+            physics: None,
         }
     }
 }
@@ -102,6 +112,12 @@ pub struct Go2Snapshot {
     pub state_lateness: LatenessSummary,
     /// |interval − 2 ms| between accepted LowCmds as they arrive, µs.
     pub command_jitter: LatenessSummary,
+    /// Where the base is (physics only).
+    pub base: Option<BasePose>,
+    /// Simulated time so far, s.
+    pub sim_time_s: f64,
+    /// Wall time since the simulator started, s.
+    pub wall_time_s: f64,
 }
 
 /// What the Go2's services thread hands its state stream: the latest accepted LowCmd.
@@ -146,6 +162,13 @@ pub struct Go2Sim {
 impl Go2Sim {
     /// Joins the domain, starts the services, the LowCmd reader and the 500 Hz state stream.
     pub fn spawn(config: Go2SimConfig) -> Result<Self, Go2SimError> {
+        #[cfg(feature = "mujoco")]
+        let body = match &config.physics {
+            Some(physics) => Go2Body::physics(physics)?,
+            None => Go2Body::new(),
+        };
+        #[cfg(not(feature = "mujoco"))]
+        let body = Go2Body::new();
         let participant = crate::unitree::join(&config.participant)?;
         let tap = &config.low_level_tap;
         let (reader, lowcmd) = crate::unitree::command_reader::<LowCmd>(&participant, LowCmd::TOPIC, tap)?;
@@ -166,9 +189,14 @@ impl Go2Sim {
             BOOT_SPORT_MODE,
             format!("booted lying down; sport mode \"{BOOT_SPORT_MODE}\" owns the motors"),
         );
-        let options =
-            StreamOptions { period: config.state_period, cpu: config.cpu, tap: config.low_level_tap, name: "go2-sim" };
-        let robot = Go2Robot { body: Go2Body::new(), seen_command: None };
+        let options = StreamOptions {
+            period: config.state_period,
+            cpu: config.cpu,
+            tap: config.low_level_tap,
+            name: "go2-sim",
+            clock: config.clock,
+        };
+        let robot = Go2Robot { body, seen_command: None };
         let sim = Sim::spawn(participant, options, robot, inbox, report, |handover, report| {
             move || services::run(handover, report, endpoints)
         })?;
@@ -197,6 +225,9 @@ impl Go2Sim {
             requests: counters.requests,
             state_lateness: counters.state_lateness,
             command_jitter: inbox.lowcmd.jitter(),
+            base: self.sim.base(),
+            sim_time_s: counters.sim_time_s,
+            wall_time_s: counters.wall_time_s,
         }
     }
 }

@@ -1,6 +1,7 @@
-//! The Go2's body, sans I/O: 12 joints under the shared PD joint model, driven by the latched
-//! `LowCmd`, and the `LowState` it reports (IMU at rest, foot forces from the calf torques,
-//! battery, tick).
+//! The Go2's body, sans I/O: 12 motors on a [`Plant`] (the shared PD joint model, or physics
+//! with the `mujoco` feature), driven by the latched `LowCmd`, and the `LowState` it reports
+//! (IMU and foot forces from the physics, else at rest and from the calf torques; battery,
+//! tick).
 //!
 //! The firmware's sentinels are modelled as torque terms that vanish with their gain: `PosStopF`
 //! with kp 0 and `VelStopF` with kd 0 contribute nothing (a `VelStopF` with kd > 0 would be a
@@ -8,7 +9,8 @@
 
 use lowcmd_proto::{LowCmd, LowState};
 
-use crate::joints::{JointModel, PdTarget};
+use crate::joints::PdTarget;
+use crate::plant::{BaseReading, LegJoints, Plant};
 use crate::unitree::COMMAND_HOLD_S;
 
 /// The pose Unitree's stand example starts from, per motor (hip, thigh, calf × FR, FL, RR, RL):
@@ -20,9 +22,9 @@ pub const STAND_POSE_RAD: [f32; 3] = [0.0, 0.67, -1.3];
 pub const JOINTS: usize = 12;
 
 /// The body.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Go2Body {
-    joints: JointModel,
+    plant: Box<dyn Plant>,
     command: Option<LowCmd>,
     command_age_s: f32,
     /// Motors that failed: they report mode 0, produce no torque, count lost frames.
@@ -38,13 +40,24 @@ impl Default for Go2Body {
 }
 
 impl Go2Body {
-    /// Lying, at rest, motors passive.
+    /// Lying, at rest, motors passive, on the kinematic joint model.
     pub fn new() -> Self {
-        let mut joints = JointModel::at([LYING_POSE_RAD[0], LYING_POSE_RAD[1], LYING_POSE_RAD[2]]);
-        for (motor, q) in LYING_POSE_RAD.iter().enumerate() {
-            joints.q_rad[motor / 3][motor % 3] = *q;
+        Self::on(Box::new(LegJoints::at(&LYING_POSE_RAD)))
+    }
+
+    /// Lying on its floor in MuJoCo, motors passive: robowire's model of the Go2 or the user's
+    /// MJCF of `options`.
+    #[cfg(feature = "mujoco")]
+    pub fn physics(options: &crate::physics::PhysicsOptions) -> Result<Self, crate::physics::PhysicsError> {
+        let mut physics = crate::physics::Physics::load(&physics_rig(), options)?;
+        if !options.hanging {
+            physics.settle(1.0);
         }
-        Self { joints, command: None, command_age_s: 0.0, faulted: [false; JOINTS], lost: [0; JOINTS], tick_ms: 0 }
+        Ok(Self::on(Box::new(physics)))
+    }
+
+    fn on(plant: Box<dyn Plant>) -> Self {
+        Self { plant, command: None, command_age_s: 0.0, faulted: [false; JOINTS], lost: [0; JOINTS], tick_ms: 0 }
     }
 
     /// A LowCmd the robot accepted: the motors follow it.
@@ -62,7 +75,23 @@ impl Go2Body {
 
     /// Joint positions, rad, in motor order.
     pub fn joint_positions(&self) -> [f32; JOINTS] {
-        core::array::from_fn(|m| self.joints.q_rad[m / 3][m % 3])
+        core::array::from_fn(|m| self.plant.joint(m).q_rad)
+    }
+
+    /// The base (position, velocity, orientation) when the body is simulated physics; `None`
+    /// on the kinematic joint model.
+    pub(crate) fn base(&self) -> Option<BaseReading> {
+        self.plant.base()
+    }
+
+    /// Simulated time stepped so far, s.
+    pub fn time_s(&self) -> f64 {
+        self.plant.time_s()
+    }
+
+    /// What `rt/sportmodestate` says (physics only): the base's place and the 4 feet's forces.
+    pub fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+        crate::plant::sport_mode_state(&*self.plant, 4)
     }
 
     /// Advances the `tick` counter by `ms` (the state stream: its period per slot, skipped slots
@@ -75,25 +104,22 @@ impl Go2Body {
     pub fn step(&mut self, dt_s: f32) {
         self.command_age_s += dt_s;
         let active = self.command.filter(|_| self.command_age_s <= COMMAND_HOLD_S);
-        let faulted = self.faulted;
-        self.joints.step(dt_s, |leg, joint| {
-            let motor = leg * 3 + joint;
-            match active {
-                Some(cmd) if joint < 3 && !faulted[motor] => {
-                    let m = &cmd.motor_cmd[motor];
-                    let (kp, kd) = (m.kp.get(), m.kd.get());
-                    PdTarget {
-                        // A term without its gain contributes nothing, sentinel or not.
-                        q_rad: if kp == 0.0 { 0.0 } else { m.q.get() },
-                        qd_radps: if kd == 0.0 { 0.0 } else { m.dq.get() },
-                        kp,
-                        kd,
-                        tau_ff_nm: m.tau.get(),
-                    }
+        let targets: [PdTarget; JOINTS] = core::array::from_fn(|motor| match active {
+            Some(cmd) if !self.faulted[motor] => {
+                let m = &cmd.motor_cmd[motor];
+                let (kp, kd) = (m.kp.get(), m.kd.get());
+                PdTarget {
+                    // A term without its gain contributes nothing, sentinel or not.
+                    q_rad: if kp == 0.0 { 0.0 } else { m.q.get() },
+                    qd_radps: if kd == 0.0 { 0.0 } else { m.dq.get() },
+                    kp,
+                    kd,
+                    tau_ff_nm: m.tau.get(),
                 }
-                _ => PdTarget::default(),
             }
+            _ => PdTarget::default(),
         });
+        self.plant.step(dt_s, &targets);
         for (motor, faulted) in self.faulted.iter().enumerate() {
             if *faulted {
                 self.lost[motor] = self.lost[motor].wrapping_add(1);
@@ -101,32 +127,43 @@ impl Go2Body {
         }
     }
 
+    /// Each foot's force (FR, FL, RR, RL) as the state reports it: with physics the contact
+    /// force in N, else the calf's load in the robot's raw units (about 10 per N·m).
+    pub fn foot_forces(&self) -> [i16; 4] {
+        core::array::from_fn(|leg| {
+            let force = match self.plant.foot_force_n(leg) {
+                Some(newtons) => newtons,
+                None => self.plant.joint(leg * 3 + 2).tau_nm.abs() * 10.0,
+            };
+            force.clamp(0.0, f32::from(i16::MAX)) as i16
+        })
+    }
+
     /// The state the robot reports now (the CRC is written by the encoder).
     pub fn low_state(&self) -> LowState {
         let mut state = LowState::default();
         state.head = lowcmd_proto::go2::HEAD;
-        state.imu_state.quaternion = [1.0, 0.0, 0.0, 0.0].map(Into::into);
-        state.imu_state.accelerometer = [0.0, 0.0, 9.81].map(Into::into);
+        let base = self.plant.base().unwrap_or(BaseReading::at_rest(0.0));
+        state.imu_state.quaternion = base.quaternion.map(Into::into);
+        state.imu_state.gyroscope = base.gyro_radps.map(Into::into);
+        state.imu_state.accelerometer = base.accelerometer_mps2.map(Into::into);
+        state.imu_state.rpy = base.rpy_rad.map(Into::into);
         state.imu_state.temperature = 40;
         let mut total_torque = 0.0;
         for motor in 0..JOINTS {
-            let (leg, joint) = (motor / 3, motor % 3);
+            let joint = self.plant.joint(motor);
             let s = &mut state.motor_state[motor];
-            let tau = self.joints.tau_nm[leg][joint];
             s.mode = u8::from(!self.faulted[motor]);
-            s.q = self.joints.q_rad[leg][joint].into();
-            s.dq = self.joints.qd_radps[leg][joint].into();
-            s.tau_est = tau.into();
+            s.q = joint.q_rad.into();
+            s.dq = joint.qd_radps.into();
+            s.tau_est = joint.tau_nm.into();
             s.q_raw = s.q;
             s.dq_raw = s.dq;
-            s.temperature = 30 + (tau.abs() / 3.0) as u8;
+            s.temperature = 30 + (joint.tau_nm.abs() / 3.0) as u8;
             s.lost = self.lost[motor].into();
-            total_torque += tau.abs();
+            total_torque += joint.tau_nm.abs();
         }
-        for leg in 0..4 {
-            // Raw foot force: the calf's load, in the robot's raw units (about 10 per N·m).
-            let calf = self.joints.tau_nm[leg][2].abs();
-            let force = (calf * 10.0).clamp(0.0, f32::from(i16::MAX)) as i16;
+        for (leg, force) in self.foot_forces().into_iter().enumerate() {
             state.foot_force[leg] = force.into();
             state.foot_force_est[leg] = force.into();
         }
@@ -140,6 +177,23 @@ impl Go2Body {
         // client can match a state to a command (round trips). A real Go2 leaves it 0.
         state.reserve = self.command.map_or(0, |c| c.reserve.get()).into();
         state
+    }
+}
+
+/// The Go2 as the physics drives it: its motors' joints by Unitree's names (`FR_hip`, matched as
+/// `FR_hip_joint` too), torques from [`lowcmd_proto::robot::GO2_JOINT_LIMITS`], lying at the
+/// start, the calves' bodies its feet.
+#[cfg(feature = "mujoco")]
+fn physics_rig() -> crate::physics::Rig {
+    use lowcmd_proto::robot::{GO2_JOINT_LIMITS, GO2_JOINT_NAMES};
+    crate::physics::Rig {
+        robot: "Go2",
+        mjcf: include_str!("../../models/go2.xml"),
+        joints: GO2_JOINT_NAMES.iter().map(|&name| Some(name)).collect(),
+        tau_max_nm: GO2_JOINT_LIMITS.iter().map(|l| l.tau_max).collect(),
+        start_pose_rad: LYING_POSE_RAD.to_vec(),
+        base_height_m: 0.2,
+        feet: vec![2, 5, 8, 11],
     }
 }
 

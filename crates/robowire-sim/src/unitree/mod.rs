@@ -21,12 +21,13 @@ use robowire_rt::stats::Counter;
 use robowire_rt::{Latest, lock};
 use robowire_tap::Tap;
 use tokio::sync::watch;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 pub(crate) use services::{CommandInbox, Owner, ServiceServer, answer_at_once, serve, service_server};
 pub(crate) use stream::{FlipSite, StreamBody, forward_to_body};
 
 use crate::handover::{Requests, StreamStats};
-use stream::{BitFlipped, StateStream};
+use stream::{BitFlipped, StateStream, Writers};
 
 /// Without a command for this long the motors go passive (kp = kd = 0), s.
 pub const COMMAND_HOLD_S: f32 = 0.1;
@@ -49,6 +50,54 @@ pub enum Fault {
     },
 }
 
+/// How a simulator's time runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SimClock {
+    /// With the wall clock, `speed` times as fast (1.0: real time; 0 < speed ≤ [`MAX_SPEED`]).
+    /// When the body cannot keep up, simulated time falls behind (the real-time factor says
+    /// by how much) and each step is at most 50 ms.
+    RealTime {
+        /// Simulated seconds per wall second.
+        speed: f32,
+    },
+    /// Time stands still until the handle advances it (`advance`): a test's sequence of
+    /// commands and states is the same on a loaded machine.
+    LockStep,
+}
+
+impl Default for SimClock {
+    fn default() -> Self {
+        Self::RealTime { speed: 1.0 }
+    }
+}
+
+/// Where the robot's base is, when its body is simulated physics.
+#[derive(Debug, Clone, Copy, PartialEq, FromBytes, IntoBytes, KnownLayout, Immutable)]
+#[repr(C)]
+pub struct BasePose {
+    /// Position in the world, z up from the floor, m.
+    pub position_m: [f32; 3],
+    /// Velocity in the world, m/s.
+    pub velocity_mps: [f32; 3],
+    /// Roll, pitch, yaw (ZYX), rad.
+    pub rpy_rad: [f32; 3],
+}
+
+/// The fastest a real-time simulator runs, × real time.
+pub const MAX_SPEED: f32 = 100.0;
+
+/// Why a lock-step simulator did not advance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum AdvanceError {
+    /// The simulator runs on the wall clock.
+    #[error("the simulator runs in real time; only a lock-step one is advanced")]
+    NotLockStep,
+    /// The state stream did not take the request within its bound (a stalled thread).
+    #[error("the simulator's state stream did not answer")]
+    Stalled,
+}
+
 /// What a simulated Unitree robot counts of its state stream and its services.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StreamCounters {
@@ -60,6 +109,11 @@ pub struct StreamCounters {
     pub requests: u64,
     /// Lateness of the state stream against its absolute deadlines, µs.
     pub state_lateness: LatenessSummary,
+    /// Simulated time so far, s.
+    pub sim_time_s: f64,
+    /// Wall time since the simulator started, s (`sim_time_s / wall_time_s`: the real-time
+    /// factor).
+    pub wall_time_s: f64,
 }
 
 /// Why the simulator could not start.
@@ -75,6 +129,13 @@ pub enum SimError {
     /// The services' thread.
     #[error("cannot start the services' thread: {0}")]
     Services(#[source] std::io::Error),
+    /// A speed outside 0 < speed ≤ [`MAX_SPEED`] (or not a number).
+    #[error("speed {0} is outside 0 < speed <= {MAX_SPEED}")]
+    Speed(f32),
+    /// The physics model cannot drive the robot.
+    #[cfg(feature = "mujoco")]
+    #[error(transparent)]
+    Physics(#[from] crate::physics::PhysicsError),
 }
 
 /// What the user is told: the mode owning the motors and the log. Written by the services
@@ -112,6 +173,10 @@ pub(crate) struct Handover<B: StreamBody> {
     pub(crate) corrupted: Counter,
     /// Service requests answered (the services thread).
     pub(crate) requests_answered: Counter,
+    /// The body's simulated time, µs.
+    pub(crate) sim_time_us: Counter,
+    /// Where the base is (physics only), as the stream last stepped it.
+    pub(crate) base: Latest<BasePose>,
 }
 
 /// What the handle asks of the state stream.
@@ -119,7 +184,14 @@ pub(crate) struct Handover<B: StreamBody> {
 enum Request {
     Inject(Fault),
     ClearFaults,
+    /// Lock-step: step this many state periods.
+    Advance {
+        periods: u32,
+    },
 }
+
+/// State periods one lock-step request steps at most (well within the handle's wait bound).
+const ADVANCE_CHUNK: u32 = 50;
 
 /// Requests the stream has not taken yet (the handle waits for each).
 const REQUESTS: usize = 16;
@@ -135,6 +207,8 @@ pub(crate) struct StreamOptions {
     pub(crate) tap: Option<Tap>,
     /// The threads' names start with this (`"go2-sim"`).
     pub(crate) name: &'static str,
+    /// Real time (at a speed) or lock-step.
+    pub(crate) clock: SimClock,
 }
 
 /// Joins the domain.
@@ -172,6 +246,13 @@ macro_rules! handle_methods {
         pub fn take_log(&self) -> Vec<String> {
             self.sim.take_log()
         }
+
+        /// Lock-step (`SimClock::LockStep`): advances simulated
+        /// time by `by` (rounded to state periods, at least one), taking the latest accepted
+        /// command before each period and sending each period's state; returns when done.
+        pub fn advance(&self, by: std::time::Duration) -> Result<(), crate::unitree::AdvanceError> {
+            self.sim.advance(by)
+        }
     };
 }
 pub(crate) use handle_methods;
@@ -185,6 +266,9 @@ pub(crate) struct Sim<B: StreamBody> {
     waker: Waker,
     stop: watch::Sender<bool>,
     services: Option<JoinHandle<()>>,
+    clock: SimClock,
+    period: Duration,
+    started: std::time::Instant,
     _participant: Arc<Participant>,
 }
 
@@ -210,6 +294,11 @@ impl<B: StreamBody> Sim<B> {
         F: FnOnce() -> Fut + Send + 'static,
         Fut: Future<Output = ()>,
     {
+        if let SimClock::RealTime { speed } = options.clock
+            && !(speed > 0.0 && speed <= MAX_SPEED)
+        {
+            return Err(SimError::Speed(speed));
+        }
         let handover = Arc::new(Handover {
             requests: Requests::new(REQUESTS),
             inbox,
@@ -218,6 +307,8 @@ impl<B: StreamBody> Sim<B> {
             stream: StreamStats::default(),
             corrupted: Counter::default(),
             requests_answered: Counter::default(),
+            sim_time_us: Counter::default(),
+            base: Latest::new(),
         });
         handover.published.write(robowire_rt::now(), &body.published());
         let report = Arc::new(Mutex::new(report));
@@ -229,13 +320,17 @@ impl<B: StreamBody> Sim<B> {
         writer.set_tap(options.tap.clone());
         corrupt.set_tap(options.tap);
         let lowstate = writer.stats_handle();
-        let job = StateStream::new(
-            body,
-            handover.clone(),
-            writer,
-            corrupt,
-            Periodic::new(robowire_rt::now(), options.period),
-        );
+        let wall_period = match options.clock {
+            SimClock::RealTime { speed } => options.period.div_f32(speed),
+            SimClock::LockStep => options.period,
+        };
+        let grid = Periodic::new(robowire_rt::now(), wall_period);
+        let sport = match body.base_pose() {
+            Some(_) => Some(participant.writer(lowcmd_proto::sport_state::SPORT_MODE_STATE_TOPIC, Qos::STREAM_WRITER)?),
+            None => None,
+        };
+        let writers = Writers { state: writer, corrupt, sport };
+        let job = StateStream::new(body, handover.clone(), writers, (options.period, grid), options.clock);
         let placement = robowire_rt::Placement { cpu: options.cpu, ..Default::default() };
         let stream = Runner::spawn(RunnerOptions::placed(format!("{}-state", options.name), placement), job)?;
         let (stop, stop_rx) = watch::channel(false);
@@ -250,8 +345,28 @@ impl<B: StreamBody> Sim<B> {
             stream: Some(stream),
             stop,
             services: Some(services),
+            clock: options.clock,
+            period: options.period,
+            started: std::time::Instant::now(),
             _participant: participant,
         })
+    }
+
+    /// Lock-step: advances simulated time by `by` (rounded to state periods, at least one),
+    /// each period stepped, its state published and sent; returns when done.
+    pub(crate) fn advance(&self, by: Duration) -> Result<(), AdvanceError> {
+        if self.clock != SimClock::LockStep {
+            return Err(AdvanceError::NotLockStep);
+        }
+        let mut periods = ((by.as_secs_f64() / self.period.as_secs_f64()).round() as u32).max(1);
+        while periods > 0 {
+            let chunk = periods.min(ADVANCE_CHUNK);
+            if !self.handover.requests.call(Request::Advance { periods: chunk }, || self.waker.wake()) {
+                return Err(AdvanceError::Stalled);
+            }
+            periods -= chunk;
+        }
+        Ok(())
     }
 
     /// Injects a fault; in force when this returns.
@@ -279,12 +394,19 @@ impl<B: StreamBody> Sim<B> {
             corrupted_states: h.corrupted.get(),
             requests: h.requests_answered.get(),
             state_lateness: h.stream.summary().lateness,
+            sim_time_s: h.sim_time_us.get() as f64 * 1e-6,
+            wall_time_s: self.started.elapsed().as_secs_f64(),
         }
     }
 
     /// The mode owning the motors; empty once released.
     pub(crate) fn mode(&self) -> String {
         lock(&self.report).mode.clone()
+    }
+
+    /// Where the base is (physics only), as the stream last stepped it.
+    pub(crate) fn base(&self) -> Option<BasePose> {
+        self.handover.base.read().map(|(_, pose)| pose)
     }
 
     /// What the stream last published of the body (published once before the stream starts).

@@ -5,13 +5,14 @@
 use std::sync::Arc;
 
 use lowcmd_proto::Message;
+use lowcmd_proto::sport_state::SportModeState;
 use robowire_core::cdr::{CdrEncoding, CdrType};
 use robowire_core::schedule::{Periodic, Tick, Time};
 use robowire_dds::Writer;
 use robowire_rt::runner::Job;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
-use super::{Fault, Handover, Request};
+use super::{BasePose, Fault, Handover, Request, SimClock};
 
 /// Where a bit flip of [`Fault::BitFlips`] lands in a LowState's XCDR1 body: one of the joints'
 /// `q` (data, never alignment padding, which a decoder rightly ignores).
@@ -46,6 +47,12 @@ pub(crate) trait StreamBody: Send + 'static {
     fn low_state(&self) -> Self::State;
     /// What the handle reads.
     fn published(&self) -> Self::Published;
+    /// Simulated time the body has stepped, s.
+    fn time_s(&self) -> f64;
+    /// Where the base is; `None`: the body has none (the kinematic joint model).
+    fn base_pose(&self) -> Option<BasePose>;
+    /// `rt/sportmodestate`; `None`: the body has no base.
+    fn sport_state(&self) -> Option<SportModeState>;
     /// Motor `motor` fails (or recovers).
     fn set_motor_fault(&mut self, motor: usize, faulted: bool);
     /// Every motor recovers.
@@ -68,6 +75,19 @@ macro_rules! forward_to_body {
         }
         fn low_state(&self) -> Self::State {
             self.body.low_state()
+        }
+        fn time_s(&self) -> f64 {
+            self.body.time_s()
+        }
+        fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+            self.body.sport_state()
+        }
+        fn base_pose(&self) -> Option<crate::unitree::BasePose> {
+            self.body.base().map(|b| crate::unitree::BasePose {
+                position_m: b.position_m,
+                velocity_mps: b.velocity_mps,
+                rpy_rad: b.rpy_rad,
+            })
         }
         fn set_motor_fault(&mut self, motor: usize, faulted: bool) {
             self.body.set_motor_fault(motor, faulted);
@@ -112,9 +132,11 @@ struct WireFaults {
     bit_flip_every: u32,
 }
 
-/// Applies a request of the handle to the body and the wire.
+/// Applies a request of the handle to the body and the wire (not [`Request::Advance`], which
+/// the stream runs).
 fn apply<B: StreamBody>(body: &mut B, wire: &mut WireFaults, request: Request) {
     match request {
+        Request::Advance { .. } => {}
         Request::Inject(Fault::Silence) => wire.silent = true,
         Request::Inject(Fault::MotorFault { motor }) => body.set_motor_fault(motor, true),
         Request::Inject(Fault::BitFlips { every }) => wire.bit_flip_every = every.max(1),
@@ -125,6 +147,14 @@ fn apply<B: StreamBody>(body: &mut B, wire: &mut WireFaults, request: Request) {
     }
 }
 
+/// What a state stream writes: `rt/lowstate`, the same with a flipped bit, and
+/// `rt/sportmodestate` for a body with a base.
+pub(super) struct Writers<B: StreamBody> {
+    pub(super) state: Writer<B::State>,
+    pub(super) corrupt: Writer<BitFlipped<B>>,
+    pub(super) sport: Option<Writer<SportModeState>>,
+}
+
 /// The periodic state stream of one robot.
 pub(super) struct StateStream<B: StreamBody> {
     body: B,
@@ -132,7 +162,13 @@ pub(super) struct StateStream<B: StreamBody> {
     handover: Arc<Handover<B>>,
     writer: Writer<B::State>,
     corrupt: Writer<BitFlipped<B>>,
+    /// `rt/sportmodestate`, for a body with a base.
+    sport: Option<Writer<SportModeState>>,
+    /// The grid in wall time (the period divided by the speed).
     grid: Periodic,
+    clock: SimClock,
+    /// The state period, s of simulated time.
+    period_s: f32,
     /// The tick's step per slot, ms.
     period_ms: u32,
     last_step: Option<Time>,
@@ -140,28 +176,56 @@ pub(super) struct StateStream<B: StreamBody> {
 }
 
 impl<B: StreamBody> StateStream<B> {
+    /// `period` is the state's period in simulated time; `grid` runs it in wall time.
     pub(super) fn new(
         body: B,
         handover: Arc<Handover<B>>,
-        writer: Writer<B::State>,
-        corrupt: Writer<BitFlipped<B>>,
-        grid: Periodic,
+        Writers { state: writer, corrupt, sport }: Writers<B>,
+        (period, grid): (std::time::Duration, Periodic),
+        clock: SimClock,
     ) -> Self {
-        let period_ms = u32::try_from(grid.period().as_millis()).unwrap_or(u32::MAX).max(1);
-        Self { body, wire: WireFaults::default(), handover, writer, corrupt, grid, period_ms, last_step: None, sent: 0 }
+        let period_ms = u32::try_from(period.as_millis()).unwrap_or(u32::MAX).max(1);
+        Self {
+            body,
+            wire: WireFaults::default(),
+            handover,
+            writer,
+            corrupt,
+            sport,
+            grid,
+            clock,
+            period_s: period.as_secs_f32(),
+            period_ms,
+            last_step: None,
+            sent: 0,
+        }
     }
 
-    /// One tick: step, publish, send.
+    /// A real-time tick: step by the wall time since the last one times the speed.
     fn tick(&mut self, now: Time, tick: &Tick) {
-        let h = &*self.handover;
-        h.stream.record(tick, true);
+        self.handover.stream.record(tick, true);
+        let speed = match self.clock {
+            SimClock::RealTime { speed } => speed,
+            SimClock::LockStep => 1.0,
+        };
         let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
-        self.body.step(dt.min(MAX_STEP_S));
         let slots = u32::try_from(tick.skipped + 1).unwrap_or(u32::MAX);
+        self.step_and_send(now, (dt * speed).min(MAX_STEP_S), slots);
+    }
+
+    /// Steps the body by `dt_s`, advances the tick by `slots` periods, publishes the state and
+    /// sends it (unless silenced).
+    fn step_and_send(&mut self, now: Time, dt_s: f32, slots: u32) {
+        let h = &*self.handover;
+        self.body.step(dt_s);
+        h.sim_time_us.set((self.body.time_s() * 1e6) as u64);
         self.body.advance_tick(self.period_ms.saturating_mul(slots));
         let state = self.body.low_state();
         h.state.write(now, &state);
         h.published.write(now, &self.body.published());
+        if let Some(pose) = self.body.base_pose() {
+            h.base.write(now, &pose);
+        }
         if self.wire.silent {
             return;
         }
@@ -173,20 +237,43 @@ impl<B: StreamBody> StateStream<B> {
         } else {
             let _ = self.writer.try_write(state);
         }
+        if let (Some(writer), Some(sport)) = (&mut self.sport, self.body.sport_state()) {
+            let _ = writer.try_write(sport);
+        }
+    }
+
+    /// Lock-step: `periods` state periods of simulated time, each stepped, published and sent.
+    fn advance(&mut self, now: Time, periods: u32) {
+        for _ in 0..periods {
+            self.body.take(&self.handover.inbox);
+            self.step_and_send(now, self.period_s, 1);
+        }
     }
 }
 
+/// How long a lock-step stream sleeps between looks at its requests (it is woken by each).
+const LOCK_STEP_IDLE: std::time::Duration = std::time::Duration::from_millis(100);
+
 impl<B: StreamBody> Job for StateStream<B> {
     fn next_run(&mut self) -> Option<Time> {
-        Some(self.grid.deadline())
+        match self.clock {
+            SimClock::RealTime { .. } => Some(self.grid.deadline()),
+            SimClock::LockStep => Some(robowire_rt::now() + LOCK_STEP_IDLE),
+        }
     }
 
     fn run(&mut self, now: Time) {
-        let taken = self.handover.requests.take(|request| apply(&mut self.body, &mut self.wire, request));
-        self.body.take(&self.handover.inbox);
-        if let Some(tick) = self.grid.poll(now) {
+        let handover = self.handover.clone();
+        let taken = handover.requests.take(|request| match request {
+            Request::Advance { periods } => self.advance(now, periods),
+            other => apply(&mut self.body, &mut self.wire, other),
+        });
+        self.body.take(&handover.inbox);
+        if matches!(self.clock, SimClock::RealTime { .. })
+            && let Some(tick) = self.grid.poll(now)
+        {
             self.tick(now, &tick);
         }
-        self.handover.requests.confirm(taken);
+        handover.requests.confirm(taken);
     }
 }

@@ -16,6 +16,7 @@ pub(crate) mod replay_device;
 pub(crate) mod ros2;
 pub(crate) mod shm;
 pub(crate) mod sim;
+pub(crate) mod sim_body;
 pub(crate) mod unitree;
 
 /// A duration argument in seconds, 0–3600.

@@ -61,12 +61,20 @@ pub(crate) struct G1SimArgs {
     report_every_s: f64,
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
+    #[command(flatten)]
+    body: crate::cmd::sim_body::BodyArgs,
+    /// With --physics: the pelvis free on the floor (default: held where it starts, hanging as
+    /// on Unitree's elastic band; the G1's balance controller is not simulated).
+    #[arg(long, requires = "physics")]
+    free_base: bool,
 }
 
 #[derive(Debug, Args)]
 pub(crate) struct Go2SimArgs {
     #[command(flatten)]
     dds: crate::cmd::go2::DdsArgs,
+    #[command(flatten)]
+    body: crate::cmd::sim_body::BodyArgs,
     /// Print the simulator's state every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
@@ -304,6 +312,8 @@ fn joints(q_rad: &[f32]) -> String {
 }
 
 /// The Go2 simulator's periodic report line.
+use crate::cmd::sim_body::physics_report;
+
 fn go2_report(s: &robowire_sim::go2::Go2Snapshot) -> String {
     format!(
         "sport mode {:?} | q {} | lowcmd accepted {} ignored {} bad CRC {} bad head {} | lowstate {} | requests {}",
@@ -369,11 +379,16 @@ fn until_ctrl_c_with_log(
 
 fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+    #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
+    let physics = args.body.physics(false)?;
     let recorder = args.record.start("robowire sim go2")?;
     let config = Go2SimConfig {
         participant: args.dds.participant(),
         low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
         services_tap: recorder.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
+        clock: args.body.clock(),
+        #[cfg(feature = "mujoco")]
+        physics,
         ..Go2SimConfig::default()
     };
     let sim = Go2Sim::spawn(config).context("starting the Go2 simulator")?;
@@ -381,11 +396,21 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     // The first line, alone, for scripts.
     println!("go2 domain {} {interface}", args.dds.domain);
     eprintln!(
-        "Go2 simulator on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, motion_switcher and sport. \
-         Try: robowire go2 --domain {} status. Ctrl-C stops.",
-        args.dds.domain, args.dds.domain
+        "Go2 simulator ({}) on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, motion_switcher and \
+         sport. Try: robowire go2 --domain {} status. Ctrl-C stops.",
+        args.body.describe(),
+        args.dds.domain,
+        args.dds.domain
     );
-    until_ctrl_c_with_log(args.report_every_s, || sim.take_log(), || go2_report(&sim.snapshot()))?;
+    let last = std::cell::Cell::new((0.0, 0.0));
+    until_ctrl_c_with_log(
+        args.report_every_s,
+        || sim.take_log(),
+        || {
+            let s = sim.snapshot();
+            go2_report(&s) + &physics_report(s.base, s.sim_time_s, s.wall_time_s, &last)
+        },
+    )?;
     let s = sim.snapshot();
     println!(
         "lowcmd accepted {} ignored {} bad CRC {} bad head {}; final q {:?}",
@@ -412,12 +437,17 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
         }
         Some(_) => {}
     }
+    #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
+    let physics = args.body.physics(!args.free_base)?;
     let recorder = args.record.start("robowire sim g1")?;
     let config = G1SimConfig {
         participant: args.dds.participant(),
         mode_machine,
         low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
         services_tap: recorder.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_SERVER)),
+        clock: args.body.clock(),
+        #[cfg(feature = "mujoco")]
+        physics,
         ..G1SimConfig::new(variant)
     };
     let sim = G1Sim::spawn(config).context("starting the G1 simulator")?;
@@ -425,11 +455,21 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     // The first line, alone, for scripts.
     println!("g1 domain {} {interface} dof {dof} mode_machine {mode_machine}", args.dds.domain);
     eprintln!(
-        "G1 simulator ({dof} joints) on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, rt/arm_sdk, \
-         motion_switcher, sport (loco) and arm. Try: robowire g1 --domain {} zero. Ctrl-C stops.",
-        args.dds.domain, args.dds.domain
+        "G1 simulator ({dof} joints, {}) on DDS domain {} ({interface}): rt/lowstate at 500 Hz, rt/lowcmd, \
+         rt/arm_sdk, motion_switcher, sport (loco) and arm. Try: robowire g1 --domain {} zero. Ctrl-C stops.",
+        args.body.describe(),
+        args.dds.domain,
+        args.dds.domain
     );
-    until_ctrl_c_with_log(args.report_every_s, || sim.take_log(), || g1_report(&sim.snapshot()))?;
+    let last = std::cell::Cell::new((0.0, 0.0));
+    until_ctrl_c_with_log(
+        args.report_every_s,
+        || sim.take_log(),
+        || {
+            let s = sim.snapshot();
+            g1_report(&s) + &physics_report(s.base, s.stream.sim_time_s, s.stream.wall_time_s, &last)
+        },
+    )?;
     let s = sim.snapshot();
     println!(
         "{}; arm_sdk accepted {} ignored {} unsealed {} weight {:.2}; final q {:?}",

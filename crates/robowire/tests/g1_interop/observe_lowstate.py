@@ -4,6 +4,8 @@ Checks every sample's CRC with Unitree's `CRC` and follows the joints by phase. 
 once a first state arrived, then, when done, one JSON line (the Rust test asserts on it).
 
     observe_lowstate.py IFACE low_level   # done once the AB stage swung the ankle's A motor
+    observe_lowstate.py IFACE low_level_hanging   # the same on a hanging physics G1, whose waist
+                                                  # pitch bows under its upper body (zero within 0.35)
     observe_lowstate.py IFACE arm         # done when stdin closes (the example has ended)
 
 A state arriving late is no failure here: the test's bound is its own timeout.
@@ -19,6 +21,7 @@ from unitree_sdk2py.idl.unitree_hg.msg.dds_ import LowState_
 from unitree_sdk2py.utils.crc import CRC
 
 JOINTS = 29
+WAIST_PITCH = 14
 
 
 class Range:
@@ -47,6 +50,10 @@ class Range:
 class Observer:
     def __init__(self, mode):
         self.mode = mode
+        # How near 0 each joint must be for the zero posture.
+        self.zero_tolerance = [0.05] * JOINTS
+        if mode == "low_level_hanging":
+            self.zero_tolerance[WAIST_PITCH] = 0.35
         self.crc = CRC()
         self.lock = threading.Lock()
         self.done = threading.Event()
@@ -72,13 +79,13 @@ class Observer:
                 self.first = q
             self.last = q
             self.all.add(q)
-            if self.mode == "low_level":
+            if self.mode.startswith("low_level"):
                 self.follow_low_level(msg, q)
         self.ready.set()
 
     def follow_low_level(self, msg, q):
         if self.zero is None:
-            if all(abs(v) < 0.05 for v in q):
+            if all(abs(v) < t for v, t in zip(q, self.zero_tolerance)):
                 self.zero = (self.samples, q)
             return
         if msg.mode_pr == 0 and self.ab.samples == 0:

@@ -39,6 +39,41 @@ pub(crate) fn start_example(python: &std::path::Path, dir: &std::path::Path, nam
     example
 }
 
+/// An observer script (`script`, relative to this crate) on Unitree's SDK with `python` and
+/// `args`, once it printed `ready` (its stdin piped: some end when it closes).
+pub(crate) fn start_observer(python: &std::path::Path, script: &str, args: &[&str]) -> (Child, BufReader<ChildStdout>) {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
+    let mut child = Command::new(python)
+        .arg(script)
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    stdout.read_line(&mut line).unwrap();
+    if line.trim() != "ready" {
+        let _ = child.kill();
+        let mut err = String::new();
+        child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+        panic!("the observer saw no state: {line:?}\nits stderr: {err}");
+    }
+    (child, stdout)
+}
+
+/// An observer's summary (its last line, one JSON object) once it ended.
+pub(crate) fn observer_summary(mut observer: Child, mut stdout: BufReader<ChildStdout>) -> serde_json::Value {
+    let mut out = String::new();
+    stdout.read_to_string(&mut out).unwrap();
+    let status = observer.wait().unwrap();
+    let mut err = String::new();
+    observer.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    assert!(status.success(), "observer: {status}\n{out}\n{err}");
+    serde_json::from_str(out.lines().last().unwrap_or_default()).unwrap_or_else(|e| panic!("{e}: {out}\n{err}"))
+}
+
 /// The `robowire` binary under test.
 pub(crate) fn robowire() -> Command {
     Command::new(env!("CARGO_BIN_EXE_robowire"))

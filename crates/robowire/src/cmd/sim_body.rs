@@ -1,0 +1,76 @@
+//! The body behind `robowire sim go2|g1`: the kinematic joint model or MuJoCo physics
+//! (`--physics [--model MJCF]`, in a build with the `mujoco` feature), and how its time runs
+//! (`--speed X`).
+
+use clap::Args;
+
+/// How the simulated robot's body and time run.
+#[derive(Debug, Args)]
+pub(crate) struct BodyArgs {
+    /// Simulate the body in MuJoCo (a build with the `mujoco` feature): the robot stands, sinks
+    /// and falls under its motors' torques instead of following them joint by joint.
+    #[arg(long)]
+    physics: bool,
+    /// With --physics: the MJCF to load instead of robowire's own model (a scene with a floor
+    /// and the robot, e.g. unitree_mujoco's or MuJoCo Menagerie's scene.xml); its joints are
+    /// found by the motors' names (FR_hip_joint, …, left_hip_pitch_joint, …).
+    #[arg(long, value_name = "MJCF", requires = "physics")]
+    model: Option<std::path::PathBuf>,
+    /// Simulated seconds per wall second (0 < X <= 100).
+    #[arg(long, value_name = "X", default_value_t = 1.0)]
+    speed: f32,
+}
+
+impl BodyArgs {
+    /// The clock the simulator runs on.
+    pub(crate) fn clock(&self) -> robowire_sim::go2::SimClock {
+        robowire_sim::go2::SimClock::RealTime { speed: self.speed }
+    }
+
+    /// What the startup line says of the body.
+    pub(crate) fn describe(&self) -> String {
+        let body = match (&self.physics, &self.model) {
+            (false, _) => "kinematic joints".to_string(),
+            (true, None) => "MuJoCo physics, robowire's model".to_string(),
+            (true, Some(model)) => format!("MuJoCo physics, {}", model.display()),
+        };
+        if self.speed == 1.0 { body } else { format!("{body}, {}× real time", self.speed) }
+    }
+
+    /// The physics options (`hanging`: the base held), or `None` for the kinematic body.
+    #[cfg(feature = "mujoco")]
+    pub(crate) fn physics(&self, hanging: bool) -> anyhow::Result<Option<robowire_sim::physics::PhysicsOptions>> {
+        Ok(self.physics.then(|| robowire_sim::physics::PhysicsOptions { model: self.model.clone(), hanging }))
+    }
+
+    /// Refuses `--physics` in a build without MuJoCo.
+    #[cfg(not(feature = "mujoco"))]
+    pub(crate) fn physics(&self, _hanging: bool) -> anyhow::Result<Option<()>> {
+        anyhow::ensure!(
+            !self.physics,
+            "this robowire was built without physics: build it with `cargo build --release -p robowire --features \
+             mujoco`, MUJOCO_DYNAMIC_LINK_DIR naming a directory with MuJoCo 3.17.0's libmujoco.so (the PyPI wheel \
+             mujoco==3.17.0 ships it), and run it with that directory on LD_LIBRARY_PATH"
+        );
+        Ok(None)
+    }
+}
+
+/// What a report line adds for a simulator whose body is physics: the base's height and the
+/// real-time factor since the last report (`last`: the previous (sim, wall) times, updated).
+pub(crate) fn physics_report(
+    base: Option<robowire_sim::go2::BasePose>,
+    sim_time_s: f64,
+    wall_time_s: f64,
+    last: &std::cell::Cell<(f64, f64)>,
+) -> String {
+    let (sim0, wall0) = last.replace((sim_time_s, wall_time_s));
+    let rtf = if wall_time_s > wall0 { (sim_time_s - sim0) / (wall_time_s - wall0) } else { 0.0 };
+    match base {
+        Some(b) => format!(
+            " | base z {:.3} m roll {:.2} pitch {:.2} | sim {sim_time_s:.1} s, real-time factor {rtf:.2}",
+            b.position_m[2], b.rpy_rad[0], b.rpy_rad[1]
+        ),
+        None => format!(" | sim {sim_time_s:.1} s, real-time factor {rtf:.2}"),
+    }
+}
