@@ -72,10 +72,22 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     } else {
         &["--warm-up-time", "2", "--measurement-time", "5"]
     };
-    for (package, bench) in BENCHES {
+    // With MuJoCo here, the DDS bench measures round trips with physics on too, and the physics
+    // bench runs.
+    let mujoco =
+        crate::physics::lib_dir(&target).inspect_err(|missing| println!("physics benchmarks skipped: {missing}")).ok();
+    let physics_meta_path = target.join("bench-meta-physics.json");
+    let physics_bench: &[(&str, &str)] = if mujoco.is_some() { &[("robowire-sim", "physics")] } else { &[] };
+    for &(package, bench) in BENCHES.iter().chain(physics_bench) {
+        let features: &[&str] =
+            if mujoco.is_some() && matches!(bench, "dds" | "physics") { &["--features", "mujoco"] } else { &[] };
         let status = Command::new("cargo")
-            .args(["bench", "-p", package, "--bench", bench, "--"])
+            .args(["bench", "-p", package, "--bench", bench])
+            .args(features)
+            .arg("--")
             .args(times)
+            .envs(mujoco.iter().flat_map(|dir| [("MUJOCO_DYNAMIC_LINK_DIR", dir), ("LD_LIBRARY_PATH", dir)]))
+            .env("ROBOWIRE_BENCH_META_PHYSICS", &physics_meta_path)
             .env("ROBOWIRE_BENCH_META", &meta_path)
             .env("ROBOWIRE_BENCH_META_SPLINE", &spline_meta_path)
             .env("ROBOWIRE_BENCH_META_ZSL_UDP", &udp_meta_path)
@@ -151,6 +163,13 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let record: Value =
         serde_json::from_str(&std::fs::read_to_string(&record_meta_path).context("recording bench metadata")?)?;
     rows.extend(crate::bench_apps::record_rows(&record)?);
+    let physics: Option<Value> = match mujoco {
+        Some(_) => {
+            Some(serde_json::from_str(&std::fs::read_to_string(&physics_meta_path).context("physics bench metadata")?)?)
+        }
+        None => None,
+    };
+    rows.extend(crate::bench_apps::physics_rows(physics.as_ref(), &dds)?);
 
     let markdown = to_markdown(&rows);
     println!("\n{markdown}");

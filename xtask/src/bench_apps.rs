@@ -111,3 +111,37 @@ fn stream_row(run: &Value, path: &str) -> anyhow::Result<Row> {
         met: None,
     })
 }
+
+/// The physics rows (`cargo bench -p robowire-sim --features mujoco --bench physics` and the DDS
+/// bench's 500 Hz round trips): each model's real-time factor beside the kinematic joint model,
+/// and the Go2 round trip with physics on beside the kinematic simulator; none without MuJoCo.
+pub(crate) fn physics_rows(physics: Option<&Value>, dds: &Value) -> anyhow::Result<Vec<Row>> {
+    let Some(physics) = physics else { return Ok(Vec::new()) };
+    let rtf = |key: &str| physics[key].as_f64().with_context(|| format!("physics meta {key}"));
+    let mut rows = Vec::new();
+    for (robot, label) in [("go2", "Go2 standing"), ("g1", "G1 hanging, 29 joints")] {
+        let (physics, kinematic) = (rtf(&format!("{robot}_physics_rtf"))?, rtf(&format!("{robot}_kinematic_rtf"))?);
+        rows.push(Row {
+            path: format!("{label}: MuJoCo at 1 kHz, LowState built and encoded at 500 Hz, one thread"),
+            figure: format!("{physics:.0}× real time"),
+            baseline: format!("kinematic joint model, same loop: {kinematic:.0}×"),
+            ratio: format!("{:.3}×", physics / kinematic),
+            target: "≥ 1× real time".into(),
+            met: Some(physics >= 1.0),
+        });
+    }
+    let trips = &dds["go2_500hz_round_trip"];
+    let us = |body: &str, pct: &str| trips[body][pct].as_f64().with_context(|| format!("dds meta {body}.{pct}"));
+    for pct in ["p50", "p99"] {
+        let (physics, kinematic) = (us("physics_us", pct)?, us("kinematic_us", pct)?);
+        rows.push(Row {
+            path: format!("Go2 LowCmd → LowState answer, 500 Hz stream, physics on, {pct}"),
+            figure: format!("{physics:.1} µs"),
+            baseline: format!("kinematic simulator, same settings: {kinematic:.1} µs"),
+            ratio: format!("{:.2}×", physics / kinematic),
+            target: "–".into(),
+            met: None,
+        });
+    }
+    Ok(rows)
+}

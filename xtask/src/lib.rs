@@ -8,6 +8,7 @@ mod bench_apps;
 mod bench_lowcmd;
 pub mod fuzz;
 pub mod golden;
+pub mod physics;
 pub mod python;
 
 use std::path::PathBuf;

@@ -30,13 +30,17 @@ enum Task {
         #[arg(long, default_value_t = 20)]
         time: u64,
     },
-    /// Run every test of the project: `cargo test --workspace`, then the Python suite on the
-    /// wheel built as users build it, on CPython 3.10 and 3.12 (or 3.13).
+    /// Run every test of the project: `cargo test --workspace`, the physics tests (when MuJoCo
+    /// is here: `cargo xtask mujoco`), then the Python suite on the wheel built as users build
+    /// it, on CPython 3.10 and 3.12 (or 3.13).
     Test {
         /// Only the Python suite (the wheel, both CPythons).
         #[arg(long)]
         python_only: bool,
     },
+    /// Fetch MuJoCo 3.17.0's library from PyPI (the `mujoco==3.17.0` wheel, with `python3`'s
+    /// pip) into target/mujoco/lib and print how to build and run with physics.
+    Mujoco,
     /// Run the benchmarks and print the performance table.
     Bench {
         /// Shorter measurements (a smoke run).
@@ -51,6 +55,7 @@ fn main() -> ExitCode {
         Task::Fuzz { target, time } => xtask::fuzz::run(target.as_deref(), time),
         Task::Test { python_only: false } => xtask::python::test_all(),
         Task::Test { python_only: true } => xtask::python::test_python(),
+        Task::Mujoco => mujoco(),
         Task::Bench { quick } => xtask::bench::run(quick).and_then(|rows| {
             anyhow::ensure!(rows.iter().all(|r| r.met != Some(false)), "a benchmark missed its target");
             Ok(())
@@ -63,6 +68,19 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn mujoco() -> anyhow::Result<()> {
+    let root = xtask::workspace_root();
+    let dir = xtask::physics::fetch(std::path::Path::new("python3"), &xtask::python::target_dir(&root))?;
+    let dir = dir.canonicalize()?;
+    eprintln!("MuJoCo {} in {}; for physics (`--features mujoco`):", xtask::physics::MUJOCO_VERSION, dir.display());
+    // The exports alone on stdout, for `eval "$(cargo xtask mujoco)"`.
+    println!(
+        "export MUJOCO_DYNAMIC_LINK_DIR={0} LD_LIBRARY_PATH={0}${{LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}}",
+        dir.display()
+    );
+    Ok(())
 }
 
 fn golden(bless: bool) -> anyhow::Result<()> {

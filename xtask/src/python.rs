@@ -29,7 +29,8 @@ use serde_json::Value;
 use crate::bench::Row;
 use crate::workspace_root;
 
-fn target_dir(root: &Path) -> PathBuf {
+/// The target directory (`$CARGO_TARGET_DIR` or `target/`).
+pub fn target_dir(root: &Path) -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
 }
 
@@ -60,9 +61,11 @@ fn is_root() -> bool {
         .unwrap_or(false)
 }
 
-/// `cargo test --workspace`, then the Python suite.
+/// `cargo test --workspace`, the physics tests ([`crate::physics`]), then the Python suite.
 pub fn test_all() -> anyhow::Result<()> {
-    cargo(&workspace_root(), &["test", "--workspace"])?;
+    let root = workspace_root();
+    cargo(&root, &["test", "--workspace"])?;
+    crate::physics::test(&root, &target_dir(&root))?;
     test_python()
 }
 
@@ -127,27 +130,67 @@ pub fn test_python() -> anyhow::Result<()> {
             ""
         }
     };
-    let runs = py310.map(|python| (python, "vendor,sdk,mcap,cli")).into_iter().chain([(second_venv, "cli")]);
-    for (python, require) in runs {
-        install(&python, &wheel)?;
-        pip(&python, &["install", "--no-warn-script-location", "pytest"])?;
-        let require = format!("{require}{dds}");
+    // With MuJoCo here, the physics tests once more on a wheel built with the feature, in a
+    // venv of their own (the suite's other tests ran on the wheel users build by default).
+    let physics = match crate::physics::lib_dir(&target) {
+        Ok(dir) => {
+            let venv = bare_venv(&target, &format!("{version}-physics"), &second)?;
+            let wheel = build_wheel_with(&root, &target, &venv, Some(&dir))?;
+            Some(PytestRun {
+                python: venv,
+                wheel,
+                require: "physics".into(),
+                tests: "test_physics.py",
+                mujoco: Some(dir),
+            })
+        }
+        Err(missing) => {
+            interop::missing("the Python physics tests (MuJoCo)", missing).map_err(anyhow::Error::msg)?;
+            None
+        }
+    };
+    let suite = |python, require: &str| PytestRun {
+        python,
+        wheel: wheel.clone(),
+        require: require.into(),
+        tests: "",
+        mujoco: None,
+    };
+    let runs = py310.map(|python| suite(python, "vendor,sdk,mcap,cli")).into_iter().chain([suite(second_venv, "cli")]);
+    for run_ in runs.chain(physics) {
+        install(&run_.python, &run_.wheel)?;
+        pip(&run_.python, &["install", "--no-warn-script-location", "pytest"])?;
+        let require = format!("{}{dds}", run_.require);
         let mut pytest = match userns {
-            Ok(true) => userns::command(&python).map_err(anyhow::Error::msg)?,
-            _ => Command::new(&python),
+            Ok(true) => userns::command(&run_.python).map_err(anyhow::Error::msg)?,
+            _ => Command::new(&run_.python),
         };
         let inside = if matches!(userns, Ok(true)) { " in a user + network namespace" } else { "" };
-        println!("\n== pytest on {}{inside} (required here: {require})", python.display());
+        println!("\n== pytest on {}{inside} (required here: {require})", run_.python.display());
+        let tests = root.join("crates/robowire-py/tests").join(run_.tests);
         run(
             "pytest",
             pytest
-                .args(["-m", "pytest", "crates/robowire-py/tests", "-q", "-p", "no:cacheprovider", "-rs"])
+                .args(["-m", "pytest"])
+                .arg(tests)
+                .args(["-q", "-p", "no:cacheprovider", "-rs"])
                 .env("ROBOWIRE_REQUIRE", &require)
                 .env("ROBOWIRE_CLI", target.join("debug/robowire"))
+                .envs(run_.mujoco.iter().map(|dir| ("LD_LIBRARY_PATH", dir)))
                 .current_dir(&root),
         )?;
     }
     Ok(())
+}
+
+/// One pytest run: `tests` (a file of the suite, or all of it) with `python`, on `wheel`,
+/// `require` naming what must not be missing; `mujoco`: MuJoCo's directory for the loader.
+struct PytestRun {
+    python: PathBuf,
+    wheel: PathBuf,
+    require: String,
+    tests: &'static str,
+    mujoco: Option<PathBuf>,
 }
 
 /// Installs `wheel` (not editable), replacing any earlier build of the same version.
@@ -157,12 +200,25 @@ fn install(python: &Path, wheel: &Path) -> anyhow::Result<()> {
 
 /// `pip wheel crates/robowire-py`, as the README tells users to install it.
 fn build_wheel(root: &Path, target: &Path, python: &Path) -> anyhow::Result<PathBuf> {
-    let out = target.join("wheels");
+    build_wheel_with(root, target, python, None)
+}
+
+/// [`build_wheel`], with physics (the cargo feature `mujoco`, against the MuJoCo in `mujoco`)
+/// when given, as the README tells users to build it.
+fn build_wheel_with(root: &Path, target: &Path, python: &Path, mujoco: Option<&Path>) -> anyhow::Result<PathBuf> {
+    let out = target.join(if mujoco.is_some() { "wheels-mujoco" } else { "wheels" });
     let _ = std::fs::remove_dir_all(&out);
-    println!("== building the wheel (pip wheel crates/robowire-py, maturin, release)");
-    pip(
-        python,
-        &["wheel", "--no-deps", "-w", &out.to_string_lossy(), &root.join("crates/robowire-py").to_string_lossy()],
+    let with = if mujoco.is_some() { " --features mujoco" } else { "" };
+    println!("== building the wheel (pip wheel crates/robowire-py, maturin, release{with})");
+    let crate_dir = root.join("crates/robowire-py");
+    run(
+        "pip wheel",
+        Command::new(python)
+            .args(["-m", "pip", "--disable-pip-version-check", "-q", "wheel", "--no-deps", "-w"])
+            .arg(&out)
+            .arg(&crate_dir)
+            .envs(mujoco.map(|dir| ("MUJOCO_DYNAMIC_LINK_DIR", dir.as_os_str())))
+            .envs(mujoco.map(|_| ("MATURIN_PEP517_ARGS", std::ffi::OsStr::new("--features mujoco")))),
     )?;
     let wheel = std::fs::read_dir(&out)?
         .flatten()

@@ -19,6 +19,9 @@
 //!   1 s beyond, when the writer drops what it cannot admit. The stream's lateness is its wake-up
 //!   lateness on each tick (a write that waited would make the next ticks late).
 //!
+//! - with MuJoCo (feature `mujoco`): the Go2 round trip with the simulator's 500 Hz stream on,
+//!   its body the kinematic joint model, then physics (1 kHz MuJoCo on the stream's thread).
+//!
 //! Each side has a CPU of its own (client CPU 0, peer CPU 1), ddsperf's as ours. Figures to
 //! `ROBOWIRE_BENCH_META_DDS` for `cargo xtask bench`. Runs where loopback carries multicast
 //! (`robowire_dds::netns`); needs `ddsperf` (Debian's cyclonedds-tools).
@@ -107,13 +110,33 @@ fn tagged(tag: u32) -> LowCmd {
     cmd
 }
 
-/// Round trips through the simulated Go2.
+/// Round trips through the simulated Go2, its state stream at 1 Hz.
 async fn go2_round_trips(seconds: u32) -> Vec<f64> {
+    go2_round_trips_beside(seconds, Go2SimConfig { state_period: STATE_PERIOD, ..Go2SimConfig::default() }).await
+}
+
+/// Round trips through the simulated Go2 of `config` (its participant and answers set here).
+async fn go2_round_trips_beside(seconds: u32, config: Go2SimConfig) -> Vec<f64> {
     let participant = ParticipantOptions::new(0, Some("lo"));
-    let config =
-        Go2SimConfig { participant, answer_lowcmd: true, state_period: STATE_PERIOD, ..Go2SimConfig::default() };
+    let config = Go2SimConfig { participant, answer_lowcmd: true, ..config };
     let _sim = on_cpu(PEER_CPU, || Go2Sim::spawn(config).expect("simulator"));
     round_trips::<LowCmd, LowState>(seconds, tagged, |s| s.reserve.get()).await
+}
+
+/// With MuJoCo (feature `mujoco`): round trips through the Go2 with its 500 Hz stream on, its
+/// body the kinematic joint model and then physics (1 kHz MuJoCo on the stream's thread): what
+/// the physics costs a client.
+#[cfg(feature = "mujoco")]
+async fn go2_physics_round_trips(seconds: u32) -> Value {
+    let kinematic = percentiles(go2_round_trips_beside(seconds, Go2SimConfig::default()).await);
+    let physics = Some(robowire_sim::physics::PhysicsOptions::default());
+    let physics =
+        percentiles(go2_round_trips_beside(seconds, Go2SimConfig { physics, ..Go2SimConfig::default() }).await);
+    println!(
+        "Go2 round trip, 500 Hz stream: kinematic p50 {:.1} p99 {:.1} µs, physics p50 {:.1} p99 {:.1} µs",
+        kinematic.0, kinematic.1, physics.0, physics.1
+    );
+    json!({"kinematic_us": {"p50": kinematic.0, "p99": kinematic.1}, "physics_us": {"p50": physics.0, "p99": physics.1}})
 }
 
 /// Round trips through the simulated 29-dof G1 (mode_machine 5; `reserve[0]` tags).
@@ -418,6 +441,10 @@ fn main() {
         let g1_trips = runtime.block_on(g1_round_trips(seconds));
         let ways = runtime.block_on(one_way(seconds));
         let stalled = stalled_reader(seconds);
+        #[cfg(feature = "mujoco")]
+        let physics = runtime.block_on(go2_physics_round_trips(seconds));
+        #[cfg(not(feature = "mujoco"))]
+        let physics = Value::Null;
         let ((r50, r99), (w50, w99)) = (percentiles(trips.clone()), percentiles(ways.clone()));
         let (g50, g99) = percentiles(g1_trips.clone());
         println!(
@@ -436,6 +463,7 @@ fn main() {
             "g1_round_trip_us": {"p50": g50, "p99": g99, "count": g1_trips.len()},
             "ddsperf_1000_half_round_trip_us": {"p50": hg_half50, "p99": hg_half99},
             "stalled_reader": stalled,
+            "go2_500hz_round_trip": physics,
         })
     })
     .unwrap_or_else(|e| panic!("DDS on one machine needs multicast on lo: {e}"));

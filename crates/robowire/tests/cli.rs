@@ -184,3 +184,24 @@ fn error_messages_say_each_cause_once_and_what_was_expected() {
     assert!(err.contains("4-byte encapsulation header") && err.contains("2 bytes given"), "{err}");
     assert!(!err.contains("1180"), "not the struct image's length: {err}");
 }
+
+#[test]
+#[cfg(not(feature = "mujoco"))]
+fn physics_in_a_build_without_mujoco_says_how_to_get_it() {
+    for robot in ["go2", "g1"] {
+        let out = robowire().args(["sim", robot, "--physics", "--interface", "lo"]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{stderr}");
+        assert!(stderr.contains("built without physics") && stderr.contains("--features mujoco"), "{stderr}");
+    }
+}
+
+#[test]
+fn a_speed_out_of_range_and_a_model_without_physics_are_refused() {
+    let out = robowire().args(["sim", "go2", "--speed", "0", "--interface", "lo"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("speed 0 is outside"), "{stderr}");
+    let out = robowire().args(["sim", "go2", "--model", "go2.xml"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && stderr.contains("--physics"), "{stderr}");
+}

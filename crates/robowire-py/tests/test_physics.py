@@ -1,0 +1,73 @@
+"""robowire.sim.Go2 and robowire.sim.G1 with physics (MuJoCo, a wheel built with the cargo
+feature ``mujoco``; ``cargo xtask test`` builds one when MuJoCo is here). A wheel without it
+refuses ``physics=True`` with robowire.Error."""
+
+import time
+
+import pytest
+
+import robowire
+import robowire.go2
+import robowire.sim
+from conftest import missing
+
+STAND = list(robowire.go2.STAND_POSE_RAD) * 4
+
+
+def physics_go2(domain):
+    """A physics Go2 on ``domain``, or a skip (a failure where ``physics`` is required)."""
+    try:
+        return robowire.sim.Go2(domain=domain, physics=True)
+    except robowire.Error as e:
+        if "without physics" not in str(e):
+            raise
+        missing("physics", f"this wheel has no physics: {e}")
+
+
+def test_without_physics_the_simulators_say_so_or_have_a_body(dds):
+    try:
+        sim = robowire.sim.Go2(domain=8, physics=True)
+    except robowire.Error as e:
+        assert "built without physics" in str(e) and "mujoco" in str(e)
+        with pytest.raises(robowire.Error, match="without physics"):
+            robowire.sim.G1(domain=8, physics=True)
+        return
+    with sim:
+        body = sim.snapshot()["body"]
+        assert body["base"] is not None and 0.05 < body["base"]["position_m"][2] < 0.2, body
+
+
+def test_a_model_needs_physics(dds):
+    with pytest.raises(robowire.ArgumentError, match="physics"):
+        robowire.sim.Go2(domain=8, model="go2.xml")
+
+
+def test_the_physics_go2_stands_under_the_stand_gains_and_sinks_when_damped(dds):
+    with physics_go2(9) as sim, robowire.go2.LowLevel(domain=9) as robot:
+        robot.wait_state(timeout_s=5.0)
+        assert sim.snapshot()["body"]["base"]["position_m"][2] < 0.15, "lying"
+        robot.release_sport_mode()
+        start = robot.joint_positions()
+        began = time.monotonic()
+        while (t := time.monotonic() - began) < 3.0:  # 1.5 s up (Unitree's stand), 1.5 s held
+            ratio = min(t / 1.5, 1.0)
+            robot.set_joints(q=[(1 - ratio) * s + ratio * q for s, q in zip(start, STAND)], kp=60.0, kd=5.0)
+            time.sleep(0.002)
+        body = sim.snapshot()["body"]
+        assert body["base"]["position_m"][2] > 0.25, body
+        assert body["sim_time_s"] > 2.0 and body["wall_time_s"] > 0.0
+        robot.damp()
+        deadline = time.monotonic() + 10.0  # a failure bound: it sinks in well under a second
+        while time.monotonic() < deadline and sim.snapshot()["body"]["base"]["position_m"][2] > 0.15:
+            time.sleep(0.01)
+        assert sim.snapshot()["body"]["base"]["position_m"][2] < 0.15
+
+
+def test_the_physics_g1_hangs_by_its_pelvis(dds):
+    physics_go2(10).close()  # skips without physics
+    with robowire.sim.G1(domain=10, physics=True) as sim:
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline and sim.snapshot()["body"]["sim_time_s"] < 0.5:
+            time.sleep(0.01)
+        base = sim.snapshot()["body"]["base"]
+        assert base["position_m"][2] > 0.85, base
