@@ -157,7 +157,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
         serde_json::from_str(&std::fs::read_to_string(&streams_meta_path).context("streams bench metadata")?)?;
     rows.extend(stream_rows(&streams)?);
     let dds: Value = serde_json::from_str(&std::fs::read_to_string(&dds_meta_path).context("DDS bench metadata")?)?;
-    rows.extend(dds_rows(&dds)?);
+    rows.extend(crate::bench_apps::dds_rows(&dds)?);
     let ros2: Value = serde_json::from_str(&std::fs::read_to_string(&ros2_meta_path).context("ROS 2 bench metadata")?)?;
     rows.push(crate::bench_apps::ros2_row(&ros2)?);
     let record: Value =
@@ -329,54 +329,6 @@ fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// The Go2's round trip over DDS against twice `ddsperf`'s figure: ≤ 1.5× (issue 14).
-const DDS_ROUND_TRIP_RATIO: f64 = 1.5;
-
-/// Rows of the DDS bench: round trip and one way, beside `ddsperf` with the same payload.
-fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
-    let us = |path: [&str; 2]| meta[path[0]][path[1]].as_f64().with_context(|| format!("dds meta {path:?}"));
-    let seconds = meta["seconds"].as_f64().context("dds meta seconds")?;
-    let (half50, half99) = (us(["ddsperf_half_round_trip_us", "p50"])?, us(["ddsperf_half_round_trip_us", "p99"])?);
-    let mut rows = Vec::new();
-    for pct in ["p50", "p99"] {
-        let (trip, half) = (us(["round_trip_us", pct])?, if pct == "p50" { half50 } else { half99 });
-        let ratio = trip / (2.0 * half);
-        rows.push(Row {
-            path: format!("Go2 LowCmd → LowState answer via the simulator, DDS on loopback, {pct} ({seconds:.0} s)"),
-            figure: format!("{trip:.1} µs"),
-            baseline: format!("CycloneDDS ddsperf ping/pong, 812 B, round trip: {:.1} µs", 2.0 * half),
-            ratio: format!("{ratio:.2}×"),
-            target: format!("≤ {DDS_ROUND_TRIP_RATIO}× ddsperf"),
-            met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
-        });
-    }
-    let (g_half50, g_half99) =
-        (us(["ddsperf_1000_half_round_trip_us", "p50"])?, us(["ddsperf_1000_half_round_trip_us", "p99"])?);
-    for pct in ["p50", "p99"] {
-        let (trip, half) = (us(["g1_round_trip_us", pct])?, if pct == "p50" { g_half50 } else { g_half99 });
-        let ratio = trip / (2.0 * half);
-        rows.push(Row {
-            path: format!("G1 LowCmd → LowState answer via the simulator, DDS on loopback, {pct} ({seconds:.0} s)"),
-            figure: format!("{trip:.1} µs"),
-            baseline: format!("CycloneDDS ddsperf ping/pong, 1000 B, round trip: {:.1} µs", 2.0 * half),
-            ratio: format!("{ratio:.2}×"),
-            target: format!("≤ {DDS_ROUND_TRIP_RATIO}× ddsperf"),
-            met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
-        });
-    }
-    let (w50, w99) = (us(["one_way_us", "p50"])?, us(["one_way_us", "p99"])?);
-    rows.push(Row {
-        path: "Go2 LowCmd write (encode, CRC, rustdds) → verified at a reader, one way".into(),
-        figure: format!("p50 {w50:.1} µs, p99 {w99:.1} µs"),
-        baseline: format!("ddsperf half round trip: p50 {half50:.1} µs, p99 {half99:.1} µs"),
-        ratio: format!("{:.2}× (p50)", w50 / half50),
-        target: "–".into(),
-        met: None,
-    });
-    rows.extend(stalled_reader_rows(&meta["stalled_reader"])?);
-    Ok(rows)
-}
-
 /// A stalled reader may raise the LowCmd stream's p99 lateness to 1.5× the healthy run's, and no
 /// send may be later than 1 ms (issue: a reader that stops reading, reliable QoS).
 const STALLED_P99_RATIO: f64 = 1.5;
@@ -384,7 +336,7 @@ const STALLED_MAX_US: u64 = 1000;
 
 /// Rows of the stalled-reader runs: the Go2 client's LowCmd stream with a healthy RELIABLE
 /// reader, and beside it the same stream while the reader stalls.
-fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
+pub(crate) fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     let case = |key: &str| -> anyhow::Result<(u64, u64, u64, u64, f64, f64)> {
         let c = &meta[key];
         let (p50, p99, max) = percentiles_us(&c["lateness"])?;
