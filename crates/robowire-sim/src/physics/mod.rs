@@ -103,13 +103,17 @@ pub struct Physics {
     /// By body id: the foot it belongs to.
     foot_of_body: Vec<Option<usize>>,
     feet: usize,
+    /// Each foot's contact force after the last step, N.
+    foot_force_n: [f32; 4],
     /// Time given but not yet stepped (less than one step), s.
     carry_s: f64,
+    /// Time stepped since the robot was placed (its settling not counted), s.
+    time_s: f64,
 }
 
 impl std::fmt::Debug for Physics {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Physics").field("time_s", &self.data.time()).finish_non_exhaustive()
+        f.debug_struct("Physics").field("time_s", &self.time_s).finish_non_exhaustive()
     }
 }
 
@@ -190,7 +194,18 @@ impl Physics {
         data.forward();
         let feet = foot_joints.len();
         let tau_nm = vec![0.0; motors.len()];
-        Ok(Self { data, motors, tau_nm, base_qpos, base_dof, foot_of_body, feet, carry_s: 0.0 })
+        Ok(Self {
+            data,
+            motors,
+            tau_nm,
+            base_qpos,
+            base_dof,
+            foot_of_body,
+            feet,
+            foot_force_n: [0.0; 4],
+            carry_s: 0.0,
+            time_s: 0.0,
+        })
     }
 
     /// Lets the body come to rest for `seconds` with every joint held at its start place
@@ -277,7 +292,9 @@ impl Plant for Physics {
         while self.carry_s >= STEP_S * 0.999 {
             self.step_once(targets);
             self.carry_s -= STEP_S;
+            self.time_s += STEP_S;
         }
+        self.foot_force_n = self.foot_forces().map(|f| f as f32);
     }
 
     fn joint(&self, motor: usize) -> JointReading {
@@ -310,11 +327,11 @@ impl Plant for Physics {
     }
 
     fn foot_force_n(&self, foot: usize) -> Option<f32> {
-        (foot < self.feet).then(|| self.foot_forces()[foot] as f32)
+        (foot < self.feet).then(|| self.foot_force_n.get(foot).copied().unwrap_or(0.0))
     }
 
     fn time_s(&self) -> f64 {
-        self.data.time()
+        self.time_s
     }
 }
 
