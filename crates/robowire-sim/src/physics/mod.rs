@@ -194,7 +194,8 @@ impl Physics {
     }
 
     /// Lets the body come to rest for `seconds` with every joint held at its start place
-    /// (the base falls onto the floor, the legs keep their pose).
+    /// (the base falls onto the floor, the legs keep their pose), before the simulation's time
+    /// starts: the time is 0 after it.
     pub fn settle(&mut self, seconds: f64) {
         let held: Vec<(usize, usize, f64)> =
             self.motors.iter().flatten().map(|m| (m.qpos, m.dof, self.data.qpos()[m.qpos])).collect();
@@ -207,6 +208,7 @@ impl Physics {
                 self.data.qvel_mut()[dof] = 0.0;
             }
         }
+        self.data.set_time(0.0);
         self.data.forward();
     }
 
