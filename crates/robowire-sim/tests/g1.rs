@@ -3,67 +3,26 @@
 //! `mode` per motor), PR and AB on the ankles, `rt/arm_sdk` blended by its weight, the services
 //! refusing motion after ReleaseMode, and the faults.
 
-use std::time::{Duration, Instant};
+mod unitree_wire;
 
-use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, g1_arm, g1_loco, motion_switcher, status};
+use std::time::Instant;
+
+use lowcmd_proto::api::{self, g1_arm, g1_loco, motion_switcher, status};
 use lowcmd_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, ModePr, slot};
-use lowcmd_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, Message};
-use robowire_core::cdr::CdrType;
+use lowcmd_proto::{HgLowCmd, HgLowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
 use robowire_sim::g1::{G1Fault, G1Sim, G1SimConfig, G1Snapshot, JOINTS, STAND_POSE_RAD};
-
-/// Generous: a condition not reached within this is a failure, not slowness.
-const WAIT: Duration = Duration::from_secs(20);
-
-/// How long a call waits for its answer before it writes its request again (a request
-/// written before the service's reader is matched is lost).
-const RESEND_EVERY: Duration = Duration::from_millis(250);
-
-/// One of the robot's services, called by hand: its request writer and answer reader.
-struct ServiceClient {
-    requests: Writer<ApiRequest>,
-    answers: Reader<ApiResponse>,
-}
-
-impl ServiceClient {
-    fn new(participant: &Participant, service: &str) -> Self {
-        let (requests, answers) = (api::request_topic(service).to_string(), api::response_topic(service).to_string());
-        Self {
-            requests: participant.writer(&requests, Qos::WRITER).unwrap(),
-            answers: participant.reader(&answers, Qos::RPC_READER).unwrap(),
-        }
-    }
-}
-
-/// A LowCmd sent with a wrong CRC.
-#[derive(Debug, Clone, Copy)]
-struct Unsealed(HgLowCmd);
-
-impl CdrType for Unsealed {
-    const TYPE_NAME: &'static str = HgLowCmd::DDS_TYPE_NAME;
-    type Error = DecodeError<()>;
-    fn body_len(&self) -> usize {
-        self.0.body_len()
-    }
-    fn encode_body(&self, out: &mut [u8]) -> Result<usize, robowire_core::BufferTooSmall> {
-        let n = self.0.encode_body(out)?;
-        out[n - 1] ^= 0xFF; // the CRC is the body's last word
-        Ok(n)
-    }
-    fn decode_body(encoding: CdrEncoding, body: &[u8]) -> Result<Self, Self::Error> {
-        <HgLowCmd as CdrType>::decode_body(encoding, body).map(Self)
-    }
-}
+use unitree_wire::{ServiceClient, Unsealed, WAIT};
 
 /// The other end of the wire: Unitree's side.
 struct Client {
     runtime: tokio::runtime::Runtime,
     lowcmd: Writer<HgLowCmd>,
-    lowcmd_unsealed: Writer<Unsealed>,
+    lowcmd_unsealed: Writer<Unsealed<HgLowCmd>>,
     arm_sdk: Writer<HgLowCmd>,
-    arm_sdk_unsealed: Writer<Unsealed>,
+    arm_sdk_unsealed: Writer<Unsealed<HgLowCmd>>,
     states: Reader<HgLowState>,
     switcher: ServiceClient,
     loco: ServiceClient,
@@ -105,37 +64,12 @@ impl Client {
     /// code and data.
     fn call(&mut self, service: &str, api_id: i64, parameter: &str) -> (i32, String) {
         self.next_id += 1;
-        let request = ApiRequest {
-            header: RequestHeader::call(self.next_id, api_id),
-            parameter: parameter.into(),
-            binary: vec![],
-        };
         let client = match service {
             motion_switcher::SERVICE => &mut self.switcher,
             g1_loco::SERVICE => &mut self.loco,
             _ => &mut self.arm,
         };
-        let id = self.next_id;
-        let answer = self.runtime.block_on(async {
-            tokio::time::timeout(WAIT, async {
-                loop {
-                    client.requests.write(request.clone()).unwrap();
-                    let answered = tokio::time::timeout(RESEND_EVERY, async {
-                        loop {
-                            match client.answers.recv().await {
-                                Ok(sample) if sample.value.id == id => return sample.value,
-                                _ => {}
-                            }
-                        }
-                    });
-                    if let Ok(answer) = answered.await {
-                        return answer;
-                    }
-                }
-            })
-            .await
-            .expect("an answer in time")
-        });
+        let answer = self.runtime.block_on(client.call(self.next_id, api_id, parameter));
         (answer.code, answer.data)
     }
 

@@ -96,6 +96,11 @@ fn a_damped_go2_sinks_and_a_silent_one_too() {
 #[test]
 fn the_go2_s_state_comes_from_the_physics() {
     let mut body = Go2Body::physics(&PhysicsOptions::default()).unwrap();
+    // Settled before its time starts: lying at rest, the motors passive.
+    let lying = body.sport_state().unwrap();
+    let speed = lying.velocity.iter().map(|v| v.get().powi(2)).sum::<f32>().sqrt();
+    assert!(lying.body_height.get() < 0.15 && speed < 0.05, "{lying:?}");
+    assert_eq!(lying.stamp.sec.get(), 0);
     let start = body.joint_positions();
     drive(&mut body, 1000, (60.0, 5.0), |i| lerp(&start, &STAND, (i as f32 / 500.0).min(1.0)));
     let state = body.low_state();

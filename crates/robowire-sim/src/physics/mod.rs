@@ -208,20 +208,25 @@ impl Physics {
         })
     }
 
-    /// Lets the body come to rest for `seconds` with every joint held at its start place
-    /// (the base falls onto the floor, the legs keep their pose).
+    /// Lets the body come to rest for `seconds` before the simulation's time starts, every
+    /// motor holding its start angle under the stand gains of Unitree's examples (kp 60, kd 5):
+    /// the base drops onto the floor with the legs in their pose.
     pub fn settle(&mut self, seconds: f64) {
-        let held: Vec<(usize, usize, f64)> =
-            self.motors.iter().flatten().map(|m| (m.qpos, m.dof, self.data.qpos()[m.qpos])).collect();
+        let targets: Vec<PdTarget> = self
+            .motors
+            .iter()
+            .map(|m| match m {
+                Some(m) => {
+                    PdTarget { q_rad: self.data.qpos()[m.qpos] as f32, kp: 60.0, kd: 5.0, ..PdTarget::default() }
+                }
+                None => PdTarget::default(),
+            })
+            .collect();
         for _ in 0..(seconds / STEP_S).round() as u32 {
-            self.data.step();
-            for &(at, _, q) in &held {
-                self.data.qpos_mut()[at] = q;
-            }
-            for &(_, dof, _) in &held {
-                self.data.qvel_mut()[dof] = 0.0;
-            }
+            self.step_once(&targets);
         }
+        self.tau_nm.fill(0.0);
+        self.data.set_time(0.0);
         self.data.forward();
     }
 

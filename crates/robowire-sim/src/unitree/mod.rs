@@ -196,6 +196,20 @@ const ADVANCE_CHUNK: u32 = 50;
 /// Requests the stream has not taken yet (the handle waits for each).
 const REQUESTS: usize = 16;
 
+/// Samples a lock-step stream's writers keep until the transport has sent them: a lock-step
+/// request writes [`ADVANCE_CHUNK`] states at once, faster than the transport sends them, and a
+/// writer keeping only the newest (Unitree's keep-last 1, with the best-effort readers of
+/// Unitree's clients) would send a few of them. Local to the writer: not matched on the wire.
+const LOCK_STEP_KEPT: i32 = 4 * ADVANCE_CHUNK as i32;
+
+/// The QoS of the stream's writers under `clock`.
+fn stream_qos(clock: SimClock) -> Qos {
+    match clock {
+        SimClock::RealTime { .. } => Qos::STREAM_WRITER,
+        SimClock::LockStep => Qos { depth: LOCK_STEP_KEPT, ..Qos::STREAM_WRITER },
+    }
+}
+
 /// How a robot's stream runs.
 #[derive(Debug)]
 pub(crate) struct StreamOptions {
@@ -313,10 +327,9 @@ impl<B: StreamBody> Sim<B> {
         handover.published.write(robowire_rt::now(), &body.published());
         let report = Arc::new(Mutex::new(report));
         // The stream's writers never wait: a full send window is a dropped sample, counted.
-        let mut writer =
-            participant.writer::<B::State>(<B::State as lowcmd_proto::Message>::TOPIC, Qos::STREAM_WRITER)?;
-        let mut corrupt =
-            participant.writer::<BitFlipped<B>>(<B::State as lowcmd_proto::Message>::TOPIC, Qos::STREAM_WRITER)?;
+        let qos = stream_qos(options.clock);
+        let mut writer = participant.writer::<B::State>(<B::State as lowcmd_proto::Message>::TOPIC, qos)?;
+        let mut corrupt = participant.writer::<BitFlipped<B>>(<B::State as lowcmd_proto::Message>::TOPIC, qos)?;
         writer.set_tap(options.tap.clone());
         corrupt.set_tap(options.tap);
         let lowstate = writer.stats_handle();
@@ -326,7 +339,7 @@ impl<B: StreamBody> Sim<B> {
         };
         let grid = Periodic::new(robowire_rt::now(), wall_period);
         let sport = match body.base_pose() {
-            Some(_) => Some(participant.writer(lowcmd_proto::sport_state::SPORT_MODE_STATE_TOPIC, Qos::STREAM_WRITER)?),
+            Some(_) => Some(participant.writer(lowcmd_proto::sport_state::SPORT_MODE_STATE_TOPIC, qos)?),
             None => None,
         };
         let writers = Writers { state: writer, corrupt, sport };
