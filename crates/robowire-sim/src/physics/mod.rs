@@ -181,7 +181,8 @@ impl Physics {
         if options.hanging {
             hang(&mut model, base_pose, (base_qpos, base_dof));
         }
-        let mut data = MjData::new(Box::new(model));
+        let mut data = MjData::try_new(Box::new(model))
+            .map_err(|e| PhysicsError::Load { model: name.clone(), reason: e.to_string() })?;
         {
             let qpos = data.qpos_mut();
             qpos[base_qpos..base_qpos + 7].copy_from_slice(&base_pose);
@@ -276,7 +277,8 @@ const HANG_STIFFNESS: f64 = 1.0e4;
 /// `pose` and a damping near critical for the robot's mass (damping is integrated implicitly,
 /// so a stiff hold stays stable at 1 ms).
 fn hang(model: &mut MjModel, pose: [f64; 7], (qpos, dof): (usize, usize)) {
-    let mass = model.body_subtreemass().get(1).copied().unwrap_or(30.0).max(1.0);
+    let base = model.jnt_bodyid()[0] as usize;
+    let mass = model.body_subtreemass().get(base).copied().unwrap_or(30.0).max(1.0);
     model.qpos_spring_mut()[qpos..qpos + 7].copy_from_slice(&pose);
     model.jnt_stiffness_mut()[0] = HANG_STIFFNESS;
     let damping = model.dof_damping_mut();
