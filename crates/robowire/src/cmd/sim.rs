@@ -17,11 +17,12 @@ pub(crate) enum SimCommand {
     /// A ZSL-1 / ZSL-1W dog on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
     Dog(DogSimArgs),
     /// A Unitree Go2 on DDS (rt/lowcmd, rt/lowstate at 500 Hz, motion_switcher and sport), booted
-    /// with its sport mode owning the motors, as Unitree's software expects.
+    /// with its sport mode owning the motors, as Unitree's software expects; --physics: its body
+    /// in MuJoCo (a build with the `mujoco` feature).
     Go2(Go2SimArgs),
     /// A Unitree G1 humanoid on DDS (rt/lowcmd, rt/arm_sdk, rt/lowstate at 500 Hz,
     /// motion_switcher, the loco service `sport` and `arm`), booted standing under its own
-    /// controller, as Unitree's software expects.
+    /// controller, as Unitree's software expects; --physics: its body in MuJoCo, hanging.
     G1(G1SimArgs),
 }
 
