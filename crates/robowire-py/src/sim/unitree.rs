@@ -71,7 +71,10 @@ pub(crate) fn physics_arg(
     model: Option<std::path::PathBuf>,
     _hanging: bool,
 ) -> pyo3::PyResult<Option<()>> {
-    if physics || model.is_some() {
+    if model.is_some() && !physics {
+        return Err(crate::errors::error(crate::errors::Kind::Argument, "model needs physics=True"));
+    }
+    if physics {
         return Err(crate::errors::error(
             crate::errors::Kind::Error,
             "this robowire wheel was built without physics (MuJoCo): build it with the cargo feature `mujoco`",
