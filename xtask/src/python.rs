@@ -130,25 +130,6 @@ pub fn test_python() -> anyhow::Result<()> {
             ""
         }
     };
-    // With MuJoCo here, the physics tests once more on a wheel built with the feature, in a
-    // venv of their own (the suite's other tests ran on the wheel users build by default).
-    let physics = match crate::physics::lib_dir(&target) {
-        Ok(dir) => {
-            let venv = bare_venv(&target, &format!("{version}-physics"), &second)?;
-            let wheel = build_wheel_with(&root, &target, &venv, Some(&dir))?;
-            Some(PytestRun {
-                python: venv,
-                wheel,
-                require: "physics".into(),
-                tests: "test_physics.py",
-                mujoco: Some(dir),
-            })
-        }
-        Err(missing) => {
-            interop::missing("the Python physics tests (MuJoCo)", missing).map_err(anyhow::Error::msg)?;
-            None
-        }
-    };
     let suite = |python, require: &str| PytestRun {
         python,
         wheel: wheel.clone(),
@@ -157,29 +138,54 @@ pub fn test_python() -> anyhow::Result<()> {
         mujoco: None,
     };
     let runs = py310.map(|python| suite(python, "vendor,sdk,mcap,cli")).into_iter().chain([suite(second_venv, "cli")]);
-    for run_ in runs.chain(physics) {
-        install(&run_.python, &run_.wheel)?;
-        pip(&run_.python, &["install", "--no-warn-script-location", "pytest"])?;
-        let require = format!("{}{dds}", run_.require);
-        let mut pytest = match userns {
-            Ok(true) => userns::command(&run_.python).map_err(anyhow::Error::msg)?,
-            _ => Command::new(&run_.python),
-        };
-        let inside = if matches!(userns, Ok(true)) { " in a user + network namespace" } else { "" };
-        println!("\n== pytest on {}{inside} (required here: {require})", run_.python.display());
-        let tests = root.join("crates/robowire-py/tests").join(run_.tests);
-        run(
-            "pytest",
-            pytest
-                .args(["-m", "pytest"])
-                .arg(tests)
-                .args(["-q", "-p", "no:cacheprovider", "-rs"])
-                .env("ROBOWIRE_REQUIRE", &require)
-                .env("ROBOWIRE_CLI", target.join("debug/robowire"))
-                .envs(run_.mujoco.iter().map(|dir| ("LD_LIBRARY_PATH", dir)))
-                .current_dir(&root),
-        )?;
+    for run_ in runs {
+        pytest_run(&root, &target, &run_, &userns, dds)?;
     }
+    // With MuJoCo here, the physics tests once more on a wheel built with the feature, in a
+    // venv of their own: after the suite's runs, as maturin also writes each wheel it builds
+    // into target/wheels, where the default wheel of the runs above lies.
+    match crate::physics::lib_dir(&target) {
+        Ok(dir) => {
+            let venv = bare_venv(&target, &format!("{version}-physics"), &second)?;
+            let wheel = build_wheel_with(&root, &target, &venv, Some(&dir))?;
+            let tests = "test_physics.py";
+            let physics = PytestRun { python: venv, wheel, require: "physics".into(), tests, mujoco: Some(dir) };
+            pytest_run(&root, &target, &physics, &userns, dds)
+        }
+        Err(missing) => interop::missing("the Python physics tests (MuJoCo)", missing).map_err(anyhow::Error::msg),
+    }
+}
+
+/// Runs `run_`: pytest in a user + network namespace (`userns` `Ok(true)`) or here; `dds` is
+/// `",dds"` where DDS must not skip.
+fn pytest_run(
+    root: &Path,
+    target: &Path,
+    run_: &PytestRun,
+    userns: &Result<bool, String>,
+    dds: &str,
+) -> anyhow::Result<()> {
+    install(&run_.python, &run_.wheel)?;
+    pip(&run_.python, &["install", "--no-warn-script-location", "pytest"])?;
+    let require = format!("{}{dds}", run_.require);
+    let mut pytest = match userns {
+        Ok(true) => userns::command(&run_.python).map_err(anyhow::Error::msg)?,
+        _ => Command::new(&run_.python),
+    };
+    let inside = if matches!(userns, Ok(true)) { " in a user + network namespace" } else { "" };
+    println!("\n== pytest on {}{inside} (required here: {require})", run_.python.display());
+    let tests = root.join("crates/robowire-py/tests").join(run_.tests);
+    run(
+        "pytest",
+        pytest
+            .args(["-m", "pytest"])
+            .arg(tests)
+            .args(["-q", "-p", "no:cacheprovider", "-rs"])
+            .env("ROBOWIRE_REQUIRE", &require)
+            .env("ROBOWIRE_CLI", target.join("debug/robowire"))
+            .envs(run_.mujoco.iter().map(|dir| ("LD_LIBRARY_PATH", dir)))
+            .current_dir(root),
+    )?;
     Ok(())
 }
 
