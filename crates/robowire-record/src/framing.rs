@@ -234,7 +234,7 @@ fn check_summary_start(bytes: &[u8]) -> Result<(), Broken> {
 }
 
 /// Whether a top-level record starts at `offset` (walking the record headers from the start).
-fn record_starts_at(bytes: &[u8], offset: usize) -> bool {
+pub(crate) fn record_starts_at(bytes: &[u8], offset: usize) -> bool {
     let mut at = MAGIC.len();
     while at < offset {
         let Some(len) = bytes.get(at..).and_then(|record| record.get(1..9)) else { return false };

@@ -240,11 +240,16 @@ pub fn summarize(capture: &[u8], known: &[&'static dyn LinkDescription]) -> Resu
 
 /// The `robowire` metadata record, read through the summary section's index. An index whose
 /// range is not inside the file is skipped (`mcap::read::metadata` adds offset and length
-/// unchecked, and panics on their overflow).
+/// unchecked, and panics on their overflow), and so is one that does not point at a metadata
+/// record the framing check walked (the reader parses whatever bytes are there, and sizes its
+/// strings by them: 2 GiB from a 32 KiB file).
 fn read_metadata(capture: &[u8]) -> BTreeMap<String, String> {
     let Ok(Some(summary)) = mcap::Summary::read(capture) else { return BTreeMap::new() };
     let inside = |index: &mcap::records::MetadataIndex| {
         index.offset.checked_add(index.length).is_some_and(|end| end <= capture.len() as u64)
+            && usize::try_from(index.offset).is_ok_and(|offset| {
+                capture.get(offset) == Some(&0x0C) && crate::framing::record_starts_at(capture, offset)
+            })
     };
     summary
         .metadata_indexes
