@@ -58,10 +58,15 @@ pub(crate) trait Plant: Send + std::fmt::Debug {
     fn step(&mut self, dt_s: f32, targets: &[PdTarget]);
     /// Motor `motor`'s joint (a motor the robot does not have reads 0).
     fn joint(&self, motor: usize) -> JointReading;
-    /// The base; `None`: the plant has no body (the kinematic model).
-    fn base(&self) -> Option<BaseReading>;
-    /// Contact force on foot `foot` (the plant's order of feet), N; `None`: no body.
-    fn foot_force_n(&self, foot: usize) -> Option<f32>;
+    /// The base; `None` (the default): the plant has no body (the kinematic model).
+    fn base(&self) -> Option<BaseReading> {
+        None
+    }
+    /// Contact force on foot `foot` (the plant's order of feet), N; `None` (the default): no
+    /// body.
+    fn foot_force_n(&self, _foot: usize) -> Option<f32> {
+        None
+    }
     /// Simulated time stepped so far, s.
     fn time_s(&self) -> f64;
 }
@@ -103,12 +108,6 @@ impl Plant for LegJoints {
         let j = &self.joints;
         JointReading { q_rad: j.q_rad[leg][joint], qd_radps: j.qd_radps[leg][joint], tau_nm: j.tau_nm[leg][joint] }
     }
-    fn base(&self) -> Option<BaseReading> {
-        None
-    }
-    fn foot_force_n(&self, _foot: usize) -> Option<f32> {
-        None
-    }
     fn time_s(&self) -> f64 {
         self.time_s
     }
@@ -141,12 +140,6 @@ impl<const N: usize> Plant for SlotJoints<N> {
             (Some(&q_rad), Some(&qd_radps), Some(&tau_nm)) => JointReading { q_rad, qd_radps, tau_nm },
             _ => JointReading::default(),
         }
-    }
-    fn base(&self) -> Option<BaseReading> {
-        None
-    }
-    fn foot_force_n(&self, _foot: usize) -> Option<f32> {
-        None
     }
     fn time_s(&self) -> f64 {
         self.time_s
