@@ -1,0 +1,17 @@
+#![doc = include_str!("../README.md")]
+#![no_std]
+#![forbid(unsafe_code)]
+
+extern crate alloc;
+
+pub mod limits;
+pub mod types;
+pub mod wire;
+
+pub use wire::WireError;
+pub use limits::Limits;
+pub use robowire_core::schedule::Time;
+pub use types::{
+    EntityId, FragmentNumberSet, Guid, GuidPrefix, Locator, ProtocolVersion, SequenceNumber, SequenceNumberSet,
+    Timestamp, VendorId,
+};

@@ -1,0 +1,53 @@
+//! The named bounds of a participant's memory. Every table the core keeps, and every size read
+//! from a datagram that would size memory, is checked against one of these; what exceeds a limit
+//! is dropped and counted (`Event`s and counters say which), never grown.
+
+use core::time::Duration;
+
+/// A participant's bounds. `Limits::default()` is sized for a robot's network: a few dozen
+/// participants, Unitree's and ROS 2's topics, samples up to a few hundred kilobytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Limits {
+    /// Remote participants known at once; SPDP announcements of more are dropped.
+    pub participants: usize,
+    /// Remote endpoints (writers and readers) known per remote participant.
+    pub endpoints_per_participant: usize,
+    /// Local writers and readers of this participant.
+    pub local_endpoints: usize,
+    /// Locators kept per remote participant or endpoint (unicast and multicast together).
+    pub locators_per_endpoint: usize,
+    /// Bytes of one discovery parameter list (SPDP or SEDP data) accepted.
+    pub parameter_list_bytes: usize,
+    /// Bytes of one string or octet sequence inside a parameter list (topic and type names,
+    /// USER_DATA, partitions, type information).
+    pub parameter_bytes: usize,
+    /// Samples in reassembly at once per reader (DATA_FRAG).
+    pub reassemblies: usize,
+    /// Bytes of one sample reassembled from fragments; a larger `sampleSize` is refused.
+    pub reassembly_bytes: usize,
+    /// How long an incomplete sample waits for its missing fragments.
+    pub reassembly_timeout: Duration,
+    /// Samples a writer's history or a reader's queue may hold (KEEP_LAST depth, KEEP_ALL bound).
+    pub history_depth: usize,
+    /// Bytes of one sample a writer accepts (larger ones are refused, not fragmented beyond this).
+    pub sample_bytes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            participants: 64,
+            endpoints_per_participant: 512,
+            local_endpoints: 256,
+            locators_per_endpoint: 16,
+            parameter_list_bytes: 64 * 1024,
+            parameter_bytes: 16 * 1024,
+            reassemblies: 8,
+            reassembly_bytes: 1024 * 1024,
+            reassembly_timeout: Duration::from_secs(2),
+            history_depth: 1024,
+            sample_bytes: 1024 * 1024,
+        }
+    }
+}
