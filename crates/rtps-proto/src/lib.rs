@@ -8,10 +8,10 @@ pub mod limits;
 pub mod types;
 pub mod wire;
 
-pub use wire::WireError;
 pub use limits::Limits;
 pub use robowire_core::schedule::Time;
 pub use types::{
     EntityId, FragmentNumberSet, Guid, GuidPrefix, Locator, ProtocolVersion, SequenceNumber, SequenceNumberSet,
     Timestamp, VendorId,
 };
+pub use wire::WireError;
