@@ -4,6 +4,9 @@
 
 extern crate alloc;
 
+#[cfg(feature = "fuzzing")]
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod limits;
 pub mod types;
 pub mod wire;
