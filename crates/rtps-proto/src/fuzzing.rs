@@ -101,7 +101,8 @@ fn round_trip(submessage: &Submessage<'_>) {
 
 fn reparse(emitted: &[u8]) -> Submessage<'_> {
     let (kind, flags) = (emitted[0], emitted[1]);
-    let length = usize::from(u16::from_le_bytes([emitted[2], emitted[3]]));
+    let length = [emitted[2], emitted[3]];
+    let length = usize::from(if flags & 1 == 1 { u16::from_le_bytes(length) } else { u16::from_be_bytes(length) });
     let body = if length == 0 { &emitted[4..] } else { &emitted[4..4 + length] };
     Submessage::parse(kind, flags, body).expect("an emitted submessage parses")
 }

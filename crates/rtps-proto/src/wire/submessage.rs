@@ -851,7 +851,8 @@ impl<'a> Submessage<'a> {
         4 + self.body_len()
     }
 
-    /// Writes the submessage (header and body, little-endian, E set) at the start of `buf`;
+    /// Writes the submessage (header and body, little-endian, E set; an `Unknown` with its own
+    /// flags and body, its length in the byte order its E flag gives) at the start of `buf`;
     /// returns [`Submessage::buffer_len`]. Nothing is written when `buf` is too small.
     ///
     /// A body over 65535 bytes gets octetsToNextHeader 0 (it must end the message). A DATA_FRAG's
@@ -863,8 +864,11 @@ impl<'a> Submessage<'a> {
         let dst = buf.get_mut(..needed).ok_or(BufferTooSmall { needed, available })?;
         let mut w = LeWriter::new(dst);
         w.put_u8(self.kind().id())?;
-        w.put_u8(self.flags())?;
-        w.put_u16(u16::try_from(needed - 4).unwrap_or(0))?;
+        let flags = self.flags();
+        w.put_u8(flags)?;
+        // The length is in the submessage's byte order: an `Unknown`'s flags may say big-endian.
+        let length = u16::try_from(needed - 4).unwrap_or(0);
+        w.put_bytes(&if flags & FLAG_E != 0 { length.to_le_bytes() } else { length.to_be_bytes() })?;
         match self {
             Self::Data(d) => {
                 w.put_u16(0)?;
