@@ -4,14 +4,15 @@
 
 extern crate alloc;
 
+pub mod discovery;
 pub mod limits;
 pub mod types;
 pub mod wire;
 
-pub use wire::WireError;
 pub use limits::Limits;
 pub use robowire_core::schedule::Time;
 pub use types::{
     EntityId, FragmentNumberSet, Guid, GuidPrefix, Locator, ProtocolVersion, SequenceNumber, SequenceNumberSet,
     Timestamp, VendorId,
 };
+pub use wire::WireError;
