@@ -865,3 +865,92 @@ proptest! {
         let _ = ParticipantData::parse_payload(&buf[..n], &Limits::default());
     }
 }
+
+// ---- golden datagrams --------------------------------------------------------------------------
+
+/// Discovery DATA payloads from the golden captures (`fixtures/rtps/*.hex`, or the directory in
+/// `ROBOWIRE_RTPS_FIXTURES`): every SPDP and SEDP DATA with a payload parses. The RTPS header and
+/// submessages are walked by hand here, independent of the wire module's iterator.
+#[test]
+fn golden_discovery_payloads_parse() {
+    let dir = std::env::var_os("ROBOWIRE_RTPS_FIXTURES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/rtps"));
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipped: no golden RTPS fixtures at {}", dir.display());
+        return;
+    };
+    let mut files: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+    files.retain(|p| p.extension().is_some_and(|x| x == "hex"));
+    files.sort();
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (mut spdp, mut sedp) = (0, 0);
+        for (n, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let bytes: Vec<u8> =
+                (0..line.len()).step_by(2).map(|i| u8::from_str_radix(&line[i..i + 2], 16).unwrap()).collect();
+            let at = format!("{}:{}", path.display(), n + 1);
+            for (writer, payload, key) in discovery_data(&bytes) {
+                match writer {
+                    [0, 1, 0, 0xc2] => {
+                        let d = ParticipantData::parse_payload(payload, &Limits::default())
+                            .unwrap_or_else(|e| panic!("{at}: SPDP: {e}"));
+                        assert_eq!(&d.guid_prefix.0[..], &bytes[8..20], "{at}");
+                        spdp += 1;
+                    }
+                    [0, 0, 3, 0xc2] | [0, 0, 4, 0xc2] => {
+                        let d = EndpointData::parse_payload(payload, key, &Limits::default())
+                            .unwrap_or_else(|e| panic!("{at}: SEDP: {e}"));
+                        assert_eq!(d.guid.entity.is_reader(), writer[2] == 4, "{at}: {:?}", d.guid);
+                        assert!(!d.topic_name.is_empty(), "{at}");
+                        sedp += 1;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        eprintln!("{}: {spdp} SPDP and {sedp} SEDP payloads parsed", path.display());
+        assert!(spdp > 0, "{}: no SPDP DATA", path.display());
+    }
+}
+
+/// A DATA with a payload: writer entity id, serialized payload, inline key hash.
+type DataPayload<'a> = ([u8; 4], &'a [u8], Option<[u8; 16]>);
+
+/// Each DATA with a payload in the datagram.
+fn discovery_data(msg: &[u8]) -> Vec<DataPayload<'_>> {
+    let mut out = Vec::new();
+    if msg.len() < 20 || &msg[..4] != b"RTPS" {
+        return out;
+    }
+    let mut pos = 20;
+    while pos + 4 <= msg.len() {
+        let (id, flags) = (msg[pos], msg[pos + 1]);
+        let little = flags & 1 != 0;
+        let u16_at =
+            |b: &[u8]| if little { u16::from_le_bytes([b[0], b[1]]) } else { u16::from_be_bytes([b[0], b[1]]) };
+        let len = usize::from(u16_at(&msg[pos + 2..]));
+        let body_start = pos + 4;
+        let body_end = if len == 0 { msg.len() } else { (body_start + len).min(msg.len()) };
+        let body = &msg[body_start..body_end];
+        // DATA with the D flag: extraFlags, octetsToInlineQos, readerId, writerId, writerSN.
+        if id == 0x15 && flags & 0x04 != 0 && body.len() >= 20 {
+            let writer = [body[8], body[9], body[10], body[11]];
+            let mut at = 4 + usize::from(u16_at(&body[2..]));
+            let mut key = None;
+            if flags & 0x02 != 0 {
+                let e = if little { Endianness::Little } else { Endianness::Big };
+                let (qos, used) = ParameterList::parse(&body[at..], e).expect("inline QoS");
+                key = qos.find(0x0070).map(|p| p.value.try_into().expect("a 16-byte key hash"));
+                at += used;
+            }
+            out.push((writer, &body[at..], key));
+        }
+        pos = body_end;
+    }
+    out
+}
