@@ -4,6 +4,7 @@
 
 extern crate alloc;
 
+pub mod discovery;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod fuzzing;
