@@ -8,7 +8,9 @@ pub mod discovery;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod endpoint;
 pub mod limits;
+pub mod participant;
 pub mod types;
 pub mod wire;
 
@@ -19,3 +21,4 @@ pub use types::{
     Timestamp, VendorId,
 };
 pub use wire::WireError;
+

@@ -22,7 +22,7 @@ pub struct Limits {
     /// Bytes of one string or octet sequence inside a parameter list (topic and type names,
     /// USER_DATA, partitions, type information).
     pub parameter_bytes: usize,
-    /// Samples in reassembly at once per reader (DATA_FRAG).
+    /// Samples in reassembly at once per matched writer (DATA_FRAG).
     pub reassemblies: usize,
     /// Bytes of one sample reassembled from fragments; a larger `sampleSize` is refused.
     pub reassembly_bytes: usize,
@@ -32,6 +32,8 @@ pub struct Limits {
     pub history_depth: usize,
     /// Bytes of one sample a writer accepts (larger ones are refused, not fragmented beyond this).
     pub sample_bytes: usize,
+    /// Events (samples included) queued and not yet polled; more are dropped and counted.
+    pub events: usize,
 }
 
 impl Default for Limits {
@@ -48,6 +50,7 @@ impl Default for Limits {
             reassembly_timeout: Duration::from_secs(2),
             history_depth: 1024,
             sample_bytes: 1024 * 1024,
+            events: 4096,
         }
     }
 }

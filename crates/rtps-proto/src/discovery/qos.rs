@@ -218,6 +218,16 @@ impl Qos {
         Self { reliability: Reliability::BestEffort, ..Self::default() }
     }
 
+    /// Reliable (not best effort).
+    pub fn is_reliable(&self) -> bool {
+        matches!(self.reliability, Reliability::Reliable { .. })
+    }
+
+    /// Transient-local or a stronger durability (late joiners get the history).
+    pub fn is_transient_local(&self) -> bool {
+        !matches!(self.durability, Durability::Volatile)
+    }
+
     /// Writes every policy: the fixed-size ones always, the sequences when not empty.
     pub(crate) fn emit(&self, w: &mut ParameterWriter<'_>) -> Result<(), BufferTooSmall> {
         let (kind, mbt) = match self.reliability {
