@@ -5,10 +5,10 @@
 extern crate alloc;
 
 pub mod discovery;
+pub mod endpoint;
 #[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod fuzzing;
-pub mod endpoint;
 pub mod limits;
 pub mod participant;
 pub mod types;
@@ -21,4 +21,3 @@ pub use types::{
     Timestamp, VendorId,
 };
 pub use wire::WireError;
-

@@ -13,11 +13,11 @@ mod reassembly;
 mod writer;
 
 pub use history::{Change, ChangeKind, History};
-pub(crate) use reader::{Delivery, Reader, ReaderConfig, WriterProxy};
 pub use reader::ReaderCounters;
+pub(crate) use reader::{Delivery, Reader, ReaderConfig, WriterProxy};
 pub use reassembly::{Reassembly, ReassemblyError};
-pub(crate) use writer::{ReaderProxy, Writer, WriterConfig};
 pub use writer::WriterCounters;
+pub(crate) use writer::{ReaderProxy, Writer, WriterConfig};
 
 use crate::types::{Guid, SequenceNumber, Timestamp};
 

@@ -343,11 +343,14 @@ impl Reader {
             return;
         }
         proxy.last_heartbeat_frag = Some(hb.count);
-        if let Some(r) = proxy.reassembly.iter().find(|r| r.sequence() == hb.writer_sn) {
-            if let Some(set) = r.missing(hb.last_fragment_num) {
-                proxy.nack_frag = Some((hb.writer_sn, set));
-                proxy.ack_due.get_or_insert(now + delay);
-            }
+        let missing = proxy
+            .reassembly
+            .iter()
+            .find(|r| r.sequence() == hb.writer_sn)
+            .and_then(|r| r.missing(hb.last_fragment_num));
+        if let Some(set) = missing {
+            proxy.nack_frag = Some((hb.writer_sn, set));
+            proxy.ack_due.get_or_insert(now + delay);
         }
     }
 

@@ -47,8 +47,7 @@ impl Reassembly {
         let mut data = buffer;
         data.clear();
         data.resize(size, 0);
-        let mut received = Vec::new();
-        received.resize(total.div_ceil(32) as usize, 0);
+        let received = alloc::vec![0; total.div_ceil(32) as usize];
         Ok(Self {
             sequence: frag.writer_sn,
             sample_size: frag.sample_size,

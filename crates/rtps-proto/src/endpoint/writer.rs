@@ -177,18 +177,6 @@ impl Writer {
         Ok(sn)
     }
 
-    /// Marks `sn` sent to every reader that was due it (the write's own datagram).
-    pub(crate) fn mark_sent_to_all(&mut self, sn: SequenceNumber) {
-        for p in &mut self.readers {
-            if p.next_unsent == sn {
-                p.next_unsent = SequenceNumber(sn.0 + 1);
-                if !p.reliable {
-                    p.acked = p.next_unsent;
-                }
-            }
-        }
-    }
-
     pub(crate) fn handle_acknack(&mut self, now: Time, reader: Guid, acknack: &AckNack) -> bool {
         let next = self.history.next_sequence();
         let delay = self.config.nack_response_delay;

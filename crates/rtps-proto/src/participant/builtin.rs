@@ -14,11 +14,12 @@ use crate::wire::Data;
 
 /// The SEDP endpoints' QoS: reliable, transient-local, keep all.
 fn sedp_qos() -> Qos {
-    let mut q = Qos::default();
-    q.reliability = crate::discovery::Reliability::Reliable { max_blocking_time: DdsDuration::ZERO };
-    q.durability = crate::discovery::Durability::TransientLocal;
-    q.history = History::KeepAll;
-    q
+    Qos {
+        reliability: crate::discovery::Reliability::Reliable { max_blocking_time: DdsDuration::ZERO },
+        durability: crate::discovery::Durability::TransientLocal,
+        history: History::KeepAll,
+        ..Qos::default()
+    }
 }
 
 impl Participant {
@@ -84,8 +85,7 @@ impl Participant {
                 return;
             }
         };
-        if parsed.domain_id.is_some_and(|d| d != self.config.domain_id) || parsed.domain_tag != self.config.domain_tag
-        {
+        if parsed.domain_id.is_some_and(|d| d != self.config.domain_id) || parsed.domain_tag != self.config.domain_tag {
             self.counters.other_domain += 1;
             return;
         }
@@ -117,21 +117,21 @@ impl Participant {
             (EntityId::SEDP_SUBSCRIPTIONS_WRITER, EntityId::SEDP_SUBSCRIPTIONS_READER, Builtin::SUBSCRIPTIONS_DETECTOR),
         ];
         for (ours, theirs, bit) in pairs {
-            if builtin.contains(bit) {
-                if let Some(w) = self.writers.iter_mut().find(|w| w.id == ours) {
-                    w.add_reader(ReaderProxy::new(Guid::new(prefix, theirs), true, true, meta.clone()), now);
-                }
+            if let Some(w) = self.writers.iter_mut().find(|w| w.id == ours && builtin.contains(bit)) {
+                w.add_reader(ReaderProxy::new(Guid::new(prefix, theirs), true, true, meta.clone()), now);
             }
         }
         let pairs = [
             (EntityId::SEDP_PUBLICATIONS_READER, EntityId::SEDP_PUBLICATIONS_WRITER, Builtin::PUBLICATIONS_ANNOUNCER),
-            (EntityId::SEDP_SUBSCRIPTIONS_READER, EntityId::SEDP_SUBSCRIPTIONS_WRITER, Builtin::SUBSCRIPTIONS_ANNOUNCER),
+            (
+                EntityId::SEDP_SUBSCRIPTIONS_READER,
+                EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+                Builtin::SUBSCRIPTIONS_ANNOUNCER,
+            ),
         ];
         for (ours, theirs, bit) in pairs {
-            if builtin.contains(bit) {
-                if let Some(r) = self.readers.iter_mut().find(|r| r.id == ours) {
-                    r.add_writer(WriterProxy::new(Guid::new(prefix, theirs), true, meta.clone()));
-                }
+            if let Some(r) = self.readers.iter_mut().find(|r| r.id == ours && builtin.contains(bit)) {
+                r.add_writer(WriterProxy::new(Guid::new(prefix, theirs), true, meta.clone()));
             }
         }
         // Tell the newcomer about us now rather than at the next period.
@@ -294,7 +294,8 @@ impl Participant {
         let data = self.endpoint_data(local);
         let mut buf = alloc::vec![0u8; self.config.limits.parameter_list_bytes.min(16 * 1024)];
         let Ok(len) = data.emit_payload(&mut buf) else { return };
-        let sedp = if id.is_writer() { EntityId::SEDP_PUBLICATIONS_WRITER } else { EntityId::SEDP_SUBSCRIPTIONS_WRITER };
+        let sedp =
+            if id.is_writer() { EntityId::SEDP_PUBLICATIONS_WRITER } else { EntityId::SEDP_SUBSCRIPTIONS_WRITER };
         let options = WriteOptions { key_hash: Some(data.guid.to_bytes()), ..WriteOptions::default() };
         if let Some(w) = self.writers.iter_mut().find(|w| w.id == sedp) {
             let _ = w.write(now, ChangeKind::Alive, &buf[..len], &options);
@@ -304,7 +305,8 @@ impl Participant {
     /// Announces the removal of local endpoint `id` (a dispose) and forgets its announcement.
     pub(super) fn announce_removal(&mut self, now: Time, id: EntityId) {
         let guid = Guid::new(self.config.guid_prefix, id);
-        let sedp = if id.is_writer() { EntityId::SEDP_PUBLICATIONS_WRITER } else { EntityId::SEDP_SUBSCRIPTIONS_WRITER };
+        let sedp =
+            if id.is_writer() { EntityId::SEDP_PUBLICATIONS_WRITER } else { EntityId::SEDP_SUBSCRIPTIONS_WRITER };
         let Some(w) = self.writers.iter_mut().find(|w| w.id == sedp) else { return };
         let old: Vec<_> =
             w.history.iter().filter(|c| c.key_hash == Some(guid.to_bytes())).map(|c| c.sequence).collect();
@@ -316,7 +318,11 @@ impl Participant {
     }
 
     fn endpoint_data(&self, local: &LocalEndpoint) -> EndpointData {
-        let mut e = EndpointData::new(Guid::new(self.config.guid_prefix, local.id), local.topic.clone(), local.type_name.clone());
+        let mut e = EndpointData::new(
+            Guid::new(self.config.guid_prefix, local.id),
+            local.topic.clone(),
+            local.type_name.clone(),
+        );
         e.participant_guid = Some(Guid::new(self.config.guid_prefix, EntityId::PARTICIPANT));
         e.qos = local.qos.clone();
         e

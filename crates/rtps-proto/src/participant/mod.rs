@@ -11,7 +11,7 @@
 //! bound is dropped and counted in [`Counters`].
 //!
 //! ```
-//! use rtps_proto::participant::{Event, Participant, ParticipantConfig};
+//! use rtps_proto::participant::{Destination, Event, Participant, ParticipantConfig};
 //! use rtps_proto::discovery::Qos;
 //! use rtps_proto::{GuidPrefix, Locator, Time};
 //!
@@ -28,12 +28,19 @@
 //! let r = b.create_reader(now, "rt/lowstate", "unitree_go::msg::dds_::LowState_", Qos::default()).unwrap();
 //! // Carry every datagram from one to the other until both are quiet.
 //! let mut buf = [0u8; 1500];
+//! let from = "127.0.0.1:7411".parse().unwrap();
 //! for _ in 0..20 {
-//!     while let Some(t) = a.poll_transmit(now, &mut buf) { b.handle_datagram(now, &buf[..t.len]); }
-//!     while let Some(t) = b.poll_transmit(now, &mut buf) { a.handle_datagram(now, &buf[..t.len]); }
+//!     while let Some(t) = a.poll_transmit(now, &mut buf) {
+//!         b.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
+//!     }
+//!     while let Some(t) = b.poll_transmit(now, &mut buf) {
+//!         a.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
+//!     }
 //! }
 //! let sent = a.write(now, w, &[0, 1, 0, 0, 42, 0, 0, 0], &Default::default(), &mut buf).unwrap();
-//! b.handle_datagram(now, &buf[..sent.transmit.unwrap().len]);
+//! let t = sent.transmit.expect("a matched reader");
+//! assert_eq!(t.destinations(), &b.config().default_unicast[..]);
+//! b.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
 //! let mut got = None;
 //! while let Some(e) = b.poll_event() {
 //!     if let Event::Sample(s) = e { got = Some(s.payload); }
@@ -426,7 +433,13 @@ impl Participant {
     /// Creates a writer on `topic` with `type_name` and `qos`; it is announced (SEDP) and
     /// matched with the readers known now and later. A full reliable history replaces its oldest
     /// sample ([`WriteMode::ReplaceOldest`]); see [`create_writer_with`](Self::create_writer_with).
-    pub fn create_writer(&mut self, now: Time, topic: &str, type_name: &str, qos: Qos) -> Result<EntityId, CreateError> {
+    pub fn create_writer(
+        &mut self,
+        now: Time,
+        topic: &str,
+        type_name: &str,
+        qos: Qos,
+    ) -> Result<EntityId, CreateError> {
         self.create_writer_with(now, topic, type_name, qos, WriteMode::ReplaceOldest)
     }
 
@@ -450,7 +463,13 @@ impl Participant {
     }
 
     /// Creates a reader on `topic` with `type_name` and `qos`; announced and matched likewise.
-    pub fn create_reader(&mut self, now: Time, topic: &str, type_name: &str, qos: Qos) -> Result<EntityId, CreateError> {
+    pub fn create_reader(
+        &mut self,
+        now: Time,
+        topic: &str,
+        type_name: &str,
+        qos: Qos,
+    ) -> Result<EntityId, CreateError> {
         let depth = self.depth(&qos)?;
         let id = self.new_entity(EntityId::KIND_READER_NO_KEY)?;
         let config = self.reader_config(depth);
@@ -492,9 +511,6 @@ impl Participant {
             return Ok(Written { sequence, transmit: None });
         }
         let transmit = self.build_data_to_all(w, sequence, buf)?;
-        if transmit.is_some() {
-            self.writers[w].mark_sent_to_all(sequence);
-        }
         Ok(Written { sequence, transmit })
     }
 

@@ -130,20 +130,30 @@ impl Participant {
                 }
                 Submessage::AckNack(a) => {
                     let reader = Guid::new(source_prefix, a.reader_id);
-                    let taken = self.writers.iter_mut().find(|w| w.id == a.writer_id).map(|w| w.handle_acknack(now, reader, &a));
+                    let taken = self
+                        .writers
+                        .iter_mut()
+                        .find(|w| w.id == a.writer_id)
+                        .map(|w| w.handle_acknack(now, reader, &a));
                     if taken != Some(true) {
                         self.counters.unmatched_source += 1;
                     }
                 }
                 Submessage::NackFrag(n) => {
                     let reader = Guid::new(source_prefix, n.reader_id);
-                    let taken =
-                        self.writers.iter_mut().find(|w| w.id == n.writer_id).map(|w| w.handle_nack_frag(now, reader, &n));
+                    let taken = self
+                        .writers
+                        .iter_mut()
+                        .find(|w| w.id == n.writer_id)
+                        .map(|w| w.handle_nack_frag(now, reader, &n));
                     if taken != Some(true) {
                         self.counters.unmatched_source += 1;
                     }
                 }
-                Submessage::InfoReply(_) | Submessage::InfoReplyIp4(_) | Submessage::Pad | Submessage::Unknown { .. } => {}
+                Submessage::InfoReply(_)
+                | Submessage::InfoReplyIp4(_)
+                | Submessage::Pad
+                | Submessage::Unknown { .. } => {}
             }
         }
         self.process_discovery_inbox(now);

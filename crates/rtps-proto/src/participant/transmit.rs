@@ -43,6 +43,23 @@ impl Transmit {
         true
     }
 
+    /// Whether every locator of `ls` is here or fits.
+    fn fits(&self, ls: &[Locator]) -> bool {
+        let new = ls.iter().filter(|l| !self.destinations[..self.count].contains(l)).count();
+        self.count + new <= MAX_DESTINATIONS
+    }
+
+    fn add_unchecked(&mut self, l: Locator) {
+        let _ = self.add(l);
+    }
+
+    /// A transmit to the locators of one endpoint (the first `MAX_DESTINATIONS`).
+    fn to(ls: &[Locator]) -> Self {
+        let mut t = Self::new(0);
+        ls.iter().for_each(|l| t.add_unchecked(*l));
+        t
+    }
+
     /// Where to send it.
     pub fn destinations(&self) -> &[Locator] {
         &self.destinations[..self.count]
@@ -158,33 +175,40 @@ impl Participant {
         Some(w.finish())
     }
 
-    /// The DATA of a fresh write, to every matched reader due it.
+    /// The DATA of a fresh write, to every matched reader due it whose locators fit in one
+    /// transmit; those are marked sent (the others get it from `poll_transmit`).
     pub(super) fn build_data_to_all(
         &mut self,
         w: usize,
         sn: SequenceNumber,
         buf: &mut [u8],
     ) -> Result<Option<Transmit>, WriteError> {
-        let writer = &self.writers[w];
-        let due: alloc::vec::Vec<usize> =
-            (0..writer.readers.len()).filter(|&i| writer.readers[i].next_unsent == sn).collect();
-        if due.is_empty() {
+        let header = self.header();
+        let writer = &mut self.writers[w];
+        let Some(change) = writer.history.get(sn) else { return Ok(None) };
+        let mut t = Transmit::new(0);
+        let mut any = false;
+        for p in writer.readers.iter().filter(|p| p.next_unsent == sn) {
+            if t.fits(&p.locators) {
+                p.locators.iter().for_each(|l| t.add_unchecked(*l));
+                any = true;
+            }
+        }
+        if !any {
             return Ok(None);
         }
-        let Some(change) = writer.history.get(sn) else { return Ok(None) };
-        let id = writer.id;
-        let len = self
-            .build(buf, None, |m| {
-                if let Some(ts) = change.source_timestamp {
-                    m.push(&Submessage::InfoTs(InfoTs { timestamp: Some(ts) }))?;
+        let mut m = MessageWriter::new(buf, &header).map_err(|_| WriteError::BufferTooSmall)?;
+        if let Some(ts) = change.source_timestamp {
+            m.push(&Submessage::InfoTs(InfoTs { timestamp: Some(ts) })).map_err(|_| WriteError::BufferTooSmall)?;
+        }
+        push_data(&mut m, EntityId::UNKNOWN, writer.id, change).map_err(|_| WriteError::BufferTooSmall)?;
+        t.len = m.finish();
+        for p in writer.readers.iter_mut().filter(|p| p.next_unsent == sn) {
+            if p.locators.iter().all(|l| t.destinations().contains(l)) {
+                p.next_unsent = SequenceNumber(sn.0 + 1);
+                if !p.reliable {
+                    p.acked = p.next_unsent;
                 }
-                push_data(m, EntityId::UNKNOWN, id, change)
-            })
-            .ok_or(WriteError::BufferTooSmall)?;
-        let mut t = Transmit::new(len);
-        for i in due {
-            for l in &writer.readers[i].locators {
-                t.add(*l);
             }
         }
         Ok(Some(t))
@@ -204,7 +228,7 @@ impl Participant {
             let requested = p.requested.take();
             let fragments = p.requested_fragments.take();
             let reader = p.guid;
-            let locators = p.locators.clone();
+            let mut t = Transmit::to(&p.locators);
             let mut m = MessageWriter::new(buf, &header).ok()?;
             m.push(&Submessage::InfoDst(InfoDst { guid_prefix: reader.prefix })).ok()?;
             let mut resent = 0;
@@ -239,37 +263,36 @@ impl Participant {
                     }
                 }
             }
-            if let Some((sn, set)) = fragments {
-                if let Some(c) = writer.history.get(sn) {
-                    for n in set.iter() {
-                        if push_fragment(&mut m, reader.entity, id, c, n, fragment_size).is_err() {
-                            break;
-                        }
+            if let Some((c, set)) = fragments.and_then(|(sn, set)| Some((writer.history.get(sn)?, set))) {
+                for n in set.iter() {
+                    if push_fragment(&mut m, reader.entity, id, c, n, fragment_size).is_err() {
+                        break;
                     }
                 }
             }
             writer.counters.resent += resent;
             writer.counters.gapped += gapped;
-            let len = m.finish();
-            let mut t = Transmit::new(len);
-            locators.iter().for_each(|l| {
-                t.add(*l);
-            });
+            t.len = m.finish();
             return Some(t);
         }
         // Pushes: changes a reader has not been sent (late joiners, fragments, go-back).
         if let Some(i) = writer.readers.iter().position(|p| p.next_unsent < next) {
             let p = &writer.readers[i];
             let (reader, from, fragment) = (p.guid, p.next_unsent, p.next_fragment);
-            let locators = p.locators.clone();
+            let mut t = Transmit::to(&p.locators);
             let mut m = MessageWriter::new(buf, &header).ok()?;
             m.push(&Submessage::InfoDst(InfoDst { guid_prefix: reader.prefix })).ok()?;
             let change = writer.history.first_from(from);
             let upto = change.map_or(next, |c| c.sequence);
             if upto > from {
                 let list = SequenceNumberSet::new(upto, 0).ok()?;
-                m.push(&Submessage::Gap(Gap { reader_id: reader.entity, writer_id: id, gap_start: from, gap_list: list }))
-                    .ok()?;
+                m.push(&Submessage::Gap(Gap {
+                    reader_id: reader.entity,
+                    writer_id: id,
+                    gap_start: from,
+                    gap_list: list,
+                }))
+                .ok()?;
             }
             let p = &mut writer.readers[i];
             match change {
@@ -299,10 +322,7 @@ impl Participant {
             if !p.reliable {
                 p.acked = p.next_unsent;
             }
-            let mut t = Transmit::new(m.finish());
-            locators.iter().for_each(|l| {
-                t.add(*l);
-            });
+            t.len = m.finish();
             return Some(t);
         }
         // Heartbeats while anything is unacknowledged.

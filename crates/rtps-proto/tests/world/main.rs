@@ -16,22 +16,19 @@ const TOPIC: &str = "rt/lowstate";
 const TYPE: &str = "unitree_go::msg::dds_::LowState_";
 
 fn reliable(depth: u32) -> Qos {
-    let mut q = Qos::default();
-    q.reliability = Reliability::Reliable { max_blocking_time: DdsDuration::ZERO };
-    q.history = History::KeepLast { depth };
-    q
+    Qos {
+        reliability: Reliability::Reliable { max_blocking_time: DdsDuration::ZERO },
+        history: History::KeepLast { depth },
+        ..Qos::default()
+    }
 }
 
 fn best_effort(depth: u32) -> Qos {
-    let mut q = reliable(depth);
-    q.reliability = Reliability::BestEffort;
-    q
+    Qos { reliability: Reliability::BestEffort, ..reliable(depth) }
 }
 
 fn transient_local(depth: u32) -> Qos {
-    let mut q = reliable(depth);
-    q.durability = Durability::TransientLocal;
-    q
+    Qos { durability: Durability::TransientLocal, ..reliable(depth) }
 }
 
 /// A CDR payload (XCDR1 little-endian header) carrying `n` and `len - 8` filler bytes.
@@ -58,7 +55,13 @@ fn matched(w: &World, node: usize, local: EntityId) -> usize {
 }
 
 /// Writes through the participant and sends its own datagram as a stream thread would.
-fn write(w: &mut World, node: usize, writer: EntityId, bytes: &[u8], options: &WriteOptions) -> Result<Written, WriteError> {
+fn write(
+    w: &mut World,
+    node: usize,
+    writer: EntityId,
+    bytes: &[u8],
+    options: &WriteOptions,
+) -> Result<Written, WriteError> {
     let mut buf = vec![0u8; 65_536];
     let now = w.now;
     let written = w.nodes[node].participant.write(now, writer, bytes, options, &mut buf)?;
@@ -77,9 +80,7 @@ fn two_to_five_participants_discover_each_other_and_match() {
         let readers: Vec<EntityId> =
             (1..n).map(|i| w.nodes[i].participant.create_reader(now, TOPIC, TYPE, reliable(1)).unwrap()).collect();
         let ok = w.run(Duration::from_secs(5), |w| {
-            w.all_discovered()
-                && matched(w, 0, writer) == n - 1
-                && (1..n).all(|i| matched(w, i, readers[i - 1]) == 1)
+            w.all_discovered() && matched(w, 0, writer) == n - 1 && (1..n).all(|i| matched(w, i, readers[i - 1]) == 1)
         });
         assert!(ok, "{n} participants did not all discover and match in 5 s of fake time");
         assert_eq!(w.nodes[0].participant.matched_readers(writer).count(), n - 1);
@@ -130,7 +131,8 @@ fn best_effort_samples_arrive_in_order_and_losses_are_counted() {
         w.advance(Duration::from_millis(2));
     }
     w.advance(Duration::from_millis(100));
-    let got: Vec<u32> = samples(&w, 1, reader).iter().map(|p| u32::from_le_bytes(p[4..8].try_into().unwrap())).collect();
+    let got: Vec<u32> =
+        samples(&w, 1, reader).iter().map(|p| u32::from_le_bytes(p[4..8].try_into().unwrap())).collect();
     assert!(got.windows(2).all(|p| p[0] < p[1]), "in order, no duplicates");
     assert!(got.len() > 100 && got.len() < 300, "about 70 % of 300 arrived: {}", got.len());
     let c = w.nodes[1].participant.reader_counters(reader).unwrap();
@@ -174,8 +176,10 @@ fn a_reader_that_stops_acknowledging_never_makes_a_write_wait() {
     let mut w = World::new(2, 5);
     let now = w.now;
     let keep_last = w.nodes[0].participant.create_writer(now, TOPIC, TYPE, reliable(4)).unwrap();
-    let refuse =
-        w.nodes[0].participant.create_writer_with(now, "rt/arm_sdk", TYPE, reliable(4), WriteMode::RefuseWhenFull).unwrap();
+    let refuse = w.nodes[0]
+        .participant
+        .create_writer_with(now, "rt/arm_sdk", TYPE, reliable(4), WriteMode::RefuseWhenFull)
+        .unwrap();
     w.nodes[1].participant.create_reader(now, TOPIC, TYPE, reliable(4)).unwrap();
     w.nodes[1].participant.create_reader(now, "rt/arm_sdk", TYPE, reliable(4)).unwrap();
     assert!(w.run(Duration::from_secs(5), |w| matched(w, 0, keep_last) == 1 && matched(w, 0, refuse) == 1));
@@ -229,7 +233,8 @@ fn a_late_joiner_gets_a_transient_local_writers_history() {
     // A volatile late joiner gets only what is written after it matched.
     let volatile_node = w.add(net::config(2));
     let now = w.now;
-    let volatile = w.nodes[volatile_node].participant.create_reader(now, "ros_discovery_info", TYPE, reliable(5)).unwrap();
+    let volatile =
+        w.nodes[volatile_node].participant.create_reader(now, "ros_discovery_info", TYPE, reliable(5)).unwrap();
     assert!(w.run(Duration::from_secs(10), |w| matched(w, volatile_node, volatile) == 1));
     w.advance(Duration::from_secs(1));
     write(&mut w, 0, writer, &payload(99, 40), &WriteOptions::default()).unwrap();
@@ -274,7 +279,10 @@ fn related_sample_identity_and_source_timestamp_reach_the_reader() {
     let writer = w.nodes[0].participant.create_writer(now, TOPIC, TYPE, reliable(4)).unwrap();
     let reader = w.nodes[1].participant.create_reader(now, TOPIC, TYPE, reliable(4)).unwrap();
     assert!(w.run(Duration::from_secs(5), |w| matched(w, 0, writer) == 1 && matched(w, 1, reader) == 1));
-    let related = SampleIdentity { writer: Guid::new(w.nodes[1].participant.guid_prefix(), reader), sequence: SequenceNumber(77) };
+    let related = SampleIdentity {
+        writer: Guid::new(w.nodes[1].participant.guid_prefix(), reader),
+        sequence: SequenceNumber(77),
+    };
     let ts = Timestamp { seconds: 1_700_000_000, fraction: 0x8000_0000 };
     let options = WriteOptions { source_timestamp: Some(ts), related: Some(related), key_hash: None };
     let sn = write(&mut w, 0, writer, &payload(1, 16), &options).unwrap().sequence;

@@ -10,17 +10,17 @@ use rtps_proto::participant::{Destination, Event, Participant, ParticipantConfig
 use rtps_proto::{GuidPrefix, Locator, Time};
 
 /// The SPDP multicast locator of domain 0.
-pub const SPDP_GROUP: SocketAddrV4 = SocketAddrV4::new(Ipv4Addr::new(239, 255, 0, 1), 7400);
+pub(crate) const SPDP_GROUP: SocketAddrV4 = SocketAddrV4::new(Ipv4Addr::new(239, 255, 0, 1), 7400);
 
 /// A small deterministic generator (xorshift64*), so that faults are seeded.
 #[derive(Debug, Clone)]
-pub struct Rng(u64);
+pub(crate) struct Rng(u64);
 
 impl Rng {
-    pub fn new(seed: u64) -> Self {
+    pub(crate) fn new(seed: u64) -> Self {
         Self(seed.max(1))
     }
-    pub fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         let mut x = self.0;
         x ^= x >> 12;
         x ^= x << 25;
@@ -29,31 +29,31 @@ impl Rng {
         x.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
     /// True with probability `p`.
-    pub fn chance(&mut self, p: f64) -> bool {
+    pub(crate) fn chance(&mut self, p: f64) -> bool {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64 <= p && p > 0.0
     }
 }
 
 /// How the network misbehaves.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Faults {
+pub(crate) struct Faults {
     /// Probability a datagram is lost.
-    pub loss: f64,
+    pub(crate) loss: f64,
     /// Probability a datagram arrives twice.
-    pub duplicate: f64,
+    pub(crate) duplicate: f64,
     /// Probability a datagram is held back by up to `max_delay`.
-    pub reorder: f64,
-    pub max_delay: Duration,
+    pub(crate) reorder: f64,
+    pub(crate) max_delay: Duration,
 }
 
-pub struct Node {
-    pub participant: Participant,
-    pub events: Vec<Event>,
+pub(crate) struct Node {
+    pub(crate) participant: Participant,
+    pub(crate) events: Vec<Event>,
     /// Drops everything this node sends (a silent peer) when set.
-    pub muted: bool,
+    pub(crate) muted: bool,
     /// Drops everything this node receives when set.
-    pub deaf: bool,
-    pub unicast: [SocketAddr; 2],
+    pub(crate) deaf: bool,
+    pub(crate) unicast: [SocketAddr; 2],
 }
 
 struct InFlight {
@@ -64,21 +64,21 @@ struct InFlight {
     bytes: Vec<u8>,
 }
 
-pub struct World {
-    pub now: Time,
-    pub nodes: Vec<Node>,
-    pub faults: Faults,
-    pub rng: Rng,
+pub(crate) struct World {
+    pub(crate) now: Time,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) faults: Faults,
+    pub(crate) rng: Rng,
     queue: VecDeque<InFlight>,
-    pub delivered: u64,
+    pub(crate) delivered: u64,
     /// Every datagram sent, for inspection.
-    pub sent: u64,
+    pub(crate) sent: u64,
     buf: Vec<u8>,
 }
 
 /// A participant's configuration in the world: node `i` listens on 127.0.0.1:(7410+2i) for
 /// discovery and 7411+2i for data, announces to the SPDP group.
-pub fn config(i: usize) -> ParticipantConfig {
+pub(crate) fn config(i: usize) -> ParticipantConfig {
     let mut c = ParticipantConfig::new(GuidPrefix([i as u8 + 1; 12]), 0);
     let meta = SocketAddrV4::new(Ipv4Addr::LOCALHOST, 7410 + 2 * i as u16);
     let data = SocketAddrV4::new(Ipv4Addr::LOCALHOST, 7411 + 2 * i as u16);
@@ -90,7 +90,7 @@ pub fn config(i: usize) -> ParticipantConfig {
 }
 
 impl World {
-    pub fn new(n: usize, seed: u64) -> Self {
+    pub(crate) fn new(n: usize, seed: u64) -> Self {
         let mut w = Self {
             now: Time::from_nanos(1_000_000_000),
             nodes: Vec::new(),
@@ -108,7 +108,7 @@ impl World {
     }
 
     /// Adds a participant; its index.
-    pub fn add(&mut self, config: ParticipantConfig) -> usize {
+    pub(crate) fn add(&mut self, config: ParticipantConfig) -> usize {
         let unicast = [
             config.metatraffic_unicast[0].socket_addr().expect("udp"),
             config.default_unicast[0].socket_addr().expect("udp"),
@@ -128,8 +128,7 @@ impl World {
     /// Sends everything every participant has to send now.
     fn flush(&mut self) {
         for i in 0..self.nodes.len() {
-            loop {
-                let Some(t) = self.nodes[i].participant.poll_transmit(self.now, &mut self.buf) else { break };
+            while let Some(t) = self.nodes[i].participant.poll_transmit(self.now, &mut self.buf) {
                 self.sent += 1;
                 if self.nodes[i].muted {
                     continue;
@@ -193,7 +192,7 @@ impl World {
     }
 
     /// Carries a datagram node `from` built itself (a write's own transmit).
-    pub fn inject(&mut self, from: usize, bytes: &[u8], destinations: &[Locator]) {
+    pub(crate) fn inject(&mut self, from: usize, bytes: &[u8], destinations: &[Locator]) {
         self.sent += 1;
         if self.nodes[from].muted {
             return;
@@ -221,7 +220,7 @@ impl World {
 
     /// Runs until nothing is in flight and nothing is due before `now + horizon`, or `until`
     /// holds; advances the fake clock to each next deadline. Returns whether `until` held.
-    pub fn run(&mut self, horizon: Duration, mut until: impl FnMut(&World) -> bool) -> bool {
+    pub(crate) fn run(&mut self, horizon: Duration, mut until: impl FnMut(&World) -> bool) -> bool {
         let end = self.now + horizon;
         loop {
             for n in &mut self.nodes {
@@ -247,12 +246,12 @@ impl World {
     }
 
     /// Runs for `d` of fake time.
-    pub fn advance(&mut self, d: Duration) {
+    pub(crate) fn advance(&mut self, d: Duration) {
         self.run(d, |_| false);
     }
 
     /// Whether every node has discovered every other.
-    pub fn all_discovered(&self) -> bool {
+    pub(crate) fn all_discovered(&self) -> bool {
         self.nodes.iter().all(|n| n.participant.remote_participants().count() == self.nodes.len() - 1)
     }
 }

@@ -1,0 +1,183 @@
+//! The six datagrams that silence a rustdds 0.15.1 participant (`robowire/tests/dds_flood`'s
+//! `rustdds_0_15_1_trusts`), sent from a participant already discovered and matched on SEDP:
+//! each is refused or handled arithmetically and counted, the participant's heap stays small,
+//! and it goes on discovering and delivering afterwards.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rtps_proto::discovery::Qos;
+use rtps_proto::participant::{Destination, Event, Participant, ParticipantConfig};
+use rtps_proto::wire::WireErrorKind;
+use rtps_proto::{GuidPrefix, Locator, Time};
+
+/// Counts live heap bytes and their peak.
+struct Counting;
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let live = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+        PEAK.fetch_max(live, Ordering::Relaxed);
+        // SAFETY: the caller's layout, passed on.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+        // SAFETY: `ptr` came from `alloc` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+const SPDP_WRITER: [u8; 4] = [0, 1, 0, 0xc2];
+const SPDP_READER: [u8; 4] = [0, 1, 0, 0xc7];
+const SEDP_PUBLICATIONS_WRITER: [u8; 4] = [0, 0, 3, 0xc2];
+const SEDP_PUBLICATIONS_READER: [u8; 4] = [0, 0, 3, 0xc7];
+
+/// `one_datagram_each` of robowire's dds_flood, rebuilt: what each trusted field does there.
+fn one_datagram_each(from: [u8; 12]) -> [(&'static str, Vec<u8>); 6] {
+    let datagram = |kind: u8, body: Vec<u8>| {
+        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
+        d.extend(from);
+        d.extend([kind, 0x01]);
+        d.extend(u16::try_from(body.len()).unwrap().to_le_bytes());
+        d.extend(body);
+        d
+    };
+    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
+    let count = i32::MAX.to_le_bytes();
+    let (reader, writer) = (SEDP_PUBLICATIONS_READER, SEDP_PUBLICATIONS_WRITER);
+    let data_frag: Vec<u8> = [&[0, 0, 28, 0][..], &SPDP_READER, &SPDP_WRITER, &sn(1), &1u32.to_le_bytes()]
+        .concat()
+        .into_iter()
+        .chain(1u16.to_le_bytes())
+        .chain(1024u16.to_le_bytes())
+        .chain(0xFFFF_FFF0u32.to_le_bytes())
+        .chain([0; 1024])
+        .collect();
+    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
+    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
+    let words = [0xFFu8; 32];
+    let nack_frag =
+        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &words, &count].concat();
+    let fragment_0 =
+        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
+    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
+    [
+        ("DATA_FRAG sampleSize", datagram(0x16, data_frag)),
+        ("HEARTBEAT range", datagram(0x07, heartbeat)),
+        ("GAP range", datagram(0x08, gap)),
+        ("NACK_FRAG fragment numbers", datagram(0x12, nack_frag)),
+        ("NACK_FRAG fragment number 0", datagram(0x12, fragment_0)),
+        ("sequence number overflow", datagram(0x06, acknack)),
+    ]
+}
+
+fn config(n: u8) -> ParticipantConfig {
+    let mut c = ParticipantConfig::new(GuidPrefix([n; 12]), 0);
+    let addr: SocketAddr = format!("127.0.0.1:{}", 7400 + 10 * u16::from(n)).parse().unwrap();
+    c.metatraffic_unicast = vec![Locator::udp(addr)];
+    c.default_unicast = c.metatraffic_unicast.clone();
+    c
+}
+
+/// Carries datagrams both ways until both are quiet.
+fn exchange(now: Time, a: &mut Participant, b: &mut Participant) {
+    let mut buf = vec![0u8; 65_536];
+    let from: SocketAddr = "127.0.0.1:7400".parse().unwrap();
+    for _ in 0..20 {
+        while let Some(t) = a.poll_transmit(now, &mut buf) {
+            b.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
+        }
+        while let Some(t) = b.poll_transmit(now, &mut buf) {
+            a.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
+        }
+    }
+}
+
+#[test]
+fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on() {
+    let now = Time::from_nanos(1_000_000_000);
+    let mut ours = Participant::new(config(1), now);
+    let mut attacker = Participant::new(config(2), now);
+    exchange(now, &mut ours, &mut attacker);
+    assert_eq!(ours.remote_participants().count(), 1, "the sender is a discovered, SEDP-matched participant");
+    let source: SocketAddr = "127.0.0.1:7420".parse().unwrap();
+    let before = ours.counters().clone();
+    let baseline = LIVE.load(Ordering::Relaxed);
+    PEAK.store(baseline, Ordering::Relaxed);
+    for (what, datagram) in one_datagram_each([2; 12]) {
+        ours.handle_datagram(now, source, Destination::Unicast, &datagram);
+        let mut buf = vec![0u8; 65_536];
+        // Whatever it answers, it answers within bounds.
+        let mut answers = 0;
+        while ours.poll_transmit(now, &mut buf).is_some() {
+            answers += 1;
+            assert!(answers < 100, "{what}: an answer without end");
+        }
+    }
+    let peak = PEAK.load(Ordering::Relaxed) - baseline;
+    assert!(peak < 512 * 1024, "the six datagrams took {peak} bytes of heap at the peak");
+    let after = ours.counters();
+    let wire = |k: WireErrorKind| after.wire.get(k) - before.wire.get(k);
+    // Refused by the wire layer: set bounds and fragment number 0.
+    assert_eq!(wire(WireErrorKind::FragmentNumberSet), 1, "NACK_FRAG fragment numbers");
+    assert_eq!(wire(WireErrorKind::FragmentNumberZero), 1, "NACK_FRAG fragment number 0");
+    assert_eq!(wire(WireErrorKind::SequenceNumberSet), 1, "sequence number overflow");
+    // A DATA_FRAG from the SPDP writer: SPDP is never fragmented here, so nothing takes it.
+    assert!(after.unmatched_source > before.unmatched_source, "DATA_FRAG sampleSize counted");
+    // The HEARTBEAT of 2^40 samples and the GAP up to 2^40 reached the SEDP reader: handled by
+    // arithmetic (the peak above), not by a table of their size.
+
+    // It goes on: a newcomer is discovered and matched, and its samples arrive.
+    let mut newcomer = Participant::new(config(3), now);
+    let w = newcomer.create_writer(now, "rt/lowstate", "T", Qos::default()).unwrap();
+    ours.create_reader(now, "rt/lowstate", "T", Qos::default()).unwrap();
+    exchange(now, &mut ours, &mut newcomer);
+    let mut buf = vec![0u8; 65_536];
+    let t = newcomer.write(now, w, &[0, 1, 0, 0, 7, 7, 7, 7], &Default::default(), &mut buf).unwrap();
+    ours.handle_datagram(now, source, Destination::Unicast, &buf[..t.transmit.expect("matched").len]);
+    let got: Vec<_> = std::iter::from_fn(|| ours.poll_event())
+        .filter_map(|e| match e {
+            Event::Sample(s) => Some(s.payload),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(got, vec![vec![0, 1, 0, 0, 7, 7, 7, 7]]);
+}
+
+#[test]
+fn a_fragmented_sample_larger_than_the_limit_is_refused_before_any_allocation() {
+    let now = Time::from_nanos(1_000_000_000);
+    let mut ours = Participant::new(config(1), now);
+    let mut peer = Participant::new(config(2), now);
+    let r = ours.create_reader(now, "big", "T", Qos::default()).unwrap();
+    let w = peer.create_writer(now, "big", "T", Qos::default()).unwrap();
+    exchange(now, &mut ours, &mut peer);
+    // A DATA_FRAG from the matched writer announcing a 4 GiB sample.
+    let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
+    d.extend([2u8; 12]);
+    let mut body = vec![0, 0, 28, 0];
+    body.extend(r.0);
+    body.extend(w.0);
+    body.extend([0, 0, 0, 0, 1, 0, 0, 0]); // sn 1
+    body.extend(1u32.to_le_bytes());
+    body.extend(1u16.to_le_bytes());
+    body.extend(1024u16.to_le_bytes());
+    body.extend(0xFFFF_FFF0u32.to_le_bytes());
+    body.extend([0u8; 1024]);
+    d.extend([0x16, 0x01]);
+    d.extend((body.len() as u16).to_le_bytes());
+    d.extend(body);
+    let baseline = LIVE.load(Ordering::Relaxed);
+    PEAK.store(baseline, Ordering::Relaxed);
+    ours.handle_datagram(now, "127.0.0.1:7420".parse().unwrap(), Destination::Unicast, &d);
+    assert!(PEAK.load(Ordering::Relaxed) - baseline < 64 * 1024);
+    assert_eq!(ours.reader_counters(r).unwrap().refused_fragments, 1);
+}
