@@ -87,10 +87,12 @@ fn golden(bless: bool) -> anyhow::Result<()> {
     let kmc_path = xtask::golden::kmc::kmc_fixture_path();
     let unitree_path = xtask::golden::unitree::vectors_path();
     let zsl1_path = xtask::golden::zsl1::frames_path();
+    let rtps_path = xtask::golden::rtps::fixtures_path();
     let suites = [
         ("kmc", xtask::golden::kmc::check_kmc(&kmc_path, bless)?),
         ("unitree", xtask::golden::unitree::check(&unitree_path)?),
         ("zsl1", xtask::golden::zsl1::check(&zsl1_path)?),
+        ("rtps", xtask::golden::rtps::check(&rtps_path)?),
     ];
     let mut failed = 0;
     let mut total = 0;
@@ -105,7 +107,7 @@ fn golden(bless: bool) -> anyhow::Result<()> {
             } else {
                 "ok"
             };
-            println!("{suite:<8} {:<40} {status}", outcome.name);
+            println!("{suite:<8} {:<48} {status}", outcome.name);
             for problem in &outcome.problems {
                 println!("    {problem}");
             }
@@ -113,10 +115,11 @@ fn golden(bless: bool) -> anyhow::Result<()> {
     }
     anyhow::ensure!(failed == 0, "{failed} of {total} golden checks failed");
     println!(
-        "{total} golden checks passed ({}, {}, {})",
+        "{total} golden checks passed ({}, {}, {}, {})",
         kmc_path.display(),
         unitree_path.display(),
-        zsl1_path.display()
+        zsl1_path.display(),
+        rtps_path.display()
     );
     Ok(())
 }

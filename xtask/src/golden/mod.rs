@@ -3,6 +3,7 @@
 //! bytes); vendor-generated vectors (Unitree) are never rewritten.
 
 pub mod kmc;
+pub mod rtps;
 pub mod unitree;
 pub mod zsl1;
 
