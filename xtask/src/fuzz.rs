@@ -63,7 +63,109 @@ pub const TARGETS: &[Target] = &[
         seeds: || Ok(messages::api_seeds()),
         check: lowcmd_proto::decode_roundtrip::api_decode,
     },
+    Target { name: "rtps_message_parse", seeds: rtps_seeds, check: rtps_proto::fuzzing::parse_all },
 ];
+
+/// RTPS seeds: the six hostile datagrams of the DDS flood test (`one_datagram_each` in
+/// `crates/robowire/tests/dds_flood/datagrams.rs`, rebuilt here), and one datagram of the
+/// submessages a reliable exchange uses, written with the crate's own emitter.
+fn rtps_seeds() -> Seeds {
+    use rtps_proto::wire::{self, Submessage};
+    use rtps_proto::{EntityId, GuidPrefix, ProtocolVersion, SequenceNumber, SequenceNumberSet, VendorId};
+
+    let from = [1, 0x0f, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1];
+    let datagram = |kind: u8, body: Vec<u8>| -> anyhow::Result<Vec<u8>> {
+        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
+        d.extend(from);
+        d.extend([kind, 0x01]);
+        d.extend(u16::try_from(body.len())?.to_le_bytes());
+        d.extend(body);
+        Ok(d)
+    };
+    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
+    let count = i32::MAX.to_le_bytes();
+    let (spdp_reader, spdp_writer) = ([0u8, 1, 0, 0xC7], [0u8, 1, 0, 0xC2]);
+    let (reader, writer) = ([0u8, 0, 3, 0xC7], [0u8, 0, 3, 0xC2]);
+    let data_frag = [&[0, 0, 28, 0][..], &spdp_reader, &spdp_writer, &sn(1), &1u32.to_le_bytes()]
+        .concat()
+        .into_iter()
+        .chain(1u16.to_le_bytes())
+        .chain(1024u16.to_le_bytes())
+        .chain(0xFFFF_FFF0u32.to_le_bytes())
+        .chain([0; 1024])
+        .collect();
+    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
+    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
+    let nack_frag =
+        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &[0xFF; 32], &count]
+            .concat();
+    let fragment_0 =
+        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
+    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
+    let mut seeds = vec![
+        ("seed-data-frag-sample-size".to_string(), datagram(0x16, data_frag)?),
+        ("seed-heartbeat-range".to_string(), datagram(0x07, heartbeat)?),
+        ("seed-gap-range".to_string(), datagram(0x08, gap)?),
+        ("seed-nack-frag-fragment-numbers".to_string(), datagram(0x12, nack_frag)?),
+        ("seed-nack-frag-fragment-0".to_string(), datagram(0x12, fragment_0)?),
+        ("seed-acknack-sequence-number-overflow".to_string(), datagram(0x06, acknack)?),
+    ];
+
+    // A writer's DATA with inline QoS, a HEARTBEAT, a reader's ACKNACK, a GAP.
+    let mut qos = [0u8; 64];
+    let mut params = wire::ParameterWriter::new(&mut qos);
+    params.push(wire::pid::KEY_HASH, &[7; 16]).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    params.push(wire::pid::STATUS_INFO, &[0, 0, 0, 1]).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let qos_len = params.finish().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let inline_qos = wire::ParameterList::little_endian(&qos[..qos_len]).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (reader, writer) = (EntityId(reader), EntityId(writer));
+    let mut set = SequenceNumberSet::new(SequenceNumber(2), 8).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    set.insert(SequenceNumber(3));
+    let submessages = [
+        Submessage::InfoDst(wire::InfoDst { guid_prefix: GuidPrefix(from) }),
+        Submessage::Data(wire::Data {
+            reader_id: reader,
+            writer_id: writer,
+            writer_sn: SequenceNumber(1),
+            inline_qos: Some(inline_qos),
+            payload: wire::Payload::Data(&[0, 1, 0, 0, 1, 2, 3, 4]),
+            non_standard_payload: false,
+        }),
+        Submessage::Heartbeat(wire::Heartbeat {
+            reader_id: reader,
+            writer_id: writer,
+            first_sn: SequenceNumber(1),
+            last_sn: SequenceNumber(3),
+            count: 1,
+            final_flag: false,
+            liveliness_flag: false,
+        }),
+        Submessage::AckNack(wire::AckNack {
+            reader_id: reader,
+            writer_id: writer,
+            reader_sn_state: set,
+            count: 1,
+            final_flag: true,
+        }),
+        Submessage::Gap(wire::Gap {
+            reader_id: reader,
+            writer_id: writer,
+            gap_start: SequenceNumber(2),
+            gap_list: SequenceNumberSet::new(SequenceNumber(3), 0).map_err(|e| anyhow::anyhow!("{e:?}"))?,
+        }),
+    ];
+    let header =
+        wire::Header { version: ProtocolVersion::V2_4, vendor: VendorId::ROBOWIRE, guid_prefix: GuidPrefix(from) };
+    let mut buf = vec![0u8; 512];
+    let mut message = wire::MessageWriter::new(&mut buf, &header).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    for s in &submessages {
+        message.push(s).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    }
+    let len = message.finish();
+    buf.truncate(len);
+    seeds.push(("seed-reliable-exchange".to_string(), buf));
+    Ok(seeds)
+}
 
 /// DDS sample seeds: every golden CDR payload (Go2, selector 0 `LowCmd_`, 1 `LowState_`) as
 /// sent, with its CRC broken, and with the big-endian header of its representation (`00 00`,
