@@ -83,6 +83,8 @@ fn spdp(o: Order) -> Vec<u8> {
         o.parameter(0x0062, &o.string("robot")),
         o.parameter(0x000f, &o.u32(7)),
         o.parameter(0x8007, &[0xde, 0xad, 0xbe, 0xef]),
+        o.parameter(0x4014, &o.string("lab")),
+        o.parameter(0x4000 | 0x000f, &o.u32(9)),
         o.parameter(0x0001, &[]),
     ]
     .concat();
@@ -124,6 +126,12 @@ fn spdp_data_with_its_parameter_list_in_both_byte_orders() {
         assert_eq!(by_name("PID_METATRAFFIC_UNICAST_LOCATOR"), "udp/192.168.1.2:7410");
         assert_eq!(by_name("PID_ENTITY_NAME"), "robot");
         assert_eq!(by_name("PID_DOMAIN_ID"), 7);
+        assert_eq!(by_name("PID_DOMAIN_TAG"), "lab");
+        // PID_DOMAIN_ID with the must-understand bit: named and decoded as PID_DOMAIN_ID.
+        assert_eq!(
+            (&payload["parameters"][9]["pid"], &payload["parameters"][9]["value"]),
+            (&"0x400f".into(), &9.into())
+        );
         let vendor = &payload["parameters"][7];
         assert_eq!(
             (&vendor["pid"], &vendor["name"], &vendor["value"]),

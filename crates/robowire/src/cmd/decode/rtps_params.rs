@@ -42,16 +42,23 @@ enum Decoded {
 }
 
 fn decode(id: u16, value: &[u8], e: Endianness) -> Decoded {
-    let base = if id & pid::VENDOR_SPECIFIC != 0 {
+    if id & pid::VENDOR_SPECIFIC != 0 {
         // Vendor-specific PIDs mean what the sender's vendor says; only the legacy
         // PID_RELATED_SAMPLE_IDENTITY is shared by those that use it.
-        if id != pid::RELATED_SAMPLE_IDENTITY_LEGACY {
-            return Decoded::Unknown;
-        }
-        pid::RELATED_SAMPLE_IDENTITY
-    } else {
-        id & !pid::MUST_UNDERSTAND
-    };
+        return match id {
+            pid::RELATED_SAMPLE_IDENTITY_LEGACY => decode_as(pid::RELATED_SAMPLE_IDENTITY, value, e),
+            _ => Decoded::Unknown,
+        };
+    }
+    // The PID as it is (PID_DOMAIN_TAG has the must-understand bit in its value), else without
+    // the must-understand bit.
+    match decode_as(id, value, e) {
+        Decoded::Unknown if id & pid::MUST_UNDERSTAND != 0 => decode_as(id & !pid::MUST_UNDERSTAND, value, e),
+        decoded => decoded,
+    }
+}
+
+fn decode_as(base: u16, value: &[u8], e: Endianness) -> Decoded {
     let mut r = Cdr { bytes: value, at: 0, e };
     let decoded = match base {
         pid::TOPIC_NAME | pid::TYPE_NAME | pid::ENTITY_NAME | pid::DOMAIN_TAG => r.string().map(Value::String),
