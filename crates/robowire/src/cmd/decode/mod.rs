@@ -4,6 +4,10 @@
 //! form); the human form is derived from it here.
 
 mod kmc;
+mod pcap;
+mod rtps;
+mod rtps_json;
+mod rtps_params;
 pub(crate) mod unitree;
 pub(crate) mod zsl;
 
@@ -34,6 +38,9 @@ pub(crate) enum DecodeCommand {
     Kmc(kmc::KmcDecodeArgs),
     /// A ZSL-1 / ZSL-1W UDP datagram, told by its length and magic, decoded strictly.
     Zsl(zsl::ZslDecodeArgs),
+    /// RTPS (DDS) datagrams: one in hex, a file of hex lines (--file) or a pcap capture (--pcap),
+    /// as JSON. Exit status 1 if any datagram was refused.
+    Rtps(rtps::RtpsDecodeArgs),
     /// Unitree Go2 LowCmd (812-byte struct image, or a CDR payload with --cdr).
     Lowcmd(unitree::DecodeArgs),
     /// Unitree Go2 LowState (1180-byte struct image, or a CDR payload with --cdr).
@@ -48,11 +55,12 @@ pub(crate) fn run(args: &DecodeArgs) -> anyhow::Result<ExitCode> {
     let command = match (&args.mcap, &args.command) {
         (Some(path), _) => return crate::cmd::record::summarize(path, args.json),
         (None, Some(command)) => command,
-        (None, None) => anyhow::bail!("give what to decode (kmc, zsl, lowcmd, …) or --mcap FILE"),
+        (None, None) => anyhow::bail!("give what to decode (kmc, zsl, rtps, lowcmd, …) or --mcap FILE"),
     };
     match command {
         DecodeCommand::Kmc(args) => kmc::run(args),
         DecodeCommand::Zsl(args) => zsl::run(args),
+        DecodeCommand::Rtps(args) => rtps::run(args),
         DecodeCommand::Lowcmd(args) => unitree::decode(UnitreeMessage::LowCmd, args),
         DecodeCommand::Lowstate(args) => unitree::decode(UnitreeMessage::LowState, args),
         DecodeCommand::LowcmdHg(args) => unitree::decode(UnitreeMessage::HgLowCmd, args),
