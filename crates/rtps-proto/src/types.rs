@@ -244,7 +244,9 @@ impl Bitmap {
 }
 
 /// A set of sequence numbers as ACKNACK and GAP carry it: `base` and up to 256 numbers from it.
-/// A value of this type is always valid: base ≥ 1, at most 256 bits, no member past `i64::MAX`.
+/// A value of this type is always valid: base ≥ 1, at most 256 bits, no member past `i64::MAX`;
+/// the one exception is the empty set at base 0, which Fast DDS sends in a reader's first
+/// ACKNACK (nothing received, nothing asked for).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct SequenceNumberSet {
     base: SequenceNumber,
@@ -254,7 +256,7 @@ pub struct SequenceNumberSet {
 impl SequenceNumberSet {
     /// The empty set at `base` with room for `num_bits` members.
     pub fn new(base: SequenceNumber, num_bits: u32) -> Result<Self, SetError> {
-        if base.0 < 1 {
+        if base.0 < 1 && !(base.0 == 0 && num_bits == 0) {
             return Err(SetError::Base);
         }
         if num_bits > Bitmap::MAX_BITS {

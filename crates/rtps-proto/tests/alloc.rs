@@ -3,7 +3,8 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
 use rtps_proto::discovery::{History, Qos, Reliability};
@@ -12,20 +13,28 @@ use rtps_proto::types::DdsDuration;
 use rtps_proto::{GuidPrefix, Locator, Time};
 
 struct Counting;
-static COUNTING: AtomicBool = AtomicBool::new(false);
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    /// Counting on this thread only (the test harness's own threads allocate when they like).
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+}
+
+fn counting() -> bool {
+    COUNTING.try_with(Cell::get).unwrap_or(false)
+}
 
 // SAFETY: forwards to the system allocator; only counts.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
+        if counting() {
             ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
         }
         // SAFETY: the caller's layout, passed on.
         unsafe { System.alloc(layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
+        if counting() {
             ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
         }
         // SAFETY: as the caller's contract.
@@ -94,20 +103,19 @@ fn steady_state_allocations(reliable: bool) -> usize {
     // The next samples, 2 ms apart (heartbeats every 100 ms), counted; SPDP announcements are
     // not the sample path: the window stays inside one announcement period.
     ALLOCATIONS.store(0, Ordering::Relaxed);
-    COUNTING.store(true, Ordering::Relaxed);
+    COUNTING.with(|c| c.set(true));
     let mut received = 0;
     for i in 200..1200 {
         received += step(now, &mut a, &mut b, i);
         now = now + Duration::from_micros(2000);
     }
-    COUNTING.store(false, Ordering::Relaxed);
+    COUNTING.with(|c| c.set(false));
     assert_eq!(received, 1000, "every sample arrived");
     ALLOCATIONS.load(Ordering::Relaxed)
 }
 
 #[test]
 fn steady_writes_and_receives_allocate_nothing() {
-    // One test (not two) so the counter is not shared by tests running at once.
     assert_eq!(steady_state_allocations(false), 0, "best effort");
     assert_eq!(steady_state_allocations(true), 0, "reliable");
 }
