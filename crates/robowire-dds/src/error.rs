@@ -1,7 +1,4 @@
-//! Why a DDS operation failed. The middleware's own error is kept as the source.
-
-use rustdds::dds::CreateError;
-use rustdds::dds::WriteError;
+//! Why a DDS operation failed. The protocol core's or the socket's error is kept as the source.
 
 /// Why a participant, a writer, a reader or a call failed.
 #[derive(Debug, thiserror::Error)]
@@ -15,34 +12,34 @@ pub enum DdsError {
         /// The host's interfaces with IPv4 addresses.
         available: String,
     },
-    /// The participant could not be created (sockets, ports).
+    /// The participant could not be created (sockets, ports, its thread).
     #[error("cannot create a DDS participant in domain {domain}")]
     Participant {
         /// The domain.
         domain: u16,
-        /// What the middleware said.
+        /// What the system said.
         #[source]
-        source: CreateError,
+        source: std::io::Error,
     },
-    /// A topic, writer or reader could not be created.
+    /// A writer or reader could not be created.
     #[error("cannot create the {what} of topic {topic}")]
     Create {
-        /// Writer, reader or topic.
+        /// Writer or reader.
         what: &'static str,
         /// The topic name.
         topic: String,
-        /// What the middleware said.
+        /// What the participant said.
         #[source]
-        source: CreateError,
+        source: rtps_proto::participant::CreateError,
     },
     /// A sample could not be written.
     #[error("writing to {topic} failed")]
     Write {
         /// The topic.
         topic: String,
-        /// What the middleware said.
+        /// What the participant said.
         #[source]
-        source: WriteError<()>,
+        source: rtps_proto::endpoint::WriteError,
     },
     /// A request got no answer in time.
     #[error("no answer on {topic} within {timeout:?}")]

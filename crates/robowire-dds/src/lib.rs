@@ -1,18 +1,22 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
-mod adapter;
+mod driver;
 mod error;
 #[cfg(feature = "netns")]
 pub mod netns;
 mod participant;
 pub mod qos;
+mod reader;
 pub mod rpc;
-mod topic;
+mod sample;
+mod sockets;
+mod writer;
 
-#[doc(hidden)]
-#[doc(hidden)]
-pub use adapter::fuzz_check_sample;
 pub use error::DdsError;
 pub use participant::{DiscoveredEndpoint, DiscoveredTopic, Participant, ParticipantOptions};
-pub use topic::{RawSample, Reader, Sample, SampleIdentity, StatsHandle, TopicStats, WriteRefused, Writer};
+pub use reader::Reader;
+#[doc(hidden)]
+pub use sample::fuzz_check_sample;
+pub use sample::{RawSample, Sample, SampleIdentity, StatsHandle, TopicStats};
+pub use writer::{WriteRefused, Writer};

@@ -2,15 +2,22 @@
 //! writers and readers.
 
 use std::collections::BTreeMap;
-use std::net::{IpAddr, Ipv4Addr};
+use std::net::Ipv4Addr;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU16, Ordering};
+use std::thread::JoinHandle;
 
 use robowire_core::cdr::CdrType;
-use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, RTPSEntity, Subscriber, TopicKind};
+use rtps_proto::participant::{Participant as Core, ParticipantConfig};
+use rtps_proto::{EntityId, Guid, GuidPrefix, VendorId};
 
 use crate::DdsError;
-use crate::adapter::CdrAdapter;
+use crate::driver::{self, Shared};
 use crate::qos::Qos;
-use crate::topic::{RawSample, Reader, Writer};
+use crate::reader::{Reader, ReaderSlot};
+use crate::sample::{Counters, RawSample};
+use crate::sockets::Sockets;
+use crate::writer::Writer;
 
 /// Where a participant lives.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -18,14 +25,16 @@ pub struct ParticipantOptions {
     /// DDS domain (Unitree's robots: 0).
     pub domain: u16,
     /// The network interface by name (`eth0`, `enp3s0`, `lo`), as Unitree's
-    /// `ChannelFactoryInitialize(0, iface)`; `None` lets the library choose.
+    /// `ChannelFactoryInitialize(0, iface)`; `None`: every interface with an IPv4 address.
     pub interface: Option<String>,
+    /// Participant USER_DATA announced to others (ROS 2's `enclave=/;`).
+    pub user_data: Vec<u8>,
 }
 
 impl ParticipantOptions {
     /// Domain `domain` on `interface`.
     pub fn new(domain: u16, interface: Option<&str>) -> Self {
-        Self { domain, interface: interface.map(str::to_owned) }
+        Self { domain, interface: interface.map(str::to_owned), user_data: Vec::new() }
     }
 }
 
@@ -55,12 +64,13 @@ pub struct DiscoveredEndpoint {
     pub type_name: String,
 }
 
-/// A domain participant; see the [crate docs](crate).
+/// A domain participant; see the [crate docs](crate). Its background thread (discovery,
+/// heartbeats, acknowledgements, receiving) ends when it is dropped, after announcing that it
+/// leaves.
 pub struct Participant {
-    inner: DomainParticipant,
-    publisher: Publisher,
-    subscriber: Subscriber,
+    shared: Arc<Shared>,
     options: ParticipantOptions,
+    thread: Option<JoinHandle<()>>,
 }
 
 impl std::fmt::Debug for Participant {
@@ -80,20 +90,55 @@ fn interface_addresses(name: &str) -> Result<Vec<Ipv4Addr>, DdsError> {
     Ok(ips)
 }
 
+/// Every IPv4 address of the host, loopback last (or alone).
+fn host_addresses() -> Vec<Ipv4Addr> {
+    let mut ips = robowire_udp::host_ipv4_addresses();
+    ips.sort_by_key(Ipv4Addr::is_loopback);
+    if ips.is_empty() {
+        ips.push(Ipv4Addr::LOCALHOST);
+    }
+    ips
+}
+
+/// A GUID prefix unique on the network: robowire's vendor id, 4 bytes of the wall clock at
+/// creation, the process id, a counter of this process's participants.
+fn new_guid_prefix() -> GuidPrefix {
+    static COUNTER: AtomicU16 = AtomicU16::new(0);
+    let clock = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    let clock = (clock.as_nanos() as u32) ^ (clock.as_secs() as u32).rotate_left(16);
+    let mut p = [0u8; 12];
+    p[..2].copy_from_slice(&VendorId::ROBOWIRE.0);
+    p[2..6].copy_from_slice(&clock.to_be_bytes());
+    p[6..10].copy_from_slice(&std::process::id().to_be_bytes());
+    p[10..].copy_from_slice(&COUNTER.fetch_add(1, Ordering::Relaxed).to_be_bytes());
+    GuidPrefix(p)
+}
+
 impl Participant {
     /// Joins `options.domain` on `options.interface`.
     pub fn new(options: ParticipantOptions) -> Result<Self, DdsError> {
-        let mut builder = DomainParticipantBuilder::new(options.domain);
-        if let Some(name) = &options.interface {
-            let ips = interface_addresses(name)?;
-            builder = builder.with_only_networks(ips.into_iter().map(IpAddr::V4));
-        }
+        let addresses = match &options.interface {
+            Some(name) => interface_addresses(name)?,
+            None => host_addresses(),
+        };
         let failed = |source| DdsError::Participant { domain: options.domain, source };
-        let inner = builder.build().map_err(failed)?;
-        let qos = Qos::WRITER.policies();
-        let publisher = inner.create_publisher(&qos).map_err(failed)?;
-        let subscriber = inner.create_subscriber(&Qos::READER.policies()).map_err(failed)?;
-        Ok(Self { inner, publisher, subscriber, options })
+        let sockets = Sockets::open(options.domain, addresses).map_err(failed)?;
+        let mut config = ParticipantConfig::new(new_guid_prefix(), u32::from(options.domain));
+        config.metatraffic_unicast = sockets.metatraffic_unicast();
+        config.default_unicast = sockets.default_unicast();
+        config.metatraffic_multicast = vec![sockets.spdp_multicast()];
+        config.spdp_destinations = vec![sockets.spdp_multicast()];
+        config.user_data = options.user_data.clone();
+        let now = robowire_rt::now();
+        let shared = Shared::new(Core::new(config, now), sockets).map_err(failed)?;
+        let thread = std::thread::Builder::new()
+            .name("robowire-dds".into())
+            .spawn({
+                let shared = shared.clone();
+                move || driver::run(shared)
+            })
+            .map_err(failed)?;
+        Ok(Self { shared, options, thread: Some(thread) })
     }
 
     /// Where it lives.
@@ -104,35 +149,40 @@ impl Participant {
     /// Its RTPS GUID in wire order: the GUID prefix every endpoint of it shares, and the
     /// participant's entity id `00 00 01 c1`.
     pub fn guid(&self) -> [u8; 16] {
-        self.inner.guid().to_bytes()
+        Guid::new(self.prefix(), EntityId::PARTICIPANT).to_bytes()
     }
 
-    fn topic(&self, name: &str, type_name: &str, qos: Qos, what: &'static str) -> Result<rustdds::Topic, DdsError> {
-        self.inner
-            .create_topic(name.into(), type_name.into(), &qos.policies(), TopicKind::NoKey)
-            .map_err(|source| DdsError::Create { what, topic: name.into(), source })
+    fn prefix(&self) -> GuidPrefix {
+        self.shared.lock().core.guid_prefix()
     }
 
     /// A writer of `T` on topic `name`.
     pub fn writer<T: CdrType + 'static>(&self, name: &str, qos: Qos) -> Result<Writer<T>, DdsError> {
-        let topic = self.topic(name, T::TYPE_NAME, qos, "writer")?;
-        let inner = self
-            .publisher
-            .create_datawriter_no_key::<T, CdrAdapter<T>>(&topic, Some(qos.policies()))
-            .map_err(|source| DdsError::Create { what: "writer", topic: name.into(), source })?;
-        Ok(Writer::new(inner, name))
+        self.writer_of_type(name, T::TYPE_NAME, qos)
     }
 
     /// A writer of topic `name` whose samples are given as bytes ([`RawSample`]: an XCDR1 body),
     /// announced with the type name `type_name` (a passthrough of a message robowire does not
     /// decode here).
     pub fn raw_writer(&self, name: &str, type_name: &str, qos: Qos) -> Result<Writer<RawSample>, DdsError> {
-        let topic = self.topic(name, type_name, qos, "writer")?;
-        let inner = self
-            .publisher
-            .create_datawriter_no_key::<RawSample, CdrAdapter<RawSample>>(&topic, Some(qos.policies()))
+        self.writer_of_type(name, type_name, qos)
+    }
+
+    fn writer_of_type<T: CdrType + 'static>(
+        &self,
+        name: &str,
+        type_name: &str,
+        qos: Qos,
+    ) -> Result<Writer<T>, DdsError> {
+        let now = robowire_rt::now();
+        let mut st = self.shared.lock();
+        let id = st
+            .core
+            .create_writer(now, name, type_name, qos.to_rtps())
             .map_err(|source| DdsError::Create { what: "writer", topic: name.into(), source })?;
-        Ok(Writer::new(inner, name))
+        let guid = Guid::new(st.core.guid_prefix(), id).to_bytes();
+        self.shared.settle(&mut st, now);
+        Ok(Writer::new(self.shared.clone(), id, guid, name))
     }
 
     /// A reader of `T` on topic `name` (any executor).
@@ -152,29 +202,35 @@ impl Participant {
         type_name: &str,
         qos: Qos,
     ) -> Result<Reader<T>, DdsError> {
-        let topic = self.topic(name, type_name, qos, "reader")?;
-        let inner = self
-            .subscriber
-            .create_simple_datareader_no_key::<crate::adapter::Decoded<T>, CdrAdapter<T>>(&topic, Some(qos.policies()))
+        let now = robowire_rt::now();
+        let counters = Arc::new(Counters::default());
+        let slot = Arc::new(ReaderSlot::new(usize::try_from(qos.depth).unwrap_or(1), counters.clone()));
+        let mut st = self.shared.lock();
+        let id = st
+            .core
+            .create_reader(now, name, type_name, qos.to_rtps())
             .map_err(|source| DdsError::Create { what: "reader", topic: name.into(), source })?;
-        Ok(Reader::new(inner, name, usize::try_from(qos.depth).unwrap_or(1)))
+        st.readers.insert(id, slot.clone());
+        let guid = Guid::new(st.core.guid_prefix(), id).to_bytes();
+        self.shared.settle(&mut st, now);
+        Ok(Reader::new(self.shared.clone(), slot, id, guid, name, counters))
     }
 
     /// Other participants' writers and readers seen so far, writers first.
     pub fn discovered_endpoints(&self) -> Vec<DiscoveredEndpoint> {
-        let writers = self.inner.discovered_writers().into_iter().map(|w| DiscoveredEndpoint {
-            guid: w.writer_proxy.remote_writer_guid.to_bytes(),
-            writer: true,
-            topic: w.publication_topic_data.topic_name,
-            type_name: w.publication_topic_data.type_name,
-        });
-        let readers = self.inner.discovered_readers().into_iter().map(|r| DiscoveredEndpoint {
-            guid: r.reader_proxy.remote_reader_guid.to_bytes(),
-            writer: false,
-            topic: r.subscription_topic_data.topic_name().clone(),
-            type_name: r.subscription_topic_data.type_name().clone(),
-        });
-        writers.chain(readers).collect()
+        let st = self.shared.lock();
+        let mut all: Vec<DiscoveredEndpoint> = st
+            .core
+            .remote_endpoints()
+            .map(|e| DiscoveredEndpoint {
+                guid: e.guid.to_bytes(),
+                writer: e.guid.entity.is_writer(),
+                topic: e.topic_name.clone(),
+                type_name: e.type_name.clone(),
+            })
+            .collect();
+        all.sort_by_key(|e| !e.writer);
+        all
     }
 
     /// Topics seen from other participants' writers and readers, by name.
@@ -192,5 +248,25 @@ impl Participant {
             .into_iter()
             .map(|((name, type_name), (writers, readers))| DiscoveredTopic { name, type_name, writers, readers })
             .collect()
+    }
+
+    /// The participant's protocol counters: refused datagrams by kind, discovery data that did
+    /// not parse, what the limits dropped.
+    pub fn counters(&self) -> rtps_proto::participant::Counters {
+        self.shared.lock().core.counters().clone()
+    }
+
+    /// Datagrams whose `sendto` failed.
+    pub fn send_failures(&self) -> u64 {
+        self.shared.send_failures.load(Ordering::Relaxed)
+    }
+}
+
+impl Drop for Participant {
+    fn drop(&mut self) {
+        self.shared.stop();
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
     }
 }

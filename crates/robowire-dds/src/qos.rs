@@ -4,8 +4,8 @@
 //! A reader of requests or answers keeps a few more samples locally (history depth is not
 //! matched between peers), so that two calls in a row are not one.
 
-use rustdds::policy::{Durability, History, Reliability};
-use rustdds::{QosPolicies, QosPolicyBuilder};
+use rtps_proto::discovery::{Durability, History, Reliability};
+use rtps_proto::types::DdsDuration;
 
 /// How a writer or reader is set up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,16 +43,19 @@ impl Qos {
     /// ROS 2's `/tf_static`: reliable, keep last 1, transient local.
     pub const ROS_TF_STATIC: Self = Self { transient_local: true, ..Self::WRITER };
 
-    pub(crate) fn policies(self) -> QosPolicies {
+    /// The QoS as announced on the wire and matched.
+    pub(crate) fn to_rtps(self) -> rtps_proto::discovery::Qos {
         let reliability = if self.reliable {
-            Reliability::Reliable { max_blocking_time: rustdds::Duration::from_millis(self.max_blocking_ms) }
+            let ms = u64::try_from(self.max_blocking_ms).unwrap_or(0);
+            Reliability::Reliable { max_blocking_time: DdsDuration::from_duration(std::time::Duration::from_millis(ms)) }
         } else {
             Reliability::BestEffort
         };
-        QosPolicyBuilder::new()
-            .reliability(reliability)
-            .history(History::KeepLast { depth: self.depth })
-            .durability(if self.transient_local { Durability::TransientLocal } else { Durability::Volatile })
-            .build()
+        rtps_proto::discovery::Qos {
+            reliability,
+            history: History::KeepLast { depth: u32::try_from(self.depth.max(1)).unwrap_or(1) },
+            durability: if self.transient_local { Durability::TransientLocal } else { Durability::Volatile },
+            ..rtps_proto::discovery::Qos::default()
+        }
     }
 }

@@ -380,6 +380,12 @@ impl Participant {
         self.remote.iter().find(|r| r.data.guid_prefix == guid.prefix)?.endpoint(guid)
     }
 
+    /// Whether every reliable reader matched with local writer `writer` has acknowledged every
+    /// sample it wrote (`None`: no such writer).
+    pub fn writer_acknowledged(&self, writer: EntityId) -> Option<bool> {
+        self.writers.iter().find(|w| w.id == writer).map(|w| !w.has_unacknowledged())
+    }
+
     /// The remote readers matched with local writer `writer`.
     pub fn matched_readers(&self, writer: EntityId) -> impl Iterator<Item = Guid> + '_ {
         self.writers.iter().filter(move |w| w.id == writer).flat_map(|w| w.readers.iter().map(|p| p.guid))

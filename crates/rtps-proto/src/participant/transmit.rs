@@ -160,6 +160,37 @@ impl Participant {
         Some(t)
     }
 
+    /// The datagram that tells others this participant leaves (an SPDP dispose), to the SPDP
+    /// destinations and the first known participants' discovery locators.
+    pub fn leave(&mut self, buf: &mut [u8]) -> Option<Transmit> {
+        let guid = crate::types::Guid::new(self.config.guid_prefix, EntityId::PARTICIPANT);
+        // The key: PL_CDR_LE with PID_PARTICIPANT_GUID.
+        let mut key = alloc::vec![0u8, 3, 0, 0];
+        key.extend_from_slice(&pid::PARTICIPANT_GUID.to_le_bytes());
+        key.extend_from_slice(&16u16.to_le_bytes());
+        key.extend_from_slice(&guid.to_bytes());
+        key.extend_from_slice(&[1, 0, 0, 0]);
+        let change = Change {
+            sequence: SequenceNumber(self.spdp_sequence.0 + 1),
+            kind: ChangeKind::Disposed,
+            payload: key,
+            source_timestamp: None,
+            related: None,
+            key_hash: Some(guid.to_bytes()),
+        };
+        let len = self.build(buf, None, |w| push_data(w, EntityId::SPDP_READER, EntityId::SPDP_WRITER, &change))?;
+        let mut t = Transmit::new(len);
+        for l in &self.config.spdp_destinations {
+            t.add(*l);
+        }
+        for r in &self.remote {
+            for l in &r.data.metatraffic_unicast_locators {
+                t.add(*l);
+            }
+        }
+        Some(t)
+    }
+
     /// Builds a datagram: header, INFO_DST when `to` is given, then what `fill` pushes.
     fn build(
         &self,

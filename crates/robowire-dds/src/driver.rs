@@ -1,0 +1,204 @@
+//! The participant's one background thread and the state it shares with writers and readers.
+//!
+//! The core (`rtps_proto::participant::Participant`) sits behind one mutex, held only while it
+//! computes and while its datagrams go out with non-blocking `sendto`s (microseconds; no I/O
+//! that can wait). The background thread waits in `poll(2)` on the sockets and an eventfd until
+//! a datagram arrives or the core's next deadline (announcements, heartbeats, acknowledgements,
+//! leases): it never spins. It hands each received sample to its reader's slot and wakes the
+//! reader's task once. A writer's sample is sent on the writer's own thread.
+
+use std::collections::HashMap;
+use std::io;
+use std::net::{SocketAddr, UdpSocket};
+use std::os::fd::{AsFd, OwnedFd};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use crossbeam_queue::ArrayQueue;
+use rtps_proto::participant::{Destination, Event, Participant as Core};
+use rtps_proto::{EntityId, Time};
+use rustix::event::{EventfdFlags, PollFd, PollFlags};
+
+use crate::reader::ReaderSlot;
+use crate::sockets::{MAX_DATAGRAM, Sockets};
+
+/// Payload buffers handed back by readers, kept for the core to reuse.
+const RECYCLED: usize = 64;
+
+/// What the core, the background thread, writers and readers share.
+#[derive(Debug)]
+pub(crate) struct Shared {
+    state: Mutex<State>,
+    pub(crate) sockets: Sockets,
+    wake: OwnedFd,
+    /// The background thread's next deadline in monotonic ns (`u64::MAX`: none), written and
+    /// read under the state's lock.
+    armed_ns: AtomicU64,
+    stop: AtomicBool,
+    /// Payload buffers readers are done with.
+    pub(crate) recycled: ArrayQueue<Vec<u8>>,
+    /// Woken after each datagram while a writer waits for acknowledgements.
+    pub(crate) acknowledgements: tokio::sync::Notify,
+    pub(crate) ack_waiters: AtomicUsize,
+    /// Datagrams whose `sendto` failed (full buffer, unreachable network).
+    pub(crate) send_failures: AtomicU64,
+}
+
+/// The core and the readers' slots, under the lock.
+#[derive(Debug)]
+pub(crate) struct State {
+    pub(crate) core: Core,
+    pub(crate) readers: HashMap<EntityId, Arc<ReaderSlot>>,
+    /// Room for one datagram to send.
+    pub(crate) buf: Vec<u8>,
+}
+
+impl Shared {
+    pub(crate) fn new(core: Core, sockets: Sockets) -> io::Result<Arc<Self>> {
+        let wake = rustix::event::eventfd(0, EventfdFlags::CLOEXEC | EventfdFlags::NONBLOCK)?;
+        Ok(Arc::new(Self {
+            state: Mutex::new(State { core, readers: HashMap::new(), buf: vec![0; MAX_DATAGRAM] }),
+            sockets,
+            wake,
+            armed_ns: AtomicU64::new(u64::MAX),
+            stop: AtomicBool::new(false),
+            recycled: ArrayQueue::new(RECYCLED),
+            acknowledgements: tokio::sync::Notify::new(),
+            ack_waiters: AtomicUsize::new(0),
+            send_failures: AtomicU64::new(0),
+        }))
+    }
+
+    /// The state (a poisoned lock's state is still consistent: see `robowire_rt::sync`).
+    pub(crate) fn lock(&self) -> MutexGuard<'_, State> {
+        robowire_rt::lock(&self.state)
+    }
+
+    /// Sends what the core has due, hands samples to readers; then, if the core's next deadline
+    /// is earlier than the one the background thread sleeps towards, wakes it.
+    pub(crate) fn settle(&self, st: &mut State, now: Time) {
+        self.dispatch(st);
+        self.flush(st, now);
+        let next = st.core.poll_timeout().map_or(u64::MAX, Time::as_nanos);
+        if next < self.armed_ns.load(Ordering::Relaxed) {
+            self.armed_ns.store(next, Ordering::Relaxed);
+            self.wake();
+        }
+    }
+
+    /// Sends every datagram the core has due.
+    pub(crate) fn flush(&self, st: &mut State, now: Time) {
+        let State { core, buf, .. } = st;
+        while let Some(t) = core.poll_transmit(now, buf) {
+            let failed = self.sockets.send(&buf[..t.len], t.destinations());
+            if failed > 0 {
+                self.send_failures.fetch_add(failed, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// Hands received samples to their readers (the oldest kept sample replaced when a reader's
+    /// slot is full, its buffer reused) and gives readers' spent buffers back to the core.
+    fn dispatch(&self, st: &mut State) {
+        while let Some(b) = self.recycled.pop() {
+            st.core.recycle(b);
+        }
+        while let Some(e) = st.core.poll_event() {
+            if let Event::Sample(sample) = e {
+                match st.readers.get(&sample.info.reader) {
+                    Some(slot) => {
+                        if let Some(replaced) = slot.push(sample) {
+                            st.core.recycle(replaced);
+                        }
+                    }
+                    None => st.core.recycle(sample.payload),
+                }
+            }
+        }
+    }
+
+    fn wake(&self) {
+        let _ = rustix::io::write(&self.wake, &1u64.to_ne_bytes());
+    }
+
+    /// Ends the background thread.
+    pub(crate) fn stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+        self.wake();
+    }
+}
+
+fn recv_all(shared: &Shared, socket: &UdpSocket, destination: Destination, rx: &mut [u8]) {
+    loop {
+        match socket.recv_from(rx) {
+            Ok((n, from)) => handle(shared, from, destination, &rx[..n]),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(_) => return, // WouldBlock: drained (other errors: ICMP reports, ignored)
+        }
+    }
+}
+
+fn handle(shared: &Shared, from: SocketAddr, destination: Destination, datagram: &[u8]) {
+    let now = robowire_rt::now();
+    let mut st = shared.lock();
+    st.core.handle_datagram(now, from, destination, datagram);
+    shared.settle(&mut st, now);
+    drop(st);
+    if shared.ack_waiters.load(Ordering::Relaxed) > 0 {
+        shared.acknowledgements.notify_waiters();
+    }
+}
+
+/// The background thread: receives, and runs the core's timers.
+pub(crate) fn run(shared: Arc<Shared>) {
+    let mut rx = vec![0u8; MAX_DATAGRAM];
+    while !shared.stop.load(Ordering::Relaxed) {
+        let deadline = {
+            let st = shared.lock();
+            let next = st.core.poll_timeout().map_or(u64::MAX, Time::as_nanos);
+            shared.armed_ns.store(next, Ordering::Relaxed);
+            next
+        };
+        let now = robowire_rt::monotonic_ns();
+        let timeout = (deadline != u64::MAX).then(|| {
+            let ns = deadline.saturating_sub(now);
+            rustix::time::Timespec { tv_sec: (ns / 1_000_000_000) as i64, tv_nsec: (ns % 1_000_000_000) as i64 }
+        });
+        let s = &shared.sockets;
+        let mut fds = [
+            PollFd::new(&s.user, PollFlags::IN),
+            PollFd::new(&s.meta, PollFlags::IN),
+            PollFd::new(&s.spdp, PollFlags::IN),
+            PollFd::from_borrowed_fd(shared.wake.as_fd(), PollFlags::IN),
+        ];
+        if rustix::event::poll(&mut fds, timeout.as_ref()).is_err() {
+            continue; // EINTR
+        }
+        let ready: [bool; 4] = std::array::from_fn(|i| !fds[i].revents().is_empty());
+        if ready[3] {
+            let mut b = [0u8; 8];
+            let _ = rustix::io::read(&shared.wake, &mut b);
+        }
+        if ready[0] {
+            recv_all(&shared, &s.user, Destination::Unicast, &mut rx);
+        }
+        if ready[1] {
+            recv_all(&shared, &s.meta, Destination::Unicast, &mut rx);
+        }
+        if ready[2] {
+            recv_all(&shared, &s.spdp, Destination::Multicast, &mut rx);
+        }
+        let now = robowire_rt::now();
+        let mut st = shared.lock();
+        if st.core.poll_timeout().is_some_and(|t| t <= now) {
+            st.core.handle_timeout(now);
+        }
+        shared.settle(&mut st, now);
+    }
+    // Leaving: tell the others at once rather than letting the lease run out.
+    let mut st = shared.lock();
+    let State { core, buf, .. } = &mut *st;
+    if let Some(t) = core.leave(buf) {
+        shared.sockets.send(&buf[..t.len], t.destinations());
+    }
+}
