@@ -14,7 +14,7 @@ mod sockets;
 mod writer;
 
 pub use error::DdsError;
-pub use participant::{DiscoveredEndpoint, DiscoveredTopic, Participant, ParticipantOptions};
+pub use participant::{DiscoveredEndpoint, DiscoveredParticipant, DiscoveredTopic, Participant, ParticipantOptions};
 pub use reader::Reader;
 #[doc(hidden)]
 pub use sample::fuzz_check_sample;

@@ -64,6 +64,19 @@ pub struct DiscoveredEndpoint {
     pub type_name: String,
 }
 
+/// Another participant, as DDS discovery (SPDP) reports it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DiscoveredParticipant {
+    /// Its GUID prefix.
+    pub guid_prefix: [u8; 12],
+    /// Its implementation (RTPS vendor id, two bytes) and that vendor's name where known.
+    pub vendor: ([u8; 2], Option<&'static str>),
+    /// Its USER_DATA (ROS 2: `enclave=/;`).
+    pub user_data: Vec<u8>,
+    /// Where it receives discovery and user data sent to it alone.
+    pub unicast: Vec<std::net::SocketAddr>,
+}
+
 /// A domain participant; see the [crate docs](crate). Its background thread (discovery,
 /// heartbeats, acknowledgements, receiving) ends when it is dropped, after announcing that it
 /// leaves.
@@ -231,6 +244,25 @@ impl Participant {
             .collect();
         all.sort_by_key(|e| !e.writer);
         all
+    }
+
+    /// Other participants seen so far.
+    pub fn discovered_participants(&self) -> Vec<DiscoveredParticipant> {
+        let st = self.shared.lock();
+        st.core
+            .remote_participants()
+            .map(|p| DiscoveredParticipant {
+                guid_prefix: p.guid_prefix.0,
+                vendor: (p.vendor_id.0, p.vendor_id.name()),
+                user_data: p.user_data.clone(),
+                unicast: p
+                    .metatraffic_unicast_locators
+                    .iter()
+                    .chain(&p.default_unicast_locators)
+                    .filter_map(rtps_proto::Locator::socket_addr)
+                    .collect(),
+            })
+            .collect()
     }
 
     /// Topics seen from other participants' writers and readers, by name.

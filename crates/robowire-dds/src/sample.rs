@@ -148,20 +148,27 @@ pub(crate) fn decode<T: CdrType>(payload: &[u8]) -> Result<T, DecodeFailure> {
             reason: format!("unsupported representation {:02x?}", payload.get(..2).unwrap_or(payload)),
         });
     };
-    T::decode_body(encoding, &payload[4..])
-        .map_err(|e| DecodeFailure { checksum: T::is_checksum_error(&e), reason: e.to_string() })
+    // The options' last two bits: padding bytes after the body (XTypes 7.6.3.1.2).
+    let padding = usize::from(payload[3] & 3);
+    let body = &payload[4..payload.len().saturating_sub(padding).max(4)];
+    T::decode_body(encoding, body).map_err(|e| DecodeFailure { checksum: T::is_checksum_error(&e), reason: e.to_string() })
 }
 
-/// `value`'s payload: `T`'s encapsulation header and its body, into `out` (grown as needed, so
-/// a buffer reused across writes of one type stops allocating).
+/// `value`'s payload: `T`'s encapsulation header and its body, padded with zeros to a multiple
+/// of 4 bytes as RTPS needs (the padding's length in the options' last two bits, XTypes
+/// 7.6.3.1.2), into `out` (grown as needed, so a buffer reused across writes of one type stops
+/// allocating).
 pub(crate) fn encode<T: CdrType>(value: &T, out: &mut Vec<u8>) -> Result<(), robowire_core::BufferTooSmall> {
     let len = 4 + value.body_len();
-    if out.len() < len {
-        out.resize(len, 0);
+    if out.len() < len + 3 {
+        out.resize(len + 3, 0);
     }
     out[..4].copy_from_slice(&T::ENCODING.header());
     let n = value.encode_body(&mut out[4..])?;
-    out.truncate(4 + n);
+    let padding = (4 - n % 4) % 4;
+    out[4 + n..4 + n + padding].fill(0);
+    out[3] = (out[3] & !3) | padding as u8;
+    out.truncate(4 + n + padding);
     Ok(())
 }
 
@@ -204,6 +211,17 @@ mod tests {
         command.encode_cdr(CdrEncoding::Xcdr2, &mut payload).unwrap();
         assert_eq!(decode::<LowCmd>(&payload).unwrap(), command.sealed());
         assert_eq!(fuzz_check_sample::<LowCmd>(&payload), Some(Ok(command.sealed())));
+    }
+
+    #[test]
+    fn a_body_is_padded_to_four_bytes_and_the_padding_is_said_and_stripped() {
+        let sample = RawSample { encoding: CdrEncoding::Xcdr1, body: vec![1, 2, 3, 4, 5] };
+        let mut payload = Vec::new();
+        encode(&sample, &mut payload).unwrap();
+        assert_eq!(payload, [0, 1, 0, 3, 1, 2, 3, 4, 5, 0, 0, 0]);
+        assert_eq!(decode::<RawSample>(&payload).unwrap(), sample);
+        // A hostile padding count never reaches into the header.
+        assert_eq!(decode::<RawSample>(&[0, 1, 0, 3, 9]).unwrap().body, Vec::<u8>::new());
     }
 
     #[test]

@@ -12,7 +12,7 @@ use rtps_proto::{EntityId, Timestamp};
 
 use crate::DdsError;
 use crate::driver::{Shared, State};
-use crate::sample::{Counters, SampleIdentity, StatsHandle, TopicStats, encode};
+use crate::sample::{Counters, RawSample, SampleIdentity, StatsHandle, TopicStats, encode};
 
 thread_local! {
     /// The payload of the sample being written: grown to the largest sample this thread wrote,
@@ -72,43 +72,48 @@ impl<T: CdrType + 'static> Writer<T> {
         PAYLOAD.with(|payload| {
             let mut payload = payload.borrow_mut();
             encode(sample, &mut payload).map_err(|_| Refusal::Failed(WriteError::BufferTooSmall))?;
-            let unix_ns = std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
-            let options = WriteOptions {
-                source_timestamp: Some(Timestamp::from_unix_nanos(unix_ns)),
-                related: related.map(SampleIdentity::to_rtps),
-                key_hash: None,
-            };
-            let now = robowire_rt::now();
-            let written = {
-                let mut st = self.shared.lock();
-                let State { core, buf, .. } = &mut *st;
-                let written = core.write(now, self.id, &payload, &options, buf);
-                if let Ok(w) = &written {
-                    // Counted before it can arrive anywhere: a reader never sees a sample the
-                    // writer's counters do not have yet.
-                    Counters::bump(&self.counters.samples);
-                    if let Some(t) = w.transmit {
-                        let failed = self.shared.sockets.send(&buf[..t.len], t.destinations());
-                        self.shared.send_failures.fetch_add(failed, Ordering::Relaxed);
-                    }
-                    // Fragments, a heartbeat's new deadline.
-                    self.shared.settle(&mut st, now);
-                }
-                written
-            };
-            let sequence = match written {
-                Ok(w) => w.sequence,
-                Err(WriteError::HistoryFull { .. }) => return Err(Refusal::Full),
-                Err(e) => return Err(Refusal::Failed(e)),
-            };
-            if let Some(tap) = &self.tap {
-                let origin = SampleOrigin { writer: Some(self.guid), source_unix_ns: Some(unix_ns) };
-                tap.record_parts(Direction::Sent, &[&payload], origin);
-            }
-            Ok(SampleIdentity { writer: self.guid, sequence: sequence.0 })
+            self.publish_payload(&payload, related)
         })
+    }
+
+    /// Publishes `payload` (encapsulation header, body) as it is.
+    fn publish_payload(&self, payload: &[u8], related: Option<SampleIdentity>) -> Result<SampleIdentity, Refusal> {
+        let unix_ns = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
+        let options = WriteOptions {
+            source_timestamp: Some(Timestamp::from_unix_nanos(unix_ns)),
+            related: related.map(SampleIdentity::to_rtps),
+            key_hash: None,
+        };
+        let now = robowire_rt::now();
+        let written = {
+            let mut st = self.shared.lock();
+            let State { core, buf, .. } = &mut *st;
+            let written = core.write(now, self.id, payload, &options, buf);
+            if let Ok(w) = &written {
+                // Counted before it can arrive anywhere: a reader never sees a sample the
+                // writer's counters do not have yet.
+                Counters::bump(&self.counters.samples);
+                if let Some(t) = w.transmit {
+                    let failed = self.shared.sockets.send(&buf[..t.len], t.destinations());
+                    self.shared.send_failures.fetch_add(failed, Ordering::Relaxed);
+                }
+                // Fragments, a heartbeat's new deadline.
+                self.shared.settle(&mut st, now);
+            }
+            written
+        };
+        let sequence = match written {
+            Ok(w) => w.sequence,
+            Err(WriteError::HistoryFull { .. }) => return Err(Refusal::Full),
+            Err(e) => return Err(Refusal::Failed(e)),
+        };
+        if let Some(tap) = &self.tap {
+            let origin = SampleOrigin { writer: Some(self.guid), source_unix_ns: Some(unix_ns) };
+            tap.record_parts(Direction::Sent, &[payload], origin);
+        }
+        Ok(SampleIdentity { writer: self.guid, sequence: sequence.0 })
     }
 
     /// Encodes `sample` with its codec and publishes it.
@@ -141,7 +146,11 @@ impl<T: CdrType + 'static> Writer<T> {
     /// Publishes `sample`, never waiting: a full keep-all history drops it. No allocation. For
     /// stream threads.
     pub fn try_write(&self, sample: T) -> Result<(), WriteRefused> {
-        match self.publish(&sample, None) {
+        self.refused(self.publish(&sample, None))
+    }
+
+    fn refused(&self, published: Result<SampleIdentity, Refusal>) -> Result<(), WriteRefused> {
+        match published {
             Ok(_) => Ok(()),
             Err(Refusal::Full) => {
                 Counters::bump(&self.counters.dropped);
@@ -206,6 +215,14 @@ impl<T: CdrType + 'static> Writer<T> {
     /// A handle on the counters.
     pub fn stats_handle(&self) -> StatsHandle {
         StatsHandle(self.counters.clone())
+    }
+}
+
+impl Writer<RawSample> {
+    /// Publishes a recorded payload (encapsulation header with its option bytes, body) byte for
+    /// byte, never waiting, as [`try_write`](Self::try_write): what `replay --as-device` sends.
+    pub fn try_write_payload(&self, payload: &[u8]) -> Result<(), WriteRefused> {
+        self.refused(self.publish_payload(payload, None))
     }
 }
 

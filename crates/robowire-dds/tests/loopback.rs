@@ -235,3 +235,31 @@ fn a_related_sample_identity_and_the_sequence_number_cross() {
         })
     });
 }
+
+#[test]
+fn participant_user_data_is_announced_and_a_leaving_participant_is_forgotten_at_once() {
+    with_loopback_multicast(|| {
+        let options = ParticipantOptions::new(0, Some("lo"));
+        let ros = Participant::new(ParticipantOptions { user_data: b"enclave=/;".to_vec(), ..options.clone() }).unwrap();
+        let observer = Participant::new(options).unwrap();
+        let ros_prefix: [u8; 12] = ros.guid()[..12].try_into().unwrap();
+        let began = std::time::Instant::now();
+        let seen = loop {
+            if let Some(p) = observer.discovered_participants().into_iter().find(|p| p.guid_prefix == ros_prefix) {
+                break p;
+            }
+            assert!(began.elapsed() < WAIT, "never discovered");
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        assert_eq!(seen.user_data, b"enclave=/;");
+        assert_eq!(seen.vendor.1, Some("robowire"));
+        assert!(!seen.unicast.is_empty());
+        // Its dispose arrives when it is dropped: gone long before its 20 s lease.
+        drop(ros);
+        let began = std::time::Instant::now();
+        while observer.discovered_participants().iter().any(|p| p.guid_prefix == ros_prefix) {
+            assert!(began.elapsed() < Duration::from_secs(10), "still there after its dispose");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    });
+}

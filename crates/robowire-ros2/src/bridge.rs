@@ -151,7 +151,11 @@ pub async fn run(
     {
         return Err(BridgeError::Option(format!("--rate {hz} Hz is outside (0, 10000]")));
     }
-    let participant = Participant::new(ParticipantOptions::new(options.domain, options.interface.as_deref()))?;
+    // The participant's USER_DATA says its enclave, as rmw's participants do.
+    let participant = Participant::new(ParticipantOptions {
+        user_data: crate::graph::ENCLAVE_USER_DATA.to_vec(),
+        ..ParticipantOptions::new(options.domain, options.interface.as_deref())
+    })?;
     let spaces = namespaces(&options.devices, options.namespace.as_deref());
     if let Some(long) = spaces.iter().find(|ns| ns.len() > NAME_BOUND) {
         return Err(BridgeError::Option(format!("namespace {long:?} is longer than ROS 2's {NAME_BOUND} bytes")));

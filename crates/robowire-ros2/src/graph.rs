@@ -5,9 +5,8 @@
 //! As rmw does, the participant's whole [`ParticipantEntitiesInfo`] is written again whenever a
 //! node gains a reader or a writer (the devices' writers are made on their first observation),
 //! and with no node left when the bridge stops. Each endpoint is listed by its GID, its RTPS
-//! GUID padded to the distribution's GID size ([`RosDistro`]). rustdds 0.15 sends no
-//! participant USER_DATA, so the nodes' enclave (`enclave=/;`) is not announced: ROS 2 tools
-//! show it empty.
+//! GUID padded to the distribution's GID size ([`RosDistro`]). The participant announces its
+//! enclave in its USER_DATA as rmw does ([`ENCLAVE_USER_DATA`]).
 
 use std::sync::Mutex;
 
@@ -19,6 +18,9 @@ use ros2_proto::rmw_dds_common::{
 };
 
 use crate::bridge::BridgeError;
+
+/// The participant USER_DATA of rmw's participants in the root enclave.
+pub const ENCLAVE_USER_DATA: &[u8] = b"enclave=/;";
 
 /// The name of every device's node (in the device's namespace: `/kmc0/robowire`).
 pub const NODE_NAME: &str = "robowire";

@@ -7,9 +7,9 @@
 //! sample identity: the reader the client named in the request's related sample identity, else
 //! the request's writer, with the request's sequence number; a reply to a named reader waits up
 //! to 100 ms for that reader to be matched, as rmw_fastrtps does). rmw_cyclonedds' clients also
-//! announce `clientid=` in their writers' USER_DATA, which rustdds 0.15 does not reliably hand
-//! over, so it is not used. A request of neither shape is counted by the request reader as a
-//! decode error and not answered.
+//! announce `clientid=` in their writers' USER_DATA; the request's own shape is enough, so it is
+//! not used. A request of neither shape is counted by the request reader as a decode error and
+//! not answered.
 
 use std::time::Duration;
 

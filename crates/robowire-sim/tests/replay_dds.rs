@@ -1,7 +1,8 @@
 //! The DDS replay device from a raw reader in a private network (`robowire_dds::netns`): the
 //! recorded LowState payloads arrive byte for byte (header, body, CRC: a broken one stays
-//! broken), in order, once a reader matched (a reliable one: every payload, none lost); the client's LowCmds are counted; a payload the raw
-//! writer cannot send as recorded is refused before anything is published.
+//! broken; XCDR1 or XCDR2 as recorded), in order, once a reader matched (a reliable one: every
+//! payload, none lost); the client's LowCmds are counted; a payload that is not CDR is refused
+//! before anything is published.
 
 use std::time::Duration;
 
@@ -38,7 +39,11 @@ fn lowstates(count: u32, step: Duration, broken: usize) -> Vec<(Duration, Vec<u8
 fn a_reader_receives_every_payload_byte_for_byte_in_order() {
     with_loopback_multicast(|| {
         let lo = ParticipantOptions::new(0, Some("lo"));
-        let recorded = lowstates(40, Duration::from_millis(2), 7);
+        let mut recorded = lowstates(40, Duration::from_millis(2), 7);
+        // One recorded as XCDR2 (a Go2 payload from another DDS): sent as it was.
+        let mut xcdr2 = vec![0u8; LowState::cdr_len(CdrEncoding::Xcdr2)];
+        LowState::default().encode_cdr(CdrEncoding::Xcdr2, &mut xcdr2).unwrap();
+        recorded[5].1 = xcdr2;
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         runtime.block_on(async {
             let device = DdsReplay::open(lo.clone(), STATES, Some(COMMANDS), recorded.clone()).unwrap();
@@ -70,8 +75,9 @@ fn a_reader_receives_every_payload_byte_for_byte_in_order() {
             let summary = tokio::time::timeout(WATCHDOG, play).await.expect("played in time").unwrap().unwrap();
             assert_eq!((summary.frames, summary.sent, summary.client), (40, 40, None));
             assert!(summary.commands > 0, "the client's LowCmds counted: {summary:?}");
-            for ((_, payload), sample) in recorded.iter().zip(&seen) {
-                assert_eq!(sample.encoding, CdrEncoding::Xcdr1);
+            for (i, ((_, payload), sample)) in recorded.iter().zip(&seen).enumerate() {
+                let encoding = if i == 5 { CdrEncoding::Xcdr2 } else { CdrEncoding::Xcdr1 };
+                assert_eq!(sample.encoding, encoding);
                 assert_eq!(sample.body, payload[4..], "the body as recorded");
             }
             let checked: Vec<bool> =
@@ -83,21 +89,19 @@ fn a_reader_receives_every_payload_byte_for_byte_in_order() {
 }
 
 #[test]
-fn a_payload_the_raw_writer_would_change_is_refused() {
+fn a_payload_that_is_not_cdr_is_refused() {
     // No participant is made before the payloads are checked: no network needed.
     let mut recorded = lowstates(3, Duration::ZERO, usize::MAX);
-    let mut xcdr2 = vec![0u8; LowState::cdr_len(CdrEncoding::Xcdr2)];
-    LowState::default().encode_cdr(CdrEncoding::Xcdr2, &mut xcdr2).unwrap();
-    recorded.insert(2, (Duration::ZERO, xcdr2));
+    recorded.insert(2, (Duration::ZERO, vec![0, 3, 0, 0, 1, 0, 0, 0]));
     recorded.push((Duration::ZERO, vec![0, 1]));
     let lo = ParticipantOptions::new(0, Some("lo"));
     match DdsReplay::open(lo.clone(), STATES, None, recorded.clone()) {
-        Err(ReplayError::Encapsulation { index: 2, found, sent: [0, 1, 0, 0] }) => assert_eq!(found, [0, 7, 0, 0]),
+        Err(ReplayError::Encapsulation { index: 2, found }) => assert_eq!(found, [0, 3, 0, 0]),
         other => panic!("{other:?}"),
     }
     recorded.remove(2);
     match DdsReplay::open(lo, STATES, None, recorded) {
-        Err(ReplayError::Encapsulation { index: 3, found, .. }) => assert_eq!(found, [0, 1]),
+        Err(ReplayError::Encapsulation { index: 3, found }) => assert_eq!(found, [0, 1]),
         other => panic!("{other:?}"),
     }
 }

@@ -1,11 +1,11 @@
-//! [`DdsReplay`]: recorded DDS payloads published again, byte for byte, on a topic. A raw writer
-//! of `robowire-dds` ([`RawSample`]) puts its own encapsulation header before each body: the
-//! player refuses, before anything is published, a payload whose header is not that one, so
-//! that what goes out is what was recorded (body, CRC and header alike).
+//! [`DdsReplay`]: recorded DDS payloads published again, byte for byte, on a topic: body, CRC
+//! and encapsulation header alike (XCDR1 or XCDR2, its option bytes kept). A payload that is not
+//! CDR (shorter than its header, or another representation) is refused before anything is
+//! published.
 
 use std::time::Duration;
 
-use robowire_core::cdr::CdrType;
+use robowire_core::cdr::CdrEncoding;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, RawSample, Reader, Writer};
 
@@ -25,9 +25,6 @@ pub struct DdsTopic<'a> {
     /// `unitree_go::msg::dds_::LowState_`.
     pub type_name: &'a str,
 }
-
-/// The encapsulation header a raw writer sends: its encoding (XCDR1, little endian), no options.
-const RAW_HEADER: [u8; 4] = <RawSample as CdrType>::ENCODING.header();
 
 /// Recorded payloads (encapsulation header, CDR body) published as the device on a DDS topic,
 /// from the first reader that matches; the client's commands on another topic are counted.
@@ -52,7 +49,7 @@ const RAW_HEADER: [u8; 4] = <RawSample as CdrType>::ENCODING.header();
 pub struct DdsReplay {
     writer: Writer<RawSample>,
     commands: Option<Reader<RawSample>>,
-    /// Offset from the first frame, CDR body.
+    /// Offset from the first frame, payload (header and body).
     frames: Vec<(Duration, Vec<u8>)>,
     /// Dropped last: the writer and reader belong to it.
     _participant: Participant,
@@ -62,23 +59,22 @@ impl DdsReplay {
     /// Joins the domain, with a writer of `states` (reliable, never waiting) and,
     /// if given, a reader of `commands`, to publish `payloads` (each: its offset from the first,
     /// the payload as recorded, in the order to publish them). A payload whose encapsulation
-    /// header is not the raw writer's is refused, with its index.
+    /// header is neither XCDR1 nor XCDR2 is refused, with its index.
     pub fn open(
         participant: ParticipantOptions,
         states: DdsTopic<'_>,
         commands: Option<DdsTopic<'_>>,
         payloads: impl IntoIterator<Item = (Duration, Vec<u8>)>,
     ) -> Result<Self, ReplayError> {
-        let sent = RAW_HEADER;
         let frames = payloads
             .into_iter()
             .enumerate()
-            .map(|(index, (offset, mut payload))| {
-                if payload.get(..4) != Some(&sent[..]) {
+            .map(|(index, (offset, payload))| {
+                let header = payload.get(..4).and_then(|h| <[u8; 4]>::try_from(h).ok());
+                if header.and_then(CdrEncoding::from_header).is_none() {
                     let found = payload.iter().take(4).copied().collect();
-                    return Err(ReplayError::Encapsulation { index, found, sent });
+                    return Err(ReplayError::Encapsulation { index, found });
                 }
-                payload.drain(..4);
                 Ok((offset, payload))
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -118,8 +114,7 @@ impl DdsReplay {
     pub async fn play(self, pace: Pace, linger: Duration) -> Result<ReplaySummary, ReplayError> {
         let Self { writer, mut commands, frames, _participant: participant } = self;
         let count = frames.len();
-        let encoding = <RawSample as CdrType>::ENCODING;
-        let send = move |body: &[u8]| writer.try_write(RawSample { encoding, body: body.to_vec() }).is_ok();
+        let send = move |payload: &[u8]| writer.try_write_payload(payload).is_ok();
         let runner = super::spawn_playback(frames, pace, send)?;
         let mut done = tokio::task::spawn_blocking(move || runner.join());
         let mut received = 0u64;

@@ -99,18 +99,14 @@ pub enum ReplayError {
         /// The frame's.
         found: usize,
     },
-    /// A recorded DDS payload that a raw writer cannot send as recorded: its encapsulation
-    /// header is not the one the writer puts before every body.
-    #[error(
-        "frame {index}: encapsulation header {found:02x?}, but the raw writer sends {sent:02x?} (XCDR1, no options)"
-    )]
+    /// A recorded DDS payload that is not CDR: shorter than its encapsulation header, or a
+    /// representation other than XCDR1 (`00 01`) and XCDR2 (`00 07`).
+    #[error("frame {index}: encapsulation header {found:02x?} is neither XCDR1 (00 01) nor XCDR2 (00 07)")]
     Encapsulation {
         /// The frame's index among those given.
         index: usize,
         /// Its first bytes (up to 4).
         found: Vec<u8>,
-        /// The header the writer sends.
-        sent: [u8; 4],
     },
 }
 

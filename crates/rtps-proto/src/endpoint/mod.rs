@@ -91,6 +91,14 @@ pub enum WriteError {
     /// The writer has written `i64::MAX` samples.
     #[error("sequence numbers exhausted")]
     SequenceNumbersExhausted,
+    /// A payload whose length is not a multiple of 4: RTPS submessages are 4-byte aligned
+    /// (CycloneDDS drops such a DATA). Pad it, saying so in the encapsulation options' last two
+    /// bits (XTypes 7.6.3.1.2).
+    #[error("a payload of {len} bytes is not padded to a multiple of 4")]
+    Unaligned {
+        /// The payload's length.
+        len: usize,
+    },
     /// The caller's buffer cannot hold the datagram.
     #[error("the datagram buffer is too small")]
     BufferTooSmall,

@@ -496,7 +496,8 @@ impl Participant {
         true
     }
 
-    /// Writes a sample (already-encoded CDR with its encapsulation header) and builds the
+    /// Writes a sample (already-encoded CDR with its encapsulation header, padded to a multiple
+    /// of 4 bytes) and builds the
     /// datagram that carries it to every matched reader into `buf`: send it to
     /// [`Transmit::destinations`] now. Samples longer than the fragment size go as DATA_FRAG
     /// from [`poll_transmit`](Self::poll_transmit).
@@ -508,6 +509,9 @@ impl Participant {
         options: &WriteOptions,
         buf: &mut [u8],
     ) -> Result<Written, WriteError> {
+        if payload.len() % 4 != 0 {
+            return Err(WriteError::Unaligned { len: payload.len() });
+        }
         if payload.len() > self.config.limits.sample_bytes {
             return Err(WriteError::TooLarge { len: payload.len(), limit: self.config.limits.sample_bytes });
         }

@@ -31,7 +31,8 @@ fn transient_local(depth: u32) -> Qos {
     Qos { durability: Durability::TransientLocal, ..reliable(depth) }
 }
 
-/// A CDR payload (XCDR1 little-endian header) carrying `n` and `len - 8` filler bytes.
+/// A CDR payload (XCDR1 little-endian header) carrying `n` and `len - 8` filler bytes (`len` a
+/// multiple of 4).
 fn payload(n: u32, len: usize) -> Vec<u8> {
     let mut p = vec![0, 1, 0, 0];
     p.extend(n.to_le_bytes());
@@ -154,7 +155,7 @@ fn fragments_with_seed(seed: u64) {
     let reader = w.nodes[1].participant.create_reader(now, TOPIC, TYPE, reliable(16)).unwrap();
     assert!(w.run(Duration::from_secs(5), |w| matched(w, 0, writer) == 1 && matched(w, 1, reader) == 1));
     w.faults = Faults { loss: 0.15, duplicate: 0.05, reorder: 0.3, max_delay: Duration::from_millis(3) };
-    let sent: Vec<Vec<u8>> = (0..10).map(|i| payload(i, 5000 + i as usize * 7)).collect();
+    let sent: Vec<Vec<u8>> = (0..10).map(|i| payload(i, 5000 + i as usize * 8)).collect();
     for s in &sent {
         let written = write(&mut w, 0, writer, s, &WriteOptions::default()).unwrap();
         assert!(written.transmit.is_none(), "a sample above the fragment size goes out through poll_transmit");
@@ -299,6 +300,15 @@ fn related_sample_identity_and_source_timestamp_reach_the_reader() {
     assert_eq!(info.related, Some(related));
     assert_eq!(info.source_timestamp, Some(ts));
     assert_eq!(info.writer, Guid::new(w.nodes[0].participant.guid_prefix(), writer));
+}
+
+#[test]
+fn an_unpadded_payload_is_refused() {
+    let mut w = World::new(1, 1);
+    let now = w.now;
+    let writer = w.nodes[0].participant.create_writer(now, TOPIC, TYPE, reliable(1)).unwrap();
+    let refused = write(&mut w, 0, writer, &[0, 1, 0, 0, 7], &WriteOptions::default());
+    assert_eq!(refused, Err(WriteError::Unaligned { len: 5 }));
 }
 
 #[test]
