@@ -22,6 +22,18 @@ use rustix::event::{EventfdFlags, PollFd, PollFlags};
 use crate::reader::ReaderSlot;
 use crate::sockets::{MAX_DATAGRAM, Sockets};
 
+/// Incompatible remote endpoints remembered per local endpoint (the first ones).
+const INCOMPATIBLE_KEPT: usize = 32;
+
+/// A remote endpoint on a local endpoint's topic that cannot match it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Incompatible {
+    /// The remote writer's or reader's GUID in wire order.
+    pub remote: [u8; 16],
+    /// Why: the type names differ, or the QoS policy that does not match and both sides' values.
+    pub reason: String,
+}
+
 /// Payload buffers handed back by readers, kept for the core to reuse.
 const RECYCLED: usize = 64;
 
@@ -49,6 +61,8 @@ pub(crate) struct Shared {
 pub(crate) struct State {
     pub(crate) core: Core,
     pub(crate) readers: HashMap<EntityId, Arc<ReaderSlot>>,
+    /// Remote endpoints on a local endpoint's topic that cannot match it, and why.
+    pub(crate) incompatible: HashMap<EntityId, Vec<Incompatible>>,
     /// Room for one datagram to send.
     pub(crate) buf: Vec<u8>,
 }
@@ -57,7 +71,12 @@ impl Shared {
     pub(crate) fn new(core: Core, sockets: Sockets) -> io::Result<Arc<Self>> {
         let wake = rustix::event::eventfd(0, EventfdFlags::CLOEXEC | EventfdFlags::NONBLOCK)?;
         Ok(Arc::new(Self {
-            state: Mutex::new(State { core, readers: HashMap::new(), buf: vec![0; MAX_DATAGRAM] }),
+            state: Mutex::new(State {
+                core,
+                readers: HashMap::new(),
+                incompatible: HashMap::new(),
+                buf: vec![0; MAX_DATAGRAM],
+            }),
             sockets,
             wake,
             armed_ns: AtomicU64::new(u64::MAX),
@@ -104,15 +123,28 @@ impl Shared {
             st.core.recycle(b);
         }
         while let Some(e) = st.core.poll_event() {
-            if let Event::Sample(sample) = e {
-                match st.readers.get(&sample.info.reader) {
+            match e {
+                Event::Sample(sample) => match st.readers.get(&sample.info.reader) {
                     Some(slot) => {
                         if let Some(replaced) = slot.push(sample) {
                             st.core.recycle(replaced);
                         }
                     }
                     None => st.core.recycle(sample.payload),
+                },
+                Event::Incompatible { local, remote, reason } => {
+                    let list = st.incompatible.entry(local).or_default();
+                    let remote = remote.to_bytes();
+                    list.retain(|i| i.remote != remote);
+                    if list.len() < INCOMPATIBLE_KEPT {
+                        list.push(Incompatible { remote, reason: reason.to_string() });
+                    }
                 }
+                Event::Matched { remote, .. } | Event::EndpointLost { guid: remote } => {
+                    let remote = remote.to_bytes();
+                    st.incompatible.values_mut().for_each(|l| l.retain(|i| i.remote != remote));
+                }
+                _ => {}
             }
         }
     }

@@ -13,6 +13,7 @@ mod sample;
 mod sockets;
 mod writer;
 
+pub use driver::Incompatible;
 pub use error::DdsError;
 pub use participant::{DiscoveredEndpoint, DiscoveredParticipant, DiscoveredTopic, Participant, ParticipantOptions};
 pub use reader::Reader;

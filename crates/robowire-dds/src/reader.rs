@@ -157,6 +157,12 @@ impl<T: CdrType + 'static> Reader<T> {
         self.shared.lock().core.matched_writers(self.id).count()
     }
 
+    /// Writers on this topic that cannot match this reader (another type, or QoS that do not
+    /// match: a best-effort writer and this reliable reader, say), with the reason.
+    pub fn incompatible_writers(&self) -> Vec<crate::Incompatible> {
+        self.shared.lock().incompatible.get(&self.id).cloned().unwrap_or_default()
+    }
+
     /// Why the last rejected sample was rejected (the codec's words).
     pub fn last_error(&self) -> Option<&str> {
         self.last_error.as_deref()
@@ -184,6 +190,7 @@ impl<T: CdrType + 'static> Drop for Reader<T> {
         let now = robowire_rt::now();
         let mut st = self.shared.lock();
         st.readers.remove(&self.id);
+        st.incompatible.remove(&self.id);
         st.core.delete_endpoint(now, self.id);
         self.shared.settle(&mut st, now);
     }

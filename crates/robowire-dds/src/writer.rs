@@ -202,6 +202,12 @@ impl<T: CdrType + 'static> Writer<T> {
         self.shared.lock().core.matched_readers(self.id).any(|g| g.to_bytes() == reader)
     }
 
+    /// Readers on this topic that cannot match this writer (another type, or QoS that do not
+    /// match), with the reason.
+    pub fn incompatible_readers(&self) -> Vec<crate::Incompatible> {
+        self.shared.lock().incompatible.get(&self.id).cloned().unwrap_or_default()
+    }
+
     /// The topic.
     pub fn topic(&self) -> &str {
         &self.topic
@@ -231,6 +237,7 @@ impl<T: CdrType + 'static> Drop for Writer<T> {
     fn drop(&mut self) {
         let now = robowire_rt::now();
         let mut st = self.shared.lock();
+        st.incompatible.remove(&self.id);
         st.core.delete_endpoint(now, self.id);
         self.shared.settle(&mut st, now);
     }

@@ -793,6 +793,11 @@ fn best_effort_fastdds_writer_and_reliable_robowire_reader_do_not_match() {
         assert!(recv(&rt, &mut reader, Duration::from_secs(1)).is_none(), "a sample crossed a QoS mismatch");
         assert_eq!(reader.matched_writers(), 0);
         assert_eq!(reader.stats().samples, 0);
+        // robowire says why, naming the writer.
+        let why = reader.incompatible_writers();
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert_eq!(&why[0].remote[..12], &hex_prefix(&prefix)[..], "{why:?}");
+        assert!(why[0].reason.contains("reliab"), "{why:?}");
         let summary = peer.leave();
         assert_eq!(int(&summary["publication_matched"]), 0, "{summary}");
         assert!(int(&summary["offered_incompatible_qos"]) >= 1, "{summary}");
@@ -852,4 +857,9 @@ fn fastdds_leaves_and_comes_back() {
         assert_eq!(reader.stats().checksum_errors, 0);
         second.leave();
     });
+}
+
+/// A GUID prefix from its hex (as the peer prints it).
+fn hex_prefix(hex: &str) -> Vec<u8> {
+    (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect()
 }

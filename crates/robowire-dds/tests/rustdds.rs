@@ -638,6 +638,10 @@ fn a_reliable_reader_and_a_best_effort_writer_do_not_match() {
             }
             assert_eq!(state_writer.matched_readers(), 0);
             assert_eq!(cmd_reader.matched_writers(), 0);
+            // robowire says why, for each side.
+            for why in [state_writer.incompatible_readers(), cmd_reader.incompatible_writers()] {
+                assert!(why.len() == 1 && why[0].reason.contains("reliab"), "{why:?}");
+            }
             assert_eq!(take(&state_reader), None, "nothing delivered");
             assert!(cmd_reader.recv().now_or_never().is_none(), "nothing delivered");
         })

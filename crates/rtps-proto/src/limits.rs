@@ -26,6 +26,10 @@ pub struct Limits {
     pub reassemblies: usize,
     /// Bytes of one sample reassembled from fragments; a larger `sampleSize` is refused.
     pub reassembly_bytes: usize,
+    /// Bytes in reassembly at once, all readers and writers together: a reassembly's buffer
+    /// is its announced sample size, so this bounds what any number of small DATA_FRAGs can
+    /// make the participant hold.
+    pub reassembly_bytes_total: usize,
     /// How long an incomplete sample waits for its missing fragments.
     pub reassembly_timeout: Duration,
     /// Samples a writer's history or a reader's queue may hold (KEEP_LAST depth, KEEP_ALL bound).
@@ -47,6 +51,7 @@ impl Default for Limits {
             parameter_bytes: 16 * 1024,
             reassemblies: 8,
             reassembly_bytes: 1024 * 1024,
+            reassembly_bytes_total: 8 * 1024 * 1024,
             reassembly_timeout: Duration::from_secs(2),
             history_depth: 1024,
             sample_bytes: 1024 * 1024,

@@ -181,3 +181,51 @@ fn a_fragmented_sample_larger_than_the_limit_is_refused_before_any_allocation() 
     assert!(PEAK.load(Ordering::Relaxed) - baseline < 64 * 1024);
     assert_eq!(ours.reader_counters(r).unwrap().refused_fragments, 1);
 }
+
+/// A DATA_FRAG of fragment 1 from `writer` (of participant `prefix`) to `reader`, sample `sn`,
+/// announcing a sample of `size` bytes in 1024-byte fragments.
+fn small_frag(prefix: [u8; 12], reader: [u8; 4], writer: [u8; 4], sn: u32, size: u32) -> Vec<u8> {
+    let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
+    d.extend(prefix);
+    let mut body = vec![0, 0, 28, 0];
+    body.extend(reader);
+    body.extend(writer);
+    body.extend(0u32.to_le_bytes());
+    body.extend(sn.to_le_bytes());
+    body.extend(1u32.to_le_bytes());
+    body.extend(1u16.to_le_bytes());
+    body.extend(1024u16.to_le_bytes());
+    body.extend(size.to_le_bytes());
+    body.extend([0u8; 1024]);
+    d.extend([0x16, 0x01]);
+    d.extend((body.len() as u16).to_le_bytes());
+    d.extend(body);
+    d
+}
+
+#[test]
+fn small_fragments_of_many_writers_hold_no_more_than_the_reassembly_budget() {
+    let now = Time::from_nanos(1_000_000_000);
+    let mut ours = Participant::new(config(1), now);
+    let mut peer = Participant::new(config(2), now);
+    let readers: Vec<_> =
+        (0..4).map(|i| ours.create_reader(now, &format!("t{i}"), "T", Qos::default()).unwrap()).collect();
+    let writers: Vec<_> =
+        (0..4).map(|i| peer.create_writer(now, &format!("t{i}"), "T", Qos::default()).unwrap()).collect();
+    exchange(now, &mut ours, &mut peer);
+    let source: SocketAddr = "127.0.0.1:7420".parse().unwrap();
+    let baseline = LIVE.load(Ordering::Relaxed);
+    PEAK.store(baseline, Ordering::Relaxed);
+    // 4 writers × 8 samples in reassembly × 1 MiB each would be 32 MiB.
+    for (r, w) in readers.iter().zip(&writers) {
+        for sn in 1..=8 {
+            let d = small_frag([2; 12], r.0, w.0, sn, 1024 * 1024);
+            ours.handle_datagram(now, source, Destination::Unicast, &d);
+        }
+    }
+    let peak = PEAK.load(Ordering::Relaxed) - baseline;
+    let budget = rtps_proto::Limits::default().reassembly_bytes_total;
+    assert!(peak <= budget + 256 * 1024, "{peak} bytes held, the budget is {budget}");
+    let dropped: u64 = readers.iter().map(|r| ours.reader_counters(*r).unwrap().dropped_at_limit).sum();
+    assert_eq!(dropped, 32 - 8, "what exceeds the budget is dropped and counted");
+}

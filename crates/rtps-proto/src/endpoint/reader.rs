@@ -45,6 +45,9 @@ pub(crate) struct WriterProxy {
     next: SequenceNumber,
     /// Whether anything (a sample, a heartbeat) came from the writer yet.
     started: bool,
+    /// The base of the ACKNACK sent before anything came (a pre-emptive one, asking for a
+    /// heartbeat): 0 for Fast DDS (the only base its writers answer at once), else 1.
+    preemptive_base: i64,
     /// The highest number the writer said it has.
     available: SequenceNumber,
     pending: BTreeMap<SequenceNumber, Pending>,
@@ -60,11 +63,12 @@ pub(crate) struct WriterProxy {
 }
 
 impl WriterProxy {
-    pub(crate) fn new(guid: Guid, reliable: bool, locators: Vec<Locator>) -> Self {
+    pub(crate) fn new(guid: Guid, reliable: bool, locators: Vec<Locator>, preemptive_base: i64) -> Self {
         Self {
             guid,
             reliable,
             locators,
+            preemptive_base,
             next: SequenceNumber::FIRST,
             started: false,
             available: SequenceNumber(0),
@@ -79,9 +83,21 @@ impl WriterProxy {
         }
     }
 
-    /// The ACKNACK's set: base = next expected, members = what is missing up to what the writer
-    /// has (at most 256 numbers).
-    pub(crate) fn acknack_state(&self) -> SequenceNumberSet {
+    /// The ACKNACK to send: its set and its final flag. Before anything came from the writer, a
+    /// pre-emptive one (empty, not final: the writer answers with a heartbeat); else base = next
+    /// expected, members = what is missing up to what the writer has (at most 256 numbers),
+    /// final when nothing is.
+    pub(crate) fn acknack(&self) -> (SequenceNumberSet, bool) {
+        if !self.started {
+            if let Ok(set) = SequenceNumberSet::new(SequenceNumber(self.preemptive_base), 0) {
+                return (set, false);
+            }
+        }
+        let set = self.acknack_state();
+        (set, set.is_empty())
+    }
+
+    fn acknack_state(&self) -> SequenceNumberSet {
         let base = self.next;
         let span = self.available.0.saturating_sub(base.0).saturating_add(1).clamp(0, 256);
         let mut set = SequenceNumberSet::new(base, span as u32)
@@ -144,13 +160,19 @@ impl Reader {
         Self { id, config, writers: Vec::new(), counters: ReaderCounters::default(), spare: Vec::new() }
     }
 
-    pub(crate) fn add_writer(&mut self, proxy: WriterProxy) -> bool {
+    /// Matches a writer; a reliable one is sent a pre-emptive ACKNACK at once, so that it
+    /// answers with a heartbeat (and a late joiner's history comes) without waiting for its
+    /// period.
+    pub(crate) fn add_writer(&mut self, mut proxy: WriterProxy, now: Time) -> bool {
         if let Some(w) = self.writers.iter_mut().find(|w| w.guid == proxy.guid) {
             w.locators = proxy.locators;
             return true;
         }
         if self.writers.len() >= self.config.max_writers {
             return false;
+        }
+        if proxy.reliable {
+            proxy.ack_due = Some(now);
         }
         self.writers.push(proxy);
         true
@@ -247,13 +269,21 @@ impl Reader {
         }
     }
 
-    /// A DATA_FRAG from matched writer `w`; delivers the sample once complete.
+    /// Bytes held in reassembly.
+    pub(crate) fn reassembly_bytes(&self) -> usize {
+        self.writers.iter().flat_map(|w| &w.reassembly).map(Reassembly::bytes).sum()
+    }
+
+    /// A DATA_FRAG from matched writer `w`; delivers the sample once complete. A new
+    /// reassembly takes its sample size from `budget` (the participant's bytes left for
+    /// reassembly), and is refused when that is not enough.
     pub(crate) fn handle_data_frag(
         &mut self,
         now: Time,
         w: usize,
         info: SampleInfo,
         frag: &DataFrag<'_>,
+        budget: &mut usize,
         deliver: &mut dyn FnMut(&SampleInfo, &[u8]),
     ) -> Delivery {
         let Some(proxy) = self.writers.get(w) else { return Delivery::Dropped };
@@ -266,7 +296,10 @@ impl Reader {
         let index = match index {
             Some(i) => i,
             None => {
-                if proxy.reassembly.len() >= self.config.reassemblies {
+                let size = usize::try_from(frag.sample_size).unwrap_or(usize::MAX);
+                if proxy.reassembly.len() >= self.config.reassemblies
+                    || (size <= self.config.reassembly_bytes && size > *budget)
+                {
                     self.counters.dropped_at_limit += 1;
                     return Delivery::Dropped;
                 }
@@ -275,6 +308,7 @@ impl Reader {
                 match Reassembly::new(frag, self.config.reassembly_bytes, expires, buffer) {
                     Ok(r) => {
                         let Some(proxy) = self.writers.get_mut(w) else { return Delivery::Dropped };
+                        *budget = budget.saturating_sub(r.bytes());
                         proxy.reassembly.push(r);
                         proxy.reassembly.len() - 1
                     }

@@ -59,6 +59,11 @@ impl Reassembly {
         })
     }
 
+    /// Bytes its buffer holds (the announced sample size).
+    pub fn bytes(&self) -> usize {
+        self.data.len()
+    }
+
     /// The sample's number.
     pub fn sequence(&self) -> SequenceNumber {
         self.sequence

@@ -112,8 +112,10 @@ impl Participant {
                 Submessage::DataFrag(f) => {
                     let q = InlineQos::parse(f.inline_qos.as_ref());
                     let info = info(Guid::new(source_prefix, f.writer_id), f.writer_sn, timestamp, q);
+                    let used: usize = self.readers.iter().map(|r| r.reassembly_bytes()).sum();
+                    let mut budget = self.config.limits.reassembly_bytes_total.saturating_sub(used);
                     self.route(now, f.reader_id, info, |r, w, info, deliver| {
-                        r.handle_data_frag(now, w, info, &f, deliver)
+                        r.handle_data_frag(now, w, info, &f, &mut budget, deliver)
                     });
                 }
                 Submessage::Heartbeat(hb) => {

@@ -393,13 +393,13 @@ impl Participant {
         let proxy = reader.writers.iter_mut().find(|p| p.ack_due.is_some_and(|t| t <= now))?;
         proxy.ack_due = None;
         proxy.acknack_count = proxy.acknack_count.wrapping_add(1).max(1);
-        let state = proxy.acknack_state();
+        let (state, final_flag) = proxy.acknack();
         let acknack = AckNack {
             reader_id: id,
             writer_id: proxy.guid.entity,
             reader_sn_state: state,
             count: proxy.acknack_count,
-            final_flag: state.is_empty(),
+            final_flag,
         };
         let mut m = MessageWriter::new(buf, &header).ok()?;
         m.push(&Submessage::InfoDst(InfoDst { guid_prefix: proxy.guid.prefix })).ok()?;
