@@ -17,6 +17,7 @@ const BENCHES: &[(&str, &str)] = &[
     ("kmc-proto", "codec"),
     ("kmc", "serial"),
     ("lowcmd-proto", "lowcmd"),
+    ("rtps-proto", "rtps"),
     ("zsl", "spline"),
     ("zsl", "udp"),
     ("robowire", "streams"),
@@ -146,6 +147,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     )?);
 
     rows.extend(crate::bench_lowcmd::rows(&criterion)?);
+    rows.extend(crate::bench_rtps::rows(&criterion)?);
     let spline: Value =
         serde_json::from_str(&std::fs::read_to_string(&spline_meta_path).context("spline bench metadata")?)?;
     rows.extend(spline_rows(&spline)?);

@@ -64,6 +64,7 @@ pub const TARGETS: &[Target] = &[
         check: lowcmd_proto::decode_roundtrip::api_decode,
     },
     Target { name: "rtps_message_parse", seeds: rtps_seeds, check: rtps_proto::fuzzing::parse_all },
+    Target { name: "rtps_participant", seeds: rtps_participant_seeds, check: rtps_proto::fuzzing::participant },
 ];
 
 /// RTPS seeds: the six hostile datagrams of the DDS flood test (`one_datagram_each` in
@@ -164,6 +165,82 @@ fn rtps_seeds() -> Seeds {
     let len = message.finish();
     buf.truncate(len);
     seeds.push(("seed-reliable-exchange".to_string(), buf));
+    Ok(seeds)
+}
+
+/// Participant seeds (steps of `rtps_proto::fuzzing::Step`, after the peer's discovery): each
+/// of the six hostile datagrams of [`rtps_seeds`] sent from the discovered peer, then polled and
+/// timed out; all six in a row; a normal exchange (a local write acknowledged, a sample
+/// received, a fragmented write nacked, a fragmented sample received) over a clock; and the
+/// discovery datagrams replayed one by one (no automatic feed, endpoints created after it).
+fn rtps_participant_seeds() -> Seeds {
+    use rtps_proto::fuzzing::{PEER_PREFIX, ParticipantSetup, Step, encode_steps};
+
+    let hostile: Vec<(String, Vec<u8>)> = rtps_seeds()?
+        .into_iter()
+        .take(6)
+        .map(|(name, mut d)| {
+            d[8..20].copy_from_slice(&PEER_PREFIX.0);
+            (name, d)
+        })
+        .collect();
+    let after = [Step::Poll, Step::Clock { ms: 1000 }, Step::Poll, Step::Clock { ms: 3000 }, Step::Poll];
+    let mut seeds: Vec<(String, Vec<u8>)> = hostile
+        .iter()
+        .map(|(name, d)| {
+            let mut steps = vec![Step::Poll, Step::Raw(d)];
+            steps.extend(after);
+            (name.replacen("seed-", "seed-hostile-", 1), encode_steps(0, &steps))
+        })
+        .collect();
+    let mut all: Vec<Step<'_>> = hostile.iter().map(|(_, d)| Step::Raw(d)).collect();
+    all.extend(after);
+    seeds.push(("seed-hostile-all-six".to_string(), encode_steps(0, &all)));
+
+    let words = [0u32; 8];
+    let exchange = [
+        Step::Poll,
+        Step::Write { len: 8 },
+        Step::Poll,
+        Step::AckNack { wrap: 0, from: 0, to: 0, base: 2, bits: 0, words, count: 1, final_flag: true },
+        Step::Data { wrap: 4, to: 0, from: 0, sn: 1, len: 8, flags: 0 },
+        Step::Heartbeat { wrap: 0, to: 0, from: 0, first: 1, last: 2, count: 1, flags: 0 },
+        Step::Poll,
+        Step::Data { wrap: 0, to: 0, from: 0, sn: 2, len: 8, flags: 0 },
+        Step::Write { len: 3000 },
+        Step::Poll,
+        Step::NackFrag { wrap: 0, from: 0, to: 0, sn: 2, base: 2, bits: 1, words: [1, 0, 0, 0, 0, 0, 0, 0], count: 1 },
+        Step::AckNack {
+            wrap: 0,
+            from: 0,
+            to: 0,
+            base: 2,
+            bits: 1,
+            words: [1 << 31, 0, 0, 0, 0, 0, 0, 0],
+            count: 2,
+            final_flag: false,
+        },
+        Step::Clock { ms: 100 },
+        Step::Poll,
+        Step::DataFrag { wrap: 0, to: 0, from: 0, sn: 3, start: 1, count: 2, size: 1024, sample: 3000, len: 0 },
+        Step::HeartbeatFrag { wrap: 0, to: 0, from: 0, sn: 3, last: 2, count: 1 },
+        Step::Heartbeat { wrap: 0, to: 0, from: 0, first: 1, last: 3, count: 2, flags: 0 },
+        Step::Poll,
+        Step::DataFrag { wrap: 0, to: 0, from: 0, sn: 3, start: 3, count: 1, size: 1024, sample: 3000, len: 0 },
+        Step::Gap { wrap: 0, to: 0, from: 0, start: 4, base: 6, bits: 0, words },
+        Step::Poll,
+        Step::Clock { ms: 3000 },
+        Step::Poll,
+        Step::Clock { ms: 10_000 },
+        Step::Clock { ms: 10_000 },
+        Step::Poll,
+    ];
+    seeds.push(("seed-exchange".to_string(), encode_steps(0, &exchange)));
+    let setup = ParticipantSetup::new();
+    let mut discovery: Vec<Step<'_>> =
+        (0..setup.discovery.len()).map(|i| Step::Discovery { index: i as u8, patches: [(0, 0); 2] }).collect();
+    discovery.extend([Step::Poll, Step::Write { len: 8 }, Step::Poll]);
+    seeds.push(("seed-discovery-steps".to_string(), encode_steps(3, &discovery)));
     Ok(seeds)
 }
 

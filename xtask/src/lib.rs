@@ -6,6 +6,7 @@ pub mod architecture;
 pub mod bench;
 mod bench_apps;
 mod bench_lowcmd;
+mod bench_rtps;
 pub mod fuzz;
 pub mod golden;
 pub mod physics;
