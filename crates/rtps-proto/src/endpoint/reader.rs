@@ -88,10 +88,10 @@ impl WriterProxy {
     /// expected, members = what is missing up to what the writer has (at most 256 numbers),
     /// final when nothing is.
     pub(crate) fn acknack(&self) -> (SequenceNumberSet, bool) {
-        if !self.started {
-            if let Ok(set) = SequenceNumberSet::new(SequenceNumber(self.preemptive_base), 0) {
-                return (set, false);
-            }
+        if !self.started
+            && let Ok(set) = SequenceNumberSet::new(SequenceNumber(self.preemptive_base), 0)
+        {
+            return (set, false);
         }
         let set = self.acknack_state();
         (set, set.is_empty())
