@@ -189,10 +189,11 @@ impl Participant {
     ) -> Result<Writer<T>, DdsError> {
         let now = robowire_rt::now();
         let mut st = self.shared.lock();
-        let id = st
-            .core
-            .create_writer(now, name, type_name, qos.to_rtps())
-            .map_err(|source| DdsError::Create { what: "writer", topic: name.into(), source })?;
+        let id = st.core.create_writer(now, name, type_name, qos.to_rtps()).map_err(|source| DdsError::Create {
+            what: "writer",
+            topic: name.into(),
+            source,
+        })?;
         let guid = Guid::new(st.core.guid_prefix(), id).to_bytes();
         self.shared.settle(&mut st, now);
         Ok(Writer::new(self.shared.clone(), id, guid, name))
@@ -219,10 +220,11 @@ impl Participant {
         let counters = Arc::new(Counters::default());
         let slot = Arc::new(ReaderSlot::new(usize::try_from(qos.depth).unwrap_or(1), counters.clone()));
         let mut st = self.shared.lock();
-        let id = st
-            .core
-            .create_reader(now, name, type_name, qos.to_rtps())
-            .map_err(|source| DdsError::Create { what: "reader", topic: name.into(), source })?;
+        let id = st.core.create_reader(now, name, type_name, qos.to_rtps()).map_err(|source| DdsError::Create {
+            what: "reader",
+            topic: name.into(),
+            source,
+        })?;
         st.readers.insert(id, slot.clone());
         let guid = Guid::new(st.core.guid_prefix(), id).to_bytes();
         self.shared.settle(&mut st, now);

@@ -47,7 +47,9 @@ impl Qos {
     pub(crate) fn to_rtps(self) -> rtps_proto::discovery::Qos {
         let reliability = if self.reliable {
             let ms = u64::try_from(self.max_blocking_ms).unwrap_or(0);
-            Reliability::Reliable { max_blocking_time: DdsDuration::from_duration(std::time::Duration::from_millis(ms)) }
+            Reliability::Reliable {
+                max_blocking_time: DdsDuration::from_duration(std::time::Duration::from_millis(ms)),
+            }
         } else {
             Reliability::BestEffort
         };

@@ -151,7 +151,8 @@ pub(crate) fn decode<T: CdrType>(payload: &[u8]) -> Result<T, DecodeFailure> {
     // The options' last two bits: padding bytes after the body (XTypes 7.6.3.1.2).
     let padding = usize::from(payload[3] & 3);
     let body = &payload[4..payload.len().saturating_sub(padding).max(4)];
-    T::decode_body(encoding, body).map_err(|e| DecodeFailure { checksum: T::is_checksum_error(&e), reason: e.to_string() })
+    T::decode_body(encoding, body)
+        .map_err(|e| DecodeFailure { checksum: T::is_checksum_error(&e), reason: e.to_string() })
 }
 
 /// `value`'s payload: `T`'s encapsulation header and its body, padded with zeros to a multiple
@@ -188,7 +189,8 @@ pub fn fuzz_check_sample<T: CdrType + std::fmt::Debug>(payload: &[u8]) -> Option
         Ok(value) => {
             let mut sent = Vec::new();
             encode(&value, &mut sent).expect("a message read encodes");
-            let again = decode::<T>(&sent).unwrap_or_else(|e| panic!("{value:?} sent does not read back: {}", e.reason));
+            let again =
+                decode::<T>(&sent).unwrap_or_else(|e| panic!("{value:?} sent does not read back: {}", e.reason));
             let mut resent = Vec::new();
             encode(&again, &mut resent).expect("a message read encodes");
             assert_eq!(resent, sent, "a message read back is the message sent");

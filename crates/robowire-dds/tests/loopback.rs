@@ -240,7 +240,8 @@ fn a_related_sample_identity_and_the_sequence_number_cross() {
 fn participant_user_data_is_announced_and_a_leaving_participant_is_forgotten_at_once() {
     with_loopback_multicast(|| {
         let options = ParticipantOptions::new(0, Some("lo"));
-        let ros = Participant::new(ParticipantOptions { user_data: b"enclave=/;".to_vec(), ..options.clone() }).unwrap();
+        let ros =
+            Participant::new(ParticipantOptions { user_data: b"enclave=/;".to_vec(), ..options.clone() }).unwrap();
         let observer = Participant::new(options).unwrap();
         let ros_prefix: [u8; 12] = ros.guid()[..12].try_into().unwrap();
         let began = std::time::Instant::now();
