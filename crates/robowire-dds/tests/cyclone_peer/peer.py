@@ -277,10 +277,19 @@ def stream(qos_name, count, hg=False):
 def late_writer(count):
     count = int(count)
     dp = participant()
+    # CycloneDDS keeps for late joiners what DURABILITY_SERVICE's history says (keep last 1 by
+    # default), not HISTORY's.
     qos = Qos(
         Policy.Reliability.Reliable(max_blocking_time=100_000_000),
         Policy.Durability.TransientLocal,
         Policy.History.KeepLast(count),
+        Policy.DurabilityService(
+            cleanup_delay=0,
+            history=Policy.History.KeepLast(count),
+            max_samples=-1,
+            max_instances=-1,
+            max_samples_per_instance=-1,
+        ),
     )
     writer = DataWriter(dp, Topic(dp, "rt/lowstate", LowState_), qos=qos)
     for tick in range(1, count + 1):
