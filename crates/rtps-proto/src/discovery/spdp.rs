@@ -51,16 +51,16 @@ impl BuiltinEndpointSet {
     /// SEDP topics reader.
     pub const TOPICS_DETECTOR: u32 = 1 << 29;
 
-    /// What robowire's participant has: SPDP, SEDP publications and subscriptions, WLP.
+    /// What robowire's participant has: SPDP, SEDP publications and subscriptions. Not WLP: a
+    /// participant message reader announced but never served makes CycloneDDS heartbeat it
+    /// forever, and a writer announced, ACKNACK it every second.
     pub const ROBOWIRE: Self = Self(
         Self::PARTICIPANT_ANNOUNCER
             | Self::PARTICIPANT_DETECTOR
             | Self::PUBLICATIONS_ANNOUNCER
             | Self::PUBLICATIONS_DETECTOR
             | Self::SUBSCRIPTIONS_ANNOUNCER
-            | Self::SUBSCRIPTIONS_DETECTOR
-            | Self::PARTICIPANT_MESSAGE_DATA_WRITER
-            | Self::PARTICIPANT_MESSAGE_DATA_READER,
+            | Self::SUBSCRIPTIONS_DETECTOR,
     );
 
     /// Whether every bit of `bits` is set.
