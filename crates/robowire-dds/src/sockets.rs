@@ -88,7 +88,7 @@ impl Sockets {
             let _ = sender.set_send_buffer_size(1 << 20);
             return Ok(Self { spdp, meta, user, addresses, participant_id: id, domain });
         }
-        Err(last.unwrap_or_else(|| invalid()))
+        Err(last.unwrap_or_else(invalid))
     }
 
     fn ports(&self) -> (u16, u16) {

@@ -509,7 +509,7 @@ impl Participant {
         options: &WriteOptions,
         buf: &mut [u8],
     ) -> Result<Written, WriteError> {
-        if payload.len() % 4 != 0 {
+        if !payload.len().is_multiple_of(4) {
             return Err(WriteError::Unaligned { len: payload.len() });
         }
         if payload.len() > self.config.limits.sample_bytes {
