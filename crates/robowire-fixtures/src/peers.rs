@@ -2,8 +2,9 @@
 //! (`../shared/peers/`, see its README): a CPython 3.10 environment with `cyclonedds` 0.10.2
 //! (Unitree's pin; its wheel bundles a libddsc of its own that names itself 0.11.0:
 //! `libddsc-….so.0.11.0`, "0.11.0" in its SPDP version info), numpy, mcap, mcap-ros2-support and
-//! rosbags (the capture readers) and Unitree's Python SDK installed as its README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
-//! tree stays untouched); and a second one with CycloneDDS 11 ([`cyclonedds11_python`]).
+//! rosbags (the capture readers) and Unitree's Python SDK installed as its README says
+//! (`pip install --no-deps -e`, from a copy under `target/` so that the peers' tree stays
+//! untouched); and a second one with CycloneDDS 11 ([`cyclonedds11_python`]).
 //!
 //! Made once per `target/` directory, under a file lock (tests run in parallel), and reused. When
 //! it cannot be made (no peers, no CPython 3.10, no PyPI on the first run) the error says what is
