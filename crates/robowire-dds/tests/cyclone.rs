@@ -297,6 +297,24 @@ fn discovery(python: &Path) {
     });
 }
 
+/// From now on, one UDP datagram in five that arrives in this private network is dropped
+/// (nftables' random number per packet): every repair path of a reliable writer and reader
+/// (HEARTBEAT, ACKNACK, NACK_FRAG, retransmissions, GAP) has work.
+fn lossy() {
+    const RULES: &str = "table inet robowire_loss {
+        chain input { type filter hook input priority 0; meta l4proto udp numgen random mod 5 0 drop; }
+    }";
+    let mut nft = Command::new("nft")
+        .args(["-f", "-"])
+        .stdin(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("nftables' nft");
+    nft.stdin.take().unwrap().write_all(RULES.as_bytes()).unwrap();
+    let out = nft.wait_with_output().unwrap();
+    assert!(out.status.success(), "nft: {}", String::from_utf8_lossy(&out.stderr));
+}
+
 // ---------------------------------------------------------------------------------------------
 // 2 and 3. Streams both ways: Go2 best effort and reliable, HG LowState fragmented.
 
@@ -310,6 +328,8 @@ struct Exchange<Out: Message + CdrType + 'static, In: Message + CdrType + 'stati
     tag: fn(&In) -> u32,
     count: u32,
     reliable: bool,
+    /// Drop one UDP datagram in five once both sides have matched ([`lossy`]).
+    loss: bool,
 }
 
 /// What each side received: (ours, the peer's summary).
@@ -332,6 +352,9 @@ fn exchange<Out: Message + CdrType + 'static, In: Message + CdrType + 'static>(
     until("our writer and reader matched to Cyclone's", || {
         writer.reader_matched(their_reader) && reader.matched_writers() == 1
     });
+    if x.loss {
+        lossy();
+    }
     peer.say("go");
     for tag in 1..=x.count {
         writer.write((x.out)(tag)).unwrap();
@@ -366,12 +389,21 @@ fn go2_exchange(reliable: bool) -> Exchange<LowCmd, LowState> {
         tag: |s| s.tick.get(),
         count: COUNT,
         reliable,
+        loss: false,
     }
 }
 
 fn go2_reliable(python: &Path) {
+    go2_reliable_losing(python, false);
+}
+
+fn go2_reliable_under_loss(python: &Path) {
+    go2_reliable_losing(python, true);
+}
+
+fn go2_reliable_losing(python: &Path, loss: bool) {
     with_loopback_multicast(|| {
-        let (ours, theirs) = exchange(python, &go2_exchange(true));
+        let (ours, theirs) = exchange(python, &Exchange { loss, ..go2_exchange(true) });
         let every: Vec<u32> = (1..=COUNT).collect();
         assert_eq!(ours, every, "reliable: every LowState of Cyclone's, in order");
         assert_eq!(tags(&theirs["tags"]), every, "reliable: every LowCmd of ours, in order: {theirs}");
@@ -390,6 +422,14 @@ fn go2_best_effort(python: &Path) {
 }
 
 fn fragmented(python: &Path) {
+    fragmented_losing(python, false);
+}
+
+fn fragmented_under_loss(python: &Path) {
+    fragmented_losing(python, true);
+}
+
+fn fragmented_losing(python: &Path, loss: bool) {
     // Above CycloneDDS's and robowire's 1344-byte fragments: DATA_FRAG both ways.
     const { assert!(HgLowState::IMAGE_LEN + 4 > 1344) };
     with_loopback_multicast(|| {
@@ -401,6 +441,7 @@ fn fragmented(python: &Path) {
             tag: |s: &HgLowState| s.tick.get(),
             count: FRAGMENTED,
             reliable: true,
+            loss,
         };
         let (ours, theirs) = exchange(python, &x);
         let every: Vec<u32> = (1..=FRAGMENTED).collect();
@@ -580,7 +621,9 @@ on_each_cyclonedds!(
     discovery,
     go2_best_effort,
     go2_reliable,
+    go2_reliable_under_loss,
     fragmented,
+    fragmented_under_loss,
     transient_local,
     incompatible_qos,
     leave_and_return

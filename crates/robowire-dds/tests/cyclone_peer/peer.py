@@ -271,7 +271,7 @@ def stream(qos_name, count, hg=False):
             writer.wait_for_acks(2_000_000_000)
         except Exception:  # noqa: BLE001: best effort at leaving cleanly
             pass
-    wait_word("quit", deadline=10)
+    wait_word("quit")
 
 
 def late_writer(count):
