@@ -1,8 +1,10 @@
 //! The vendors' own software as the other end of the wire in interop tests
 //! (`../shared/peers/`, see its README): a CPython 3.10 environment with `cyclonedds` 0.10.2
-//! (Unitree's pin; its wheel bundles libddsc), numpy, mcap, mcap-ros2-support and rosbags (the capture readers) and Unitree's Python SDK installed as its
-//! README says (`pip install --no-deps -e`, from a copy under `target/` so that the peers'
-//! tree stays untouched).
+//! (Unitree's pin; its wheel bundles a libddsc of its own that names itself 0.11.0:
+//! `libddsc-….so.0.11.0`, "0.11.0" in its SPDP version info), numpy, mcap, mcap-ros2-support and
+//! rosbags (the capture readers) and Unitree's Python SDK installed as its README says
+//! (`pip install --no-deps -e`, from a copy under `target/` so that the peers' tree stays
+//! untouched); and a second one with CycloneDDS 11 ([`cyclonedds11_python`]).
 //!
 //! Made once per `target/` directory, under a file lock (tests run in parallel), and reused. When
 //! it cannot be made (no peers, no CPython 3.10, no PyPI on the first run) the error says what is
@@ -14,6 +16,9 @@ use std::process::Command;
 
 /// `cyclonedds` on PyPI: the version Unitree's SDK pins.
 pub const CYCLONEDDS_VERSION: &str = "0.10.2";
+/// `cyclonedds` on PyPI of CycloneDDS 11 (its wheel bundles libddsc 11.0.1; wheels for CPython
+/// 3.12 and 3.13 among others, none for 3.10), the second CycloneDDS of the interop tests.
+pub const CYCLONEDDS11_VERSION: &str = "11.0.1";
 /// The `mcap` Python package: the independent reader of robowire's captures.
 pub const MCAP_PY_VERSION: &str = "1.6.0";
 /// `mcap-ros2-support`: the `mcap` package's ROS 2 decoder (`ros2msg` schemas, CDR).
@@ -143,6 +148,47 @@ pub fn unitree_python() -> Result<PathBuf, String> {
             &format!("rosbags=={ROSBAGS_VERSION}"),
         ]),
     )?;
+    let copy = dir.join("unitree_sdk2_python");
+    let _ = std::fs::remove_dir_all(&copy);
+    copy_tree(&sdk, &copy).map_err(|e| format!("copying the SDK: {e}"))?;
+    run("pip install the SDK", pip(&["--no-deps", "-e"]).arg(&copy))?;
+    std::fs::write(&stamp, b"").map_err(|e| e.to_string())?;
+    Ok(python)
+}
+
+/// The Python of a second environment, `$CARGO_TARGET_DIR/interop-cyclone11/py`: CPython 3.12
+/// (else 3.13) with `cyclonedds` [`CYCLONEDDS11_VERSION`], numpy and Unitree's Python SDK
+/// (`--no-deps -e`, from a copy beside it: its IDL classes and CRC; its pin of cyclonedds 0.10.2
+/// is not followed). Made once, under a file lock, as [`unitree_python`].
+pub fn cyclonedds11_python() -> Result<PathBuf, String> {
+    let target = env_dir();
+    let dir = target.with_file_name("interop-cyclone11");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let lock = std::fs::File::create(dir.join(".lock")).map_err(|e| e.to_string())?;
+    lock.lock().map_err(|e| format!("locking {}: {e}", dir.display()))?;
+    let venv = dir.join("py");
+    let python = venv.join("bin/python");
+    let stamp = venv.join(".robowire-ready-1");
+    if stamp.exists() {
+        return Ok(python);
+    }
+    let sdk = peers_dir().join("unitree_sdk2_python");
+    if !sdk.join("setup.py").exists() {
+        return Err(format!("Unitree's Python SDK is not at {} (set ROBOWIRE_PEERS)", sdk.display()));
+    }
+    let interpreter = cpython("3.12").or_else(|| cpython("3.13")).ok_or_else(|| {
+        format!(
+            "no CPython 3.12 or 3.13 (cyclonedds {CYCLONEDDS11_VERSION} has no wheel for 3.10): install one with pyenv"
+        )
+    })?;
+    let _ = std::fs::remove_dir_all(&venv);
+    run("creating the venv", Command::new(interpreter).args(["-m", "venv"]).arg(&venv))?;
+    let pip = |args: &[&str]| {
+        let mut c = Command::new(&python);
+        c.args(["-m", "pip", "install", "-q", "--disable-pip-version-check"]).args(args);
+        c
+    };
+    run("pip install cyclonedds numpy", &mut pip(&[&format!("cyclonedds=={CYCLONEDDS11_VERSION}"), "numpy"]))?;
     let copy = dir.join("unitree_sdk2_python");
     let _ = std::fs::remove_dir_all(&copy);
     copy_tree(&sdk, &copy).map_err(|e| format!("copying the SDK: {e}"))?;

@@ -51,8 +51,10 @@ impl BuiltinEndpointSet {
     /// SEDP topics reader.
     pub const TOPICS_DETECTOR: u32 = 1 << 29;
 
-    /// What robowire's participant has: SPDP, SEDP publications and subscriptions (no WLP:
-    /// liveliness is the participant's lease).
+    /// What robowire's participant has: SPDP, SEDP publications and subscriptions. Not WLP
+    /// (liveliness is the participant's lease): a participant message reader announced but never
+    /// served makes CycloneDDS heartbeat it forever, and a writer announced, ACKNACK it every
+    /// second.
     pub const ROBOWIRE: Self = Self(
         Self::PARTICIPANT_ANNOUNCER
             | Self::PARTICIPANT_DETECTOR
