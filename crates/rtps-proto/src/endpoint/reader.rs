@@ -488,7 +488,7 @@ mod tests {
         };
         let writer = Guid::new(GuidPrefix([1; 12]), EntityId([0, 0, 1, 3]));
         let mut reader = Reader::new(EntityId([0, 0, 1, 4]), config);
-        assert!(reader.add_writer(WriterProxy::new(writer, true, Vec::new())));
+        assert!(reader.add_writer(WriterProxy::new(writer, true, Vec::new(), 1), Time::ZERO));
         let info = SampleInfo {
             reader: reader.id,
             writer,
@@ -501,7 +501,11 @@ mod tests {
         let mut delivered = Vec::new();
         let mut deliver = |_: &SampleInfo, p: &[u8]| delivered.push(p.to_vec());
         let now = Time::ZERO;
-        assert_eq!(reader.handle_data_frag(now, 0, info, &frag(1, 1, &[1, 2, 3, 4]), &mut deliver), Delivery::Fragment);
+        let mut budget = usize::MAX;
+        assert_eq!(
+            reader.handle_data_frag(now, 0, info, &frag(1, 1, &[1, 2, 3, 4]), &mut budget, &mut deliver),
+            Delivery::Fragment
+        );
         let hb = Heartbeat {
             reader_id: EntityId::UNKNOWN,
             writer_id: writer.entity,
@@ -514,7 +518,10 @@ mod tests {
         reader.handle_heartbeat(now, 0, &hb, &mut deliver);
         let (sn, set) = reader.writers[0].nack_frag.expect("a NACK_FRAG owed");
         assert_eq!((sn, set.base(), set.iter().collect::<Vec<_>>()), (SequenceNumber(1), 2, vec![2]));
-        assert_eq!(reader.handle_data_frag(now, 0, info, &frag(1, 2, &[5, 6]), &mut deliver), Delivery::Delivered);
+        assert_eq!(
+            reader.handle_data_frag(now, 0, info, &frag(1, 2, &[5, 6]), &mut budget, &mut deliver),
+            Delivery::Delivered
+        );
         assert_eq!(delivered, [vec![1, 2, 3, 4, 5, 6]]);
     }
 }
