@@ -25,7 +25,7 @@
 //!   ACKNACK that answers asks for at most 256 numbers, a GAP marks at most its 256 bits, a reader
 //!   holds at most its depth of early samples.
 //!
-//! The bit-flipped announcements make up about a thousand participants per flood: the first
+//! The bit-flipped announcements make up a few hundred participants per flood: the first
 //! `Limits::participants` fill the table and each later one displaces the participant heard from
 //! least recently (`LostReason::Displaced`), so a new client is served at once after the flood.
 //!
