@@ -9,7 +9,8 @@ use core::time::Duration;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct Limits {
-    /// Remote participants known at once; SPDP announcements of more are dropped.
+    /// Remote participants known at once; the SPDP announcement of one more displaces the one
+    /// heard from least recently.
     pub participants: usize,
     /// Remote endpoints (writers and readers) known per remote participant.
     pub endpoints_per_participant: usize,

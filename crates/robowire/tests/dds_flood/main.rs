@@ -2,17 +2,41 @@
 //! valid header, then submessages with random fields and lying lengths) and real discovery
 //! packets with bits flipped, sent as fast as the socket takes them to every UDP port a simulated
 //! Go2 (`robowire sim go2`) or `robowire ros2`'s participant has bound and to domain 0's multicast
-//! groups. Afterwards the Go2 still publishes `rt/lowstate` and stands up for a new client; the
-//! bridge still publishes `odom` and obeys `cmd_vel`; each ends successfully on Ctrl-C and said
-//! nothing of a panic.
+//! groups. Half the near-valid datagrams carry a captured GUID prefix: the program's own (which it
+//! drops) or that of this test's participant, which the program has discovered and serves when
+//! the flood begins. Afterwards the Go2 still publishes
+//! `rt/lowstate` and stands up for a new client; the bridge still publishes `odom` and obeys
+//! `cmd_vel`; each ends successfully on Ctrl-C and said nothing of a panic.
 //!
-//! rustdds 0.15.1, robowire's DDS before `rtps-proto`, trusts six fields of what any host on the
-//! network sends (see `datagrams::rustdds_0_15_1_trusts`): one datagram made it allocate
-//! gigabytes, loop for minutes or panic on its event-loop thread, and the participant went
-//! silent. The default flood redraws those datagrams (it was written for rustdds); two tests send
-//! them, one by one and drawn into the flood. The flooded programs run under an address-space
-//! limit ([`MEMORY_LIMIT_KB`]), so that such a bug fails the test instead of exhausting the
-//! machine's memory.
+//! Both programs run robowire's own RTPS core, `rtps-proto`. The six datagrams that broke
+//! rustdds 0.15.1, robowire's DDS before it (see `datagrams::rustdds_0_15_1_trusts`: one made a
+//! participant allocate gigabytes, loop for minutes or panic on its event-loop thread), are still
+//! drawn: the default flood redraws them, as it did for rustdds; one test floods with them drawn
+//! in, and one sends each alone as each participant. What `rtps-proto` does with each (checked
+//! without sockets in `crates/rtps-proto/tests/hostile.rs`):
+//!
+//! - the NACK_FRAG naming fragments past 2^32, the NACK_FRAG naming fragment 0 and the ACKNACK
+//!   whose set reaches past `i64::MAX`: refused by the wire layer, counted by kind
+//!   (`FragmentNumberSet`, `FragmentNumberZero`, `SequenceNumberSet` in `Counters::wire`);
+//! - the DATA_FRAG of a 4 GiB sample: from a matched writer, refused before anything is allocated
+//!   (`Limits::reassembly_bytes`, counted in the reader's `refused_fragments`); from the SPDP
+//!   writer, as here, taken by no reader (SPDP is never reassembled; `unmatched_source`);
+//! - the HEARTBEAT of 2^40 samples and the GAP up to 2^40: taken, and bounded by arithmetic: the
+//!   ACKNACK that answers asks for at most 256 numbers, a GAP marks at most its 256 bits, a reader
+//!   holds at most its depth of early samples.
+//!
+//! The bit-flipped announcements make up a few hundred participants per flood: the first
+//! `Limits::participants` fill the table and each later one displaces the participant heard from
+//! least recently (`LostReason::Displaced`), so a new client is served at once after the flood.
+//!
+//! Memory: the flooded programs run under an address-space limit ([`MEMORY_LIMIT_KB`]), so that
+//! an unbounded table fails the test instead of exhausting the machine's memory. Each program's
+//! resident memory (`VmRSS`) is read before the flood, its peak (`VmHWM`) reset, and both are
+//! read after the flood and after the checks: the peak may exceed the resident memory before the
+//! flood by at most [`growth_bound_kib`], what `rtps_proto::Limits::default()` lets the flood make
+//! the participant keep (about 27 MiB, 16 of them two SEDP readers' reassemblies). The programs do
+//! not show their participant's counters; this test's participant, the same core, takes domain
+//! 0's multicast share of the flood and prints what it refused, by kind.
 //!
 //! Forged discovery packets name random locators, which the participants then send to: each test
 //! runs only in a network namespace of its own (`robowire_dds::netns`), where they lead nowhere.
@@ -59,6 +83,8 @@ struct FloodReport {
     near_valid: u64,
     bit_flipped: u64,
     bytes: u64,
+    /// The longest datagram sent, bytes.
+    largest: usize,
     /// Datagrams drawn again because rustdds 0.15.1 trusts a field of theirs, by field.
     redrawn: BTreeMap<&'static str, u64>,
     /// Sends the socket refused, by error.
@@ -94,6 +120,7 @@ fn flood(socket: &UdpSocket, targets: &[SocketAddrV4], captured: &[Vec<u8>], tru
             kind = draw(&mut rng, captured, &prefixes, &mut datagram);
         }
         *[&mut report.garbage, &mut report.near_valid, &mut report.bit_flipped][kind] += 1;
+        report.largest = report.largest.max(datagram.len());
         match socket.send_to(&datagram, rng.pick(targets)) {
             Ok(n) => report.bytes += n as u64,
             Err(e) => *report.refused.entry(e.kind().to_string()).or_default() += 1,
@@ -124,12 +151,17 @@ struct Discovery {
     datagrams: Vec<Vec<u8>>,
     /// The two GUID prefixes.
     prefixes: Vec<[u8; 12]>,
-    /// This test's participant, still there.
+    /// This test's participant, still there: the flood speaks as it to the program, which knows
+    /// it (its GUID prefix is in the captured datagrams).
     other: Participant,
+    /// The unicast ports `other` bound, which the flood spares.
+    other_ports: BTreeSet<u16>,
 }
 
 fn capture_discovery(listener: &UdpSocket) -> Discovery {
+    let bound = bound_udp_ports();
     let other = participant();
+    let other_ports = bound_udp_ports().difference(&bound).copied().collect();
     let (mut datagrams, mut announced) = (Vec::new(), BTreeSet::new());
     let mut buf = vec![0; 65_536];
     let start = Instant::now();
@@ -144,7 +176,36 @@ fn capture_discovery(listener: &UdpSocket) -> Discovery {
             datagrams.push(datagram.to_vec());
         }
     }
-    Discovery { datagrams, prefixes: announced.into_iter().collect(), other }
+    Discovery { datagrams, prefixes: announced.into_iter().collect(), other, other_ports }
+}
+
+/// How many participants the flood speaks as (the GUID prefixes of `captured`) that the flooded
+/// program takes datagrams from: all but its own.
+fn spoofed(captured: &[Vec<u8>]) -> usize {
+    let prefixes: BTreeSet<&[u8]> = captured.iter().filter_map(|d| d.get(8..20)).collect();
+    prefixes.len().saturating_sub(1)
+}
+
+/// Prints what `participant`'s core refused (by kind), dropped and counted, and asserts that it
+/// refused something: the flooded programs do not show their counters, this test's participant
+/// (the same `rtps-proto` core) does.
+fn print_counters(name: &str, participant: &Participant) {
+    let c = participant.counters();
+    let refused: Vec<_> = c.wire.iter().filter(|(_, n)| *n > 0).collect();
+    println!(
+        "{name}: {} datagrams, refused by the wire layer {refused:?}, discovery data refused {}, participants \
+         at the limit {}, endpoints at the limit {}, not for it {}, from unmatched endpoints {}, other domain {}, \
+         events at the limit {}",
+        c.datagrams,
+        c.discovery_errors,
+        c.participants_at_limit,
+        c.endpoints_at_limit,
+        c.not_for_us,
+        c.unmatched_source,
+        c.other_domain,
+        c.events_at_limit
+    );
+    assert!(c.wire.total() > 0, "{name} refused nothing: {c:?}");
 }
 
 /// A domain participant of this test's own, on `lo`.
@@ -170,12 +231,12 @@ fn udp_counters() -> BTreeMap<String, u64> {
     names.map(str::to_owned).zip(values.map(|v| v.parse().unwrap())).collect()
 }
 
-/// Floods every port bound in this namespace (but the flood's own) and domain 0's two multicast
-/// groups, after checking that participant 0's ports are among them.
-fn flood_every_port(captured: &[Vec<u8>], trusted_fields: bool) {
+/// Floods every port bound in this namespace (but the flood's own and `spared`) and domain 0's two
+/// multicast groups, after checking that participant 0's ports are among them. What it sent.
+fn flood_every_port(captured: &[Vec<u8>], trusted_fields: bool, spared: &BTreeSet<u16>) -> FloodReport {
     let socket = UdpSocket::bind((Ipv4Addr::LOCALHOST, 0)).unwrap();
     let own = socket.local_addr().unwrap().port();
-    let ports: Vec<u16> = bound_udp_ports().into_iter().filter(|p| *p != own).collect();
+    let ports: Vec<u16> = bound_udp_ports().into_iter().filter(|p| *p != own && !spared.contains(p)).collect();
     assert!(
         [SPDP_MULTICAST_PORT].iter().chain(&PARTICIPANT_0_PORTS).all(|p| ports.contains(p)),
         "participant 0 of domain 0 listens on 7400, 7410, 7411: {ports:?}"
@@ -196,6 +257,7 @@ fn flood_every_port(captured: &[Vec<u8>], trusted_fields: bool) {
         delta("RcvbufErrors"),
         delta("NoPorts")
     );
+    report
 }
 
 /// `robowire ARGS` under the address-space limit [`MEMORY_LIMIT_KB`], what it printed kept.
@@ -247,17 +309,29 @@ impl Robowire {
         &self.said
     }
 
-    /// Its resident and mapped memory now, or "ended".
-    fn memory(&self) -> String {
-        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).unwrap_or_default();
-        let field = |name: &str| {
+    /// Its memory now; `None` once it ended.
+    fn memory(&self) -> Option<Memory> {
+        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id())).ok()?;
+        let kib = |name: &str| -> Option<u64> {
             let line = status.lines().find(|l| l.starts_with(name))?;
-            Some(line.split_whitespace().collect::<Vec<_>>().join(" "))
+            line.split_whitespace().nth(1)?.parse().ok()
         };
-        match (field("VmRSS:"), field("VmSize:")) {
-            (Some(rss), Some(size)) => format!("{rss}, {size}"),
-            _ => "ended".into(),
+        Some(Memory { rss_kib: kib("VmRSS:")?, peak_kib: kib("VmHWM:")?, mapped_kib: kib("VmSize:")? })
+    }
+
+    /// Its memory now, which must be there (it still runs).
+    fn running_memory(&mut self) -> Memory {
+        self.memory().unwrap_or_else(|| panic!("it ended: {}", self.output()))
+    }
+
+    /// Sets its resident peak (`VmHWM`) to what is resident now (`clear_refs` 5, Linux 4.0);
+    /// whether it could.
+    fn reset_peak(&self) -> bool {
+        let reset = std::fs::write(format!("/proc/{}/clear_refs", self.child.id()), "5");
+        if let Err(e) = &reset {
+            println!("the peak resident memory could not be reset ({e}): the resident memory after counts");
         }
+        reset.is_ok()
     }
 
     /// CPU time each of its threads used so far, busiest first: a thread that spins after the
@@ -311,6 +385,85 @@ impl Drop for Robowire {
     }
 }
 
+/// A program's memory, from `/proc/PID/status`.
+#[derive(Debug, Clone, Copy)]
+struct Memory {
+    /// Resident now (`VmRSS`), KiB.
+    rss_kib: u64,
+    /// Resident at its peak (`VmHWM`), KiB.
+    peak_kib: u64,
+    /// Mapped (`VmSize`), KiB.
+    mapped_kib: u64,
+}
+
+impl std::fmt::Display for Memory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "VmRSS {} KiB (VmHWM {} KiB), VmSize {} KiB", self.rss_kib, self.peak_kib, self.mapped_kib)
+    }
+}
+
+/// Resident memory a program may gain that no table of its participant holds: stacks touched
+/// deeper, the allocator's per-thread arenas and fragmentation, KiB.
+const UNTABLED_KIB: usize = 2048;
+
+/// How far a flooded program's resident memory may grow, KiB, with the terms it adds up: what
+/// its participant's [`rtps_proto::Limits::default()`] lets the flood make it keep. `largest` is
+/// the longest datagram the flood sent; no entry a datagram makes holds more of it than that.
+/// `spoofed` is how many participants the flood speaks as, by their GUID prefixes in the
+/// captured datagrams (the program drops datagrams that carry its own).
+///
+/// - Remote participants: forged SPDP announcements (a captured one with a bit flipped in its GUID
+///   prefix) make new ones, at most `participants`, each a `ParticipantData` from one datagram.
+/// - Remote endpoints of a spoofed participant (forged SEDP data): `endpoints_per_participant`,
+///   each an `EndpointData` from one datagram.
+/// - The two SEDP readers, matched with each spoofed participant's SEDP writers: samples held
+///   until the ones before them come (`2 × local_endpoints`, the builtin readers' depth), each a
+///   datagram's payload, and `reassemblies` fragmented samples of up to `reassembly_bytes`.
+/// - Events not yet taken: `events`, each an `Event` and a datagram's payload.
+/// - [`UNTABLED_KIB`].
+///
+/// The participants the flood makes up it speaks as only when the same bits flip again in a
+/// captured SEDP datagram: their held samples are a datagram each, inside the slack.
+fn growth_bound_kib(largest: usize, spoofed: usize) -> (usize, Vec<(&'static str, usize)>) {
+    use rtps_proto::discovery::{EndpointData, ParticipantData};
+    use rtps_proto::participant::Event;
+    let l = rtps_proto::Limits::default();
+    let entry = largest.min(l.parameter_list_bytes);
+    let sedp_readers = 2;
+    let terms = vec![
+        ("participants", l.participants * (size_of::<ParticipantData>() + entry)),
+        ("endpoints", spoofed * l.endpoints_per_participant * (size_of::<EndpointData>() + entry)),
+        ("held SEDP samples", spoofed * sedp_readers * 2 * l.local_endpoints * entry),
+        ("reassemblies", spoofed * sedp_readers * l.reassemblies * l.reassembly_bytes),
+        ("events", l.events * (size_of::<Event>() + largest)),
+        ("untabled", UNTABLED_KIB * 1024),
+    ];
+    let terms: Vec<_> = terms.into_iter().map(|(name, bytes)| (name, bytes.div_ceil(1024))).collect();
+    (terms.iter().map(|(_, kib)| kib).sum(), terms)
+}
+
+/// Prints `program`'s memory before the flood, right after it, and after the checks, and asserts
+/// that its resident peak from the flood on (with `peak_reset` at the flood's start; else the
+/// larger of the two resident figures after) grew by no more than [`growth_bound_kib`].
+fn assert_memory_bounded(
+    program: &str,
+    [before, flooded, after]: [Memory; 3],
+    peak_reset: bool,
+    report: &FloodReport,
+    spoofed: usize,
+) {
+    let (bound, terms) = growth_bound_kib(report.largest, spoofed);
+    let top = if peak_reset { after.peak_kib } else { flooded.rss_kib.max(after.rss_kib) };
+    let grown = top.saturating_sub(before.rss_kib);
+    println!(
+        "{program} memory: {before} before the flood; {flooded} after it; {after} after the checks; \
+         resident peak +{grown} KiB, bound {bound} KiB from rtps_proto::Limits::default() \
+         (largest datagram {} B, {spoofed} spoofed participant(s)): {terms:?}",
+        report.largest
+    );
+    assert!(grown <= bound as u64, "{program}'s resident peak grew by {grown} KiB, over {bound} KiB: {terms:?}");
+}
+
 /// Sends every line of `pipe` to `lines`, then `None`, on a thread.
 fn forward_lines(pipe: impl Read + Send + 'static, lines: Sender<Option<String>>) {
     std::thread::spawn(move || {
@@ -351,6 +504,7 @@ async fn lowstate_goes_on(participant: &Participant) -> Result<(), String> {
         };
         ticks.push(sample.map_err(|e| e.to_string())?.value.tick.get());
     }
+    println!("rt/lowstate went on for a new reader within {:?}", start.elapsed());
     Ok(())
 }
 
@@ -359,11 +513,17 @@ async fn lowstate_goes_on(participant: &Participant) -> Result<(), String> {
 fn flood_a_go2(trusted_fields: bool) {
     let listener = discovery_listener();
     let mut sim = Robowire::start(&["sim", "go2", "--interface", "lo", "--report-every-s", "0"], "go2 domain 0 lo");
-    let captured = capture_discovery(&listener).datagrams;
+    let discovery = capture_discovery(&listener);
     drop(listener);
-    let before = sim.memory();
-    flood_every_port(&captured, trusted_fields);
-    println!("simulator memory: {before} before the flood, {} after", sim.memory());
+    // The simulator serves this test's participant: it has matched the participant's builtin
+    // endpoints, which the flood then speaks as.
+    runtime().block_on(lowstate_goes_on(&discovery.other)).unwrap();
+    let before = sim.running_memory();
+    let peak_reset = sim.reset_peak();
+    let captured = &discovery.datagrams;
+    let report = flood_every_port(captured, trusted_fields, &discovery.other_ports);
+    let flooded = sim.running_memory();
+    print_counters("this test's participant (domain 0's multicast share of the flood)", &discovery.other);
 
     runtime().block_on(async {
         if let Err(stopped) = lowstate_goes_on(&participant()).await {
@@ -390,6 +550,8 @@ fn flood_a_go2(trusted_fields: bool) {
         assert_eq!((s.lowstate.checksum_errors, s.lowstate.decode_errors), (0, 0), "{s:?}");
         robot.close();
     });
+    let after = sim.running_memory();
+    assert_memory_bounded("simulator", [before, flooded, after], peak_reset, &report, spoofed(captured));
     let out = sim.stop();
     assert!(out.contains("ReleaseMode"), "{out}");
 }
@@ -428,6 +590,9 @@ fn one_datagram_that_rustdds_0_15_1_trusts_does_not_silence_a_go2() {
                 Robowire::start(&["sim", "go2", "--interface", "lo", "--report-every-s", "0"], "go2 domain 0 lo");
             let discovery = capture_discovery(&listener);
             drop(listener);
+            // Once the simulator serves this test's participant, it has matched its builtin
+            // endpoints: the datagram then reaches their state, not "unmatched".
+            runtime().block_on(lowstate_goes_on(&discovery.other)).expect("rt/lowstate before the datagram");
             let socket = UdpSocket::bind((Ipv4Addr::LOCALHOST, 0)).unwrap();
             // As each participant, to the simulator's metatraffic port (participant 0).
             for prefix in &discovery.prefixes {
@@ -435,7 +600,8 @@ fn one_datagram_that_rustdds_0_15_1_trusts_does_not_silence_a_go2() {
                 socket.send_to(&datagram, (Ipv4Addr::LOCALHOST, PARTICIPANT_0_PORTS[0])).unwrap();
             }
             let streaming = runtime().block_on(lowstate_goes_on(&discovery.other));
-            println!("{field}: {streaming:?}; simulator {}", sim.memory());
+            let memory = sim.memory().map_or("ended".into(), |m| m.to_string());
+            println!("{field}: {streaming:?}; simulator {memory}");
             if let Err(stopped) = streaming {
                 let said: Vec<String> = sim.output().lines().skip(1).take(3).map(str::to_owned).collect();
                 broken.push((field, stopped, said));
@@ -451,19 +617,29 @@ fn a_flooded_ros2_bridge_still_publishes_odom_and_obeys_cmd_vel() {
         let listener = discovery_listener();
         let args = ["ros2", "--device", "sim:kmc", "--arm", "--interface", "lo", "--json"];
         let mut bridge = Robowire::start(&args, "ros2: ready");
-        let captured = capture_discovery(&listener).datagrams;
+        let discovery = capture_discovery(&listener);
         drop(listener);
-        let before = bridge.memory();
-        flood_every_port(&captured, false);
-        println!("bridge memory: {before} before the flood, {} after", bridge.memory());
+        // The bridge serves this test's participant (it has matched its builtin endpoints).
+        runtime().block_on(async {
+            let mut odom = discovery.other.reader::<Odometry>(&ros2_proto::topic("", "odom"), Qos::READER).unwrap();
+            tokio::time::timeout(WAIT, odom.recv()).await.expect("odom before the flood").unwrap();
+        });
+        let before = bridge.running_memory();
+        let peak_reset = bridge.reset_peak();
+        let captured = &discovery.datagrams;
+        let report = flood_every_port(captured, false, &discovery.other_ports);
+        let flooded = bridge.running_memory();
+        print_counters("this test's participant (domain 0's multicast share of the flood)", &discovery.other);
 
         let driven = runtime().block_on(async {
             let participant = participant();
             let mut odom = participant.reader::<Odometry>(&ros2_proto::topic("", "odom"), Qos::READER).unwrap();
             let cmd_vel = participant.writer::<Twist>(&ros2_proto::topic("", "cmd_vel"), Qos::ROS_DEFAULT).unwrap();
+            let start = Instant::now();
             if tokio::time::timeout(WAIT, odom.recv()).await.is_err() {
                 return Err(format!("no odom within {WAIT:?} after the flood"));
             }
+            println!("odom for a new reader after the flood within {:?}", start.elapsed());
             let forward = Twist { linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 }, angular: Vector3::default() };
             let start = Instant::now();
             loop {
@@ -484,6 +660,8 @@ fn a_flooded_ros2_bridge_still_publishes_odom_and_obeys_cmd_vel() {
             panic!("{failed}; the bridge's CPU by thread: {cpu}; it said {}", bridge.output());
         }
 
+        let after = bridge.running_memory();
+        assert_memory_bounded("bridge", [before, flooded, after], peak_reset, &report, spoofed(captured));
         let out = bridge.stop();
         let report = out.lines().find(|line| line.starts_with('[')).unwrap_or_else(|| panic!("no JSON report: {out}"));
         let counters: serde_json::Value = serde_json::from_str(report).unwrap_or_else(|e| panic!("{e}: {out}"));

@@ -65,6 +65,7 @@ impl Participant {
     pub(super) fn heard_from(&mut self, now: Time, prefix: GuidPrefix, source: SocketAddr) {
         if let Some(r) = self.remote.iter_mut().find(|r| r.data.guid_prefix == prefix) {
             r.lease_expires = now + lease(&r.data);
+            r.heard_at = now;
             r.last_source = Some(source);
         }
     }
@@ -97,8 +98,15 @@ impl Participant {
             return;
         }
         if self.remote.len() >= self.config.limits.participants {
+            // Refusing the newcomer would let announcements forged under made-up prefixes (with
+            // an infinite lease, at worst) shut every real participant out until they expire.
+            // A real participant is heard from all the time (announcements, heartbeats,
+            // samples); one that is not makes room.
             self.counters.participants_at_limit += 1;
-            return;
+            let Some(quietest) = self.remote.iter().min_by_key(|r| r.heard_at).map(|r| r.data.guid_prefix) else {
+                return; // a limit of 0
+            };
+            self.remove_participant(quietest, LostReason::Displaced);
         }
         let vendor = parsed.vendor_id;
         let builtin = parsed.builtin_endpoints;
@@ -106,6 +114,7 @@ impl Participant {
         self.remote.push(RemoteParticipant {
             data: parsed,
             lease_expires: expires,
+            heard_at: now,
             writers: Vec::new(),
             readers: Vec::new(),
             last_source: None,

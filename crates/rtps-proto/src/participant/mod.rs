@@ -155,6 +155,9 @@ pub enum LostReason {
     LeaseExpired,
     /// It said it is leaving (SPDP dispose).
     Left,
+    /// Forgotten to make room for a participant announcing itself while `Limits::participants`
+    /// were known: of them all, it was the one heard from least recently.
+    Displaced,
 }
 
 /// A sample received by a local reader.
@@ -230,7 +233,8 @@ pub struct Counters {
     pub wire: WireErrorCounts,
     /// SPDP/SEDP data that did not parse.
     pub discovery_errors: u64,
-    /// Participants not kept: `Limits::participants` reached.
+    /// Participants that announced themselves while `Limits::participants` were known; each
+    /// displaced the one heard from least recently ([`LostReason::Displaced`]).
     pub participants_at_limit: u64,
     /// Remote endpoints not kept: `Limits::endpoints_per_participant` reached.
     pub endpoints_at_limit: u64,
@@ -262,6 +266,8 @@ struct LocalEndpoint {
 pub(crate) struct RemoteParticipant {
     pub(crate) data: ParticipantData,
     pub(crate) lease_expires: Time,
+    /// When its last datagram came.
+    pub(crate) heard_at: Time,
     pub(crate) writers: Vec<EndpointData>,
     pub(crate) readers: Vec<EndpointData>,
     /// The address its last datagram came from.
