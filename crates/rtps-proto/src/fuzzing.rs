@@ -219,6 +219,10 @@ pub struct ParticipantSetup {
     pub peer_writer: EntityId,
     /// The peer's reader.
     pub peer_reader: EntityId,
+    /// The fuzzed participant as each setup byte's two bits leave it before the first step
+    /// (discovery fed or not; endpoints created before or after it): cloned per run, so a run
+    /// costs no discovery exchange.
+    prepared: [Option<(Participant, EntityId, EntityId)>; 4],
 }
 
 impl Default for ParticipantSetup {
@@ -249,7 +253,30 @@ impl ParticipantSetup {
                 ours.handle_datagram(T0, address(PEER_PREFIX), Destination::Unicast, &buf[..t.len]);
             }
         }
-        Self { discovery, peer_writer, peer_reader }
+        let mut setup = Self { discovery, peer_writer, peer_reader, prepared: [None, None, None, None] };
+        let prepared = core::array::from_fn(|flags| Some(setup.prepare(flags as u8)));
+        setup.prepared = prepared;
+        setup
+    }
+
+    /// The fuzzed participant before the first step, for the setup byte `flags`: endpoints
+    /// created before discovery unless bit 1, the peer's discovery fed unless bit 0.
+    fn prepare(&self, flags: u8) -> (Participant, EntityId, EntityId) {
+        let now = T0;
+        let mut p = Participant::new(fuzz_config(LOCAL_PREFIX), now);
+        let endpoints = |p: &mut Participant| {
+            let w = p.create_writer(now, TOPIC, TYPE_NAME, Qos::default()).expect("a writer");
+            let r = p.create_reader(now, TOPIC, TYPE_NAME, Qos::default()).expect("a reader");
+            (w, r)
+        };
+        let early = (flags & 2 == 0).then(|| endpoints(&mut p));
+        if flags & 1 == 0 {
+            for d in &self.discovery {
+                p.handle_datagram(now, address(PEER_PREFIX), Destination::Unicast, d);
+            }
+        }
+        let (w, r) = early.unwrap_or_else(|| endpoints(&mut p));
+        (p, w, r)
     }
 }
 
@@ -635,19 +662,10 @@ pub fn participant(input: &[u8]) {
 pub fn participant_steps(setup: &ParticipantSetup, input: &[u8]) {
     let Some((&flags, mut rest)) = input.split_first() else { return };
     let mut now = T0;
-    let mut p = Participant::new(fuzz_config(LOCAL_PREFIX), now);
-    let endpoints = |p: &mut Participant| {
-        let w = p.create_writer(now, TOPIC, TYPE_NAME, Qos::default()).expect("a writer");
-        let r = p.create_reader(now, TOPIC, TYPE_NAME, Qos::default()).expect("a reader");
-        (w, r)
+    let (mut p, writer, reader) = match &setup.prepared[usize::from(flags & 3)] {
+        Some(prepared) => prepared.clone(),
+        None => setup.prepare(flags & 3),
     };
-    let early = (flags & 2 == 0).then(|| endpoints(&mut p));
-    if flags & 1 == 0 {
-        for d in &setup.discovery {
-            p.handle_datagram(now, address(PEER_PREFIX), Destination::Unicast, d);
-        }
-    }
-    let (writer, reader) = early.unwrap_or_else(|| endpoints(&mut p));
     let ids = Ids { writer, reader, peer_writer: setup.peer_writer, peer_reader: setup.peer_reader };
     let mut buf = vec![0u8; 65_536];
     let mut datagram = Vec::with_capacity(65_536);

@@ -48,7 +48,7 @@ pub struct Change {
 }
 
 /// Changes `first ..= last` (with holes where changes were removed), at most `depth`.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct History {
     changes: VecDeque<Change>,
     depth: usize,

@@ -12,7 +12,7 @@ use crate::types::{EntityId, FragmentNumberSet, Guid, Locator, SequenceNumber, S
 use crate::wire::{DataFrag, Gap, Heartbeat, HeartbeatFrag};
 
 /// A sample that came before its turn, or a number a GAP made irrelevant.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 enum Pending {
     Sample(SampleInfo, Vec<u8>),
     Irrelevant,
@@ -36,7 +36,7 @@ pub(crate) enum Delivery {
 }
 
 /// A matched writer, as its reader sees it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct WriterProxy {
     pub(crate) guid: Guid,
     pub(crate) reliable: bool,
@@ -146,7 +146,7 @@ pub struct ReaderCounters {
 }
 
 /// A local reader.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct Reader {
     pub(crate) id: EntityId,
     pub(crate) config: ReaderConfig,

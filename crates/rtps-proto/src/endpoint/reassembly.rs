@@ -25,7 +25,7 @@ pub enum ReassemblyError {
 }
 
 /// A sample in reassembly.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Reassembly {
     sequence: SequenceNumber,
     sample_size: u32,

@@ -11,7 +11,7 @@ use crate::types::{EntityId, FragmentNumberSet, Guid, Locator, SequenceNumber, S
 use crate::wire::{AckNack, NackFrag};
 
 /// A matched reader, as its writer sees it.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct ReaderProxy {
     pub(crate) guid: Guid,
     pub(crate) reliable: bool,
@@ -70,7 +70,7 @@ pub(crate) struct WriterConfig {
 }
 
 /// A local writer.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct Writer {
     pub(crate) id: EntityId,
     pub(crate) config: WriterConfig,

@@ -262,7 +262,7 @@ struct LocalEndpoint {
 }
 
 /// A remote participant and its endpoints.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct RemoteParticipant {
     pub(crate) data: ParticipantData,
     pub(crate) lease_expires: Time,
@@ -284,8 +284,9 @@ pub struct Written {
     pub transmit: Option<Transmit>,
 }
 
-/// One DDS participant; see the [module](self).
-#[derive(Debug)]
+/// One DDS participant; see the [module](self). A clone is an independent participant in the
+/// same state (the same GUID prefix: for tests and fuzzing, not for a second one on a network).
+#[derive(Debug, Clone)]
 pub struct Participant {
     config: ParticipantConfig,
     writers: Vec<Writer>,
