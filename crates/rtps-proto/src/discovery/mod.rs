@@ -17,15 +17,16 @@
 //! [`Limits::locators_per_endpoint`]: crate::Limits::locators_per_endpoint
 
 mod error;
+mod matching;
 mod qos;
 mod sedp;
 mod spdp;
 
 pub use error::DiscoveryError;
+pub use matching::{QosMismatch, check_match};
 pub use qos::{
     DATA_REPRESENTATION_XCDR1, DATA_REPRESENTATION_XCDR2, DATA_REPRESENTATION_XML, DestinationOrder, Durability,
-    History, Liveliness, LivelinessKind, Ownership, OwnershipKind, Qos, QosMismatch, Reliability, ReliabilityKind,
-    check_match,
+    History, Liveliness, LivelinessKind, Ownership, OwnershipKind, Qos, Reliability, ReliabilityKind,
 };
 pub use sedp::EndpointData;
 pub use spdp::{BuiltinEndpointSet, ParticipantData};
