@@ -4,7 +4,8 @@
 use alloc::vec::Vec;
 use core::net::SocketAddr;
 
-use super::{Counters, Event, Participant, Sample, push_event};
+use super::event::push_event;
+use super::{Counters, Event, Participant, Sample};
 use crate::Time;
 use crate::endpoint::{SampleIdentity, SampleInfo};
 use crate::types::{EntityId, Guid, GuidPrefix, SequenceNumber, Timestamp};
