@@ -67,50 +67,27 @@ pub const TARGETS: &[Target] = &[
     Target { name: "rtps_participant", seeds: rtps_participant_seeds, check: rtps_proto::fuzzing::participant },
 ];
 
-/// RTPS seeds: the six hostile datagrams of the DDS flood test (`one_datagram_each` in
-/// `crates/robowire/tests/dds_flood/datagrams.rs`, rebuilt here), and one datagram of the
+/// RTPS seeds: the six hostile datagrams (`robowire_fixtures::rtps::hostile_datagrams`), and one datagram of the
 /// submessages a reliable exchange uses, written with the crate's own emitter.
 fn rtps_seeds() -> Seeds {
     use rtps_proto::wire::{self, Submessage};
     use rtps_proto::{EntityId, GuidPrefix, ProtocolVersion, SequenceNumber, SequenceNumberSet, VendorId};
 
     let from = [1, 0x0f, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1];
-    let datagram = |kind: u8, body: Vec<u8>| -> anyhow::Result<Vec<u8>> {
-        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
-        d.extend(from);
-        d.extend([kind, 0x01]);
-        d.extend(u16::try_from(body.len())?.to_le_bytes());
-        d.extend(body);
-        Ok(d)
-    };
-    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
-    let count = i32::MAX.to_le_bytes();
-    let (spdp_reader, spdp_writer) = ([0u8, 1, 0, 0xC7], [0u8, 1, 0, 0xC2]);
-    let (reader, writer) = ([0u8, 0, 3, 0xC7], [0u8, 0, 3, 0xC2]);
-    let data_frag = [&[0, 0, 28, 0][..], &spdp_reader, &spdp_writer, &sn(1), &1u32.to_le_bytes()]
-        .concat()
-        .into_iter()
-        .chain(1u16.to_le_bytes())
-        .chain(1024u16.to_le_bytes())
-        .chain(0xFFFF_FFF0u32.to_le_bytes())
-        .chain([0; 1024])
-        .collect();
-    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
-    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
-    let nack_frag =
-        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &[0xFF; 32], &count]
-            .concat();
-    let fragment_0 =
-        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
-    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
-    let mut seeds = vec![
-        ("seed-data-frag-sample-size".to_string(), datagram(0x16, data_frag)?),
-        ("seed-heartbeat-range".to_string(), datagram(0x07, heartbeat)?),
-        ("seed-gap-range".to_string(), datagram(0x08, gap)?),
-        ("seed-nack-frag-fragment-numbers".to_string(), datagram(0x12, nack_frag)?),
-        ("seed-nack-frag-fragment-0".to_string(), datagram(0x12, fragment_0)?),
-        ("seed-acknack-sequence-number-overflow".to_string(), datagram(0x06, acknack)?),
+    let names = [
+        "seed-data-frag-sample-size",
+        "seed-heartbeat-range",
+        "seed-gap-range",
+        "seed-nack-frag-fragment-numbers",
+        "seed-nack-frag-fragment-0",
+        "seed-acknack-sequence-number-overflow",
     ];
+    let mut seeds: Vec<(String, Vec<u8>)> = names
+        .into_iter()
+        .zip(robowire_fixtures::rtps::hostile_datagrams(from))
+        .map(|(name, (_, datagram))| (name.to_string(), datagram))
+        .collect();
+    let (reader, writer) = ([0u8, 0, 3, 0xC7], [0u8, 0, 3, 0xC2]);
 
     // A writer's DATA with inline QoS, a HEARTBEAT, a reader's ACKNACK, a GAP.
     let mut qos = [0u8; 64];

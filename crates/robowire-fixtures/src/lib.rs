@@ -3,6 +3,7 @@
 
 pub mod interop;
 pub mod peers;
+pub mod rtps;
 pub mod zsl1;
 
 use std::path::PathBuf;

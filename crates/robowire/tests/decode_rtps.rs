@@ -343,45 +343,7 @@ fn hostile_pcaps_end_in_one_error_not_a_panic() {
     assert!(String::from_utf8(out.stderr).unwrap().starts_with("error: packet 1: not an RTPS message\n"));
 }
 
-/// The six datagrams of `tests/dds_flood/datagrams.rs` (`one_datagram_each`), each setting a
-/// field rustdds 0.15.1 trusts, as the participant `from` would send them.
-fn one_datagram_each(from: [u8; 12]) -> [(&'static str, Vec<u8>); 6] {
-    let datagram = |kind: u8, body: Vec<u8>| {
-        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
-        d.extend(from);
-        d.extend([kind, 0x01]);
-        d.extend(u16::try_from(body.len()).unwrap().to_le_bytes());
-        d.extend(body);
-        d
-    };
-    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
-    let count = i32::MAX.to_le_bytes();
-    let (reader, writer) = (SEDP_PUBLICATIONS_READER, SEDP_PUBLICATIONS_WRITER);
-    let data_frag = [&[0, 0, 28, 0][..], &SPDP_READER, &SPDP_WRITER, &sn(1), &1u32.to_le_bytes()]
-        .concat()
-        .into_iter()
-        .chain(1u16.to_le_bytes())
-        .chain(1024u16.to_le_bytes())
-        .chain(0xFFFF_FFF0u32.to_le_bytes())
-        .chain([0; 1024])
-        .collect();
-    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
-    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
-    let words = [0xFFu8; 32];
-    let nack_frag =
-        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &words, &count].concat();
-    let fragment_0 =
-        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
-    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
-    [
-        ("DATA_FRAG sampleSize", datagram(0x16, data_frag)),
-        ("HEARTBEAT range", datagram(0x07, heartbeat)),
-        ("GAP range", datagram(0x08, gap)),
-        ("NACK_FRAG fragment numbers", datagram(0x12, nack_frag)),
-        ("NACK_FRAG fragment number 0", datagram(0x12, fragment_0)),
-        ("sequence number overflow", datagram(0x06, acknack)),
-    ]
-}
+use robowire_fixtures::rtps::hostile_datagrams as one_datagram_each;
 
 /// JSON on stdout and status 0, or one `error:` line on stderr and status 1; never a panic.
 fn json_or_one_refusal(out: &Output) -> Option<Value> {

@@ -1,16 +1,19 @@
 //! In steady state, writing a LowCmd-sized sample, carrying it, receiving it (and the reliable
 //! protocol's heartbeats and acknowledgements around it) allocates nothing.
 
+#[allow(dead_code)] // each test binary uses a part of it
+mod pair;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
+use rtps_proto::Time;
 use rtps_proto::discovery::{History, Qos, Reliability};
-use rtps_proto::participant::{Destination, Event, Participant, ParticipantConfig};
+use rtps_proto::participant::{Destination, Event, Participant};
 use rtps_proto::types::DdsDuration;
-use rtps_proto::{GuidPrefix, Locator, Time};
 
 struct Counting;
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
@@ -49,18 +52,10 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
-fn config(n: u8) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(GuidPrefix([n; 12]), 0);
-    let addr: SocketAddr = format!("127.0.0.1:{}", 7400 + 10 * u16::from(n)).parse().unwrap();
-    c.metatraffic_unicast = vec![Locator::udp(addr)];
-    c.default_unicast = c.metatraffic_unicast.clone();
-    c
-}
-
 fn steady_state_allocations(reliable: bool) -> usize {
     let mut now = Time::from_nanos(1_000_000_000);
-    let mut a = Participant::new(config(1), now);
-    let mut b = Participant::new(config(2), now);
+    let mut a = Participant::new(pair::config(1), now);
+    let mut b = Participant::new(pair::config(2), now);
     let reliability =
         if reliable { Reliability::Reliable { max_blocking_time: DdsDuration::ZERO } } else { Reliability::BestEffort };
     let qos = Qos { history: History::KeepLast { depth: 1 }, reliability, ..Qos::default() };

@@ -2,45 +2,26 @@
 //! made-up GUID prefixes and an infinite lease, as a flood of bit-flipped captures makes them)
 //! does not shut a real newcomer out: the participant heard from least recently makes room.
 
+#[allow(dead_code)] // each test binary uses a part of it
+mod pair;
+
 use std::net::SocketAddr;
 use std::time::Duration;
 
 use rtps_proto::discovery::Qos;
-use rtps_proto::participant::{Destination, Event, LostReason, Participant, ParticipantConfig};
-use rtps_proto::{GuidPrefix, Limits, Locator, Time};
-
-fn config(prefix: [u8; 12], port: u16) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(GuidPrefix(prefix), 0);
-    let addr: SocketAddr = format!("127.0.0.1:{port}").parse().unwrap();
-    c.metatraffic_unicast = vec![Locator::udp(addr)];
-    c.default_unicast = c.metatraffic_unicast.clone();
-    c
-}
-
-/// Carries datagrams both ways until both are quiet.
-fn exchange(now: Time, a: &mut Participant, b: &mut Participant) {
-    let mut buf = vec![0u8; 65_536];
-    let from: SocketAddr = "127.0.0.1:7400".parse().unwrap();
-    for _ in 0..20 {
-        while let Some(t) = a.poll_transmit(now, &mut buf) {
-            b.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
-        }
-        while let Some(t) = b.poll_transmit(now, &mut buf) {
-            a.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
-        }
-    }
-}
+use rtps_proto::participant::{Destination, Event, LostReason, Participant};
+use rtps_proto::{GuidPrefix, Limits, Time};
 
 #[test]
 fn forged_announcements_that_fill_the_participant_table_do_not_shut_out_a_newcomer() {
     let start = Time::from_nanos(1_000_000_000);
-    let mut ours = Participant::new(config([1; 12], 7410), start);
+    let mut ours = Participant::new(pair::config_at([1; 12], 7410), start);
     let reader = ours.create_reader(start, "rt/lowstate", "T", Qos::default()).unwrap();
     let limit = Limits::default().participants;
     let mut buf = vec![0u8; 65_536];
     let from: SocketAddr = "127.0.0.1:7400".parse().unwrap();
     for n in 0..limit {
-        let mut forged = config([0xF0, n as u8, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], 9000);
+        let mut forged = pair::config_at([0xF0, n as u8, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], 9000);
         forged.lease_duration = Duration::from_secs(u64::from(u32::MAX));
         let mut forger = Participant::new(forged, start);
         let t = forger.poll_transmit(start, &mut buf).expect("its SPDP announcement");
@@ -51,9 +32,9 @@ fn forged_announcements_that_fill_the_participant_table_do_not_shut_out_a_newcom
 
     // A second later (every forged lease still running) a real participant comes.
     let now = start + Duration::from_secs(1);
-    let mut newcomer = Participant::new(config([3; 12], 7430), now);
+    let mut newcomer = Participant::new(pair::config_at([3; 12], 7430), now);
     let w = newcomer.create_writer(now, "rt/lowstate", "T", Qos::default()).unwrap();
-    exchange(now, &mut ours, &mut newcomer);
+    pair::exchange(now, &mut ours, &mut newcomer);
     assert!(ours.remote_participants().any(|p| p.guid_prefix == GuidPrefix([3; 12])), "the newcomer is known");
     assert_eq!(ours.remote_participants().count(), limit, "one forged participant made room");
     assert_eq!(ours.counters().participants_at_limit, 1);

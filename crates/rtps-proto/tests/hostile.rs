@@ -3,14 +3,17 @@
 //! each is refused or handled arithmetically and counted, the participant's heap stays small,
 //! and it goes on discovering and delivering afterwards.
 
+#[allow(dead_code)] // each test binary uses a part of it
+mod pair;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use rtps_proto::Time;
 use rtps_proto::discovery::Qos;
-use rtps_proto::participant::{Destination, Event, Participant, ParticipantConfig};
+use rtps_proto::participant::{Destination, Event, Participant};
 use rtps_proto::wire::WireErrorKind;
-use rtps_proto::{GuidPrefix, Locator, Time};
 
 /// Counts live heap bytes and their peak.
 struct Counting;
@@ -35,78 +38,14 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
-const SPDP_WRITER: [u8; 4] = [0, 1, 0, 0xc2];
-const SPDP_READER: [u8; 4] = [0, 1, 0, 0xc7];
-const SEDP_PUBLICATIONS_WRITER: [u8; 4] = [0, 0, 3, 0xc2];
-const SEDP_PUBLICATIONS_READER: [u8; 4] = [0, 0, 3, 0xc7];
-
-/// `one_datagram_each` of robowire's dds_flood, rebuilt: what each trusted field does there.
-fn one_datagram_each(from: [u8; 12]) -> [(&'static str, Vec<u8>); 6] {
-    let datagram = |kind: u8, body: Vec<u8>| {
-        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
-        d.extend(from);
-        d.extend([kind, 0x01]);
-        d.extend(u16::try_from(body.len()).unwrap().to_le_bytes());
-        d.extend(body);
-        d
-    };
-    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
-    let count = i32::MAX.to_le_bytes();
-    let (reader, writer) = (SEDP_PUBLICATIONS_READER, SEDP_PUBLICATIONS_WRITER);
-    let data_frag: Vec<u8> = [&[0, 0, 28, 0][..], &SPDP_READER, &SPDP_WRITER, &sn(1), &1u32.to_le_bytes()]
-        .concat()
-        .into_iter()
-        .chain(1u16.to_le_bytes())
-        .chain(1024u16.to_le_bytes())
-        .chain(0xFFFF_FFF0u32.to_le_bytes())
-        .chain([0; 1024])
-        .collect();
-    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
-    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
-    let words = [0xFFu8; 32];
-    let nack_frag =
-        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &words, &count].concat();
-    let fragment_0 =
-        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
-    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
-    [
-        ("DATA_FRAG sampleSize", datagram(0x16, data_frag)),
-        ("HEARTBEAT range", datagram(0x07, heartbeat)),
-        ("GAP range", datagram(0x08, gap)),
-        ("NACK_FRAG fragment numbers", datagram(0x12, nack_frag)),
-        ("NACK_FRAG fragment number 0", datagram(0x12, fragment_0)),
-        ("sequence number overflow", datagram(0x06, acknack)),
-    ]
-}
-
-fn config(n: u8) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(GuidPrefix([n; 12]), 0);
-    let addr: SocketAddr = format!("127.0.0.1:{}", 7400 + 10 * u16::from(n)).parse().unwrap();
-    c.metatraffic_unicast = vec![Locator::udp(addr)];
-    c.default_unicast = c.metatraffic_unicast.clone();
-    c
-}
-
-/// Carries datagrams both ways until both are quiet.
-fn exchange(now: Time, a: &mut Participant, b: &mut Participant) {
-    let mut buf = vec![0u8; 65_536];
-    let from: SocketAddr = "127.0.0.1:7400".parse().unwrap();
-    for _ in 0..20 {
-        while let Some(t) = a.poll_transmit(now, &mut buf) {
-            b.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
-        }
-        while let Some(t) = b.poll_transmit(now, &mut buf) {
-            a.handle_datagram(now, from, Destination::Unicast, &buf[..t.len]);
-        }
-    }
-}
+use robowire_fixtures::rtps::hostile_datagrams as one_datagram_each;
 
 #[test]
 fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on() {
     let now = Time::from_nanos(1_000_000_000);
-    let mut ours = Participant::new(config(1), now);
-    let mut attacker = Participant::new(config(2), now);
-    exchange(now, &mut ours, &mut attacker);
+    let mut ours = Participant::new(pair::config(1), now);
+    let mut attacker = Participant::new(pair::config(2), now);
+    pair::exchange(now, &mut ours, &mut attacker);
     assert_eq!(ours.remote_participants().count(), 1, "the sender is a discovered, SEDP-matched participant");
     let source: SocketAddr = "127.0.0.1:7420".parse().unwrap();
     let before = ours.counters().clone();
@@ -136,10 +75,10 @@ fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on(
     // arithmetic (the peak above), not by a table of their size.
 
     // It goes on: a newcomer is discovered and matched, and its samples arrive.
-    let mut newcomer = Participant::new(config(3), now);
+    let mut newcomer = Participant::new(pair::config(3), now);
     let w = newcomer.create_writer(now, "rt/lowstate", "T", Qos::default()).unwrap();
     ours.create_reader(now, "rt/lowstate", "T", Qos::default()).unwrap();
-    exchange(now, &mut ours, &mut newcomer);
+    pair::exchange(now, &mut ours, &mut newcomer);
     let mut buf = vec![0u8; 65_536];
     let t = newcomer.write(now, w, &[0, 1, 0, 0, 7, 7, 7, 7], &Default::default(), &mut buf).unwrap();
     ours.handle_datagram(now, source, Destination::Unicast, &buf[..t.transmit.expect("matched").len]);
@@ -155,11 +94,11 @@ fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on(
 #[test]
 fn a_fragmented_sample_larger_than_the_limit_is_refused_before_any_allocation() {
     let now = Time::from_nanos(1_000_000_000);
-    let mut ours = Participant::new(config(1), now);
-    let mut peer = Participant::new(config(2), now);
+    let mut ours = Participant::new(pair::config(1), now);
+    let mut peer = Participant::new(pair::config(2), now);
     let r = ours.create_reader(now, "big", "T", Qos::default()).unwrap();
     let w = peer.create_writer(now, "big", "T", Qos::default()).unwrap();
-    exchange(now, &mut ours, &mut peer);
+    pair::exchange(now, &mut ours, &mut peer);
     // A DATA_FRAG from the matched writer announcing a 4 GiB sample.
     let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
     d.extend([2u8; 12]);
@@ -206,13 +145,13 @@ fn small_frag(prefix: [u8; 12], reader: [u8; 4], writer: [u8; 4], sn: u32, size:
 #[test]
 fn small_fragments_of_many_writers_hold_no_more_than_the_reassembly_budget() {
     let now = Time::from_nanos(1_000_000_000);
-    let mut ours = Participant::new(config(1), now);
-    let mut peer = Participant::new(config(2), now);
+    let mut ours = Participant::new(pair::config(1), now);
+    let mut peer = Participant::new(pair::config(2), now);
     let readers: Vec<_> =
         (0..4).map(|i| ours.create_reader(now, &format!("t{i}"), "T", Qos::default()).unwrap()).collect();
     let writers: Vec<_> =
         (0..4).map(|i| peer.create_writer(now, &format!("t{i}"), "T", Qos::default()).unwrap()).collect();
-    exchange(now, &mut ours, &mut peer);
+    pair::exchange(now, &mut ours, &mut peer);
     let source: SocketAddr = "127.0.0.1:7420".parse().unwrap();
     let baseline = LIVE.load(Ordering::Relaxed);
     PEAK.store(baseline, Ordering::Relaxed);

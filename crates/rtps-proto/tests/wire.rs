@@ -440,45 +440,7 @@ fn emit_is_little_endian_and_sized() {
 /// "DATA_FRAG sampleSize" (a 4 GiB sample: `Limits::reassembly_bytes`), "HEARTBEAT range"
 /// (2^40 samples, handled arithmetically) and "GAP range" (1000 .. 2^40 irrelevant).
 fn hostile(from: [u8; 12]) -> [(&'static str, Vec<u8>); 6] {
-    const SPDP_READER: [u8; 4] = [0, 1, 0, 0xC7];
-    const SPDP_WRITER: [u8; 4] = [0, 1, 0, 0xC2];
-    const SEDP_PUBLICATIONS_WRITER: [u8; 4] = [0, 0, 3, 0xC2];
-    const SEDP_PUBLICATIONS_READER: [u8; 4] = [0, 0, 3, 0xC7];
-    let datagram = |kind: u8, body: Vec<u8>| {
-        let mut d = b"RTPS\x02\x04\x01\x12".to_vec();
-        d.extend(from);
-        d.extend([kind, 0x01]);
-        d.extend(u16::try_from(body.len()).unwrap().to_le_bytes());
-        d.extend(body);
-        d
-    };
-    let sn = |sn: i64| [((sn >> 32) as i32).to_le_bytes(), (sn as u32).to_le_bytes()].concat();
-    let count = i32::MAX.to_le_bytes();
-    let (reader, writer) = (SEDP_PUBLICATIONS_READER, SEDP_PUBLICATIONS_WRITER);
-    let data_frag = [&[0, 0, 28, 0][..], &SPDP_READER, &SPDP_WRITER, &sn(1), &1u32.to_le_bytes()]
-        .concat()
-        .into_iter()
-        .chain(1u16.to_le_bytes())
-        .chain(1024u16.to_le_bytes())
-        .chain(0xFFFF_FFF0u32.to_le_bytes())
-        .chain([0; 1024])
-        .collect();
-    let heartbeat = [&reader[..], &writer, &sn(1), &sn(1 << 40), &count].concat();
-    let gap = [&reader[..], &writer, &sn(1000), &sn(1 << 40), &0u32.to_le_bytes()].concat();
-    let words = [0xFFu8; 32];
-    let nack_frag =
-        [&reader[..], &writer, &sn(1), &0xFFFF_FF00u32.to_le_bytes(), &256u32.to_le_bytes(), &words, &count].concat();
-    let fragment_0 =
-        [&reader[..], &writer, &sn(1), &0u32.to_le_bytes(), &1u32.to_le_bytes(), &[0, 0, 0, 0x80], &count].concat();
-    let acknack = [&reader[..], &writer, &sn(i64::MAX - 8), &32u32.to_le_bytes(), &1u32.to_le_bytes(), &count].concat();
-    [
-        ("DATA_FRAG sampleSize", datagram(0x16, data_frag)),
-        ("HEARTBEAT range", datagram(0x07, heartbeat)),
-        ("GAP range", datagram(0x08, gap)),
-        ("NACK_FRAG fragment numbers", datagram(0x12, nack_frag)),
-        ("NACK_FRAG fragment number 0", datagram(0x12, fragment_0)),
-        ("sequence number overflow", datagram(0x06, acknack)),
-    ]
+    robowire_fixtures::rtps::hostile_datagrams(from)
 }
 
 #[test]
