@@ -20,7 +20,7 @@ use ros2_proto::rmw_dds_common::{
 use crate::bridge::BridgeError;
 
 /// The participant USER_DATA of rmw's participants in the root enclave.
-pub const ENCLAVE_USER_DATA: &[u8] = b"enclave=/;";
+pub(crate) const ENCLAVE_USER_DATA: &[u8] = b"enclave=/;";
 
 /// The name of every device's node (in the device's namespace: `/kmc0/robowire`).
 pub const NODE_NAME: &str = "robowire";
