@@ -205,8 +205,15 @@ fn handle(
     let now = robowire_rt::now();
     let mut st = shared.lock();
     st.core.handle_datagram(now, from, destination, datagram);
+    // A listened sample first: what else the datagram made due (an acknowledgement, a new
+    // deadline) goes out after the listener, which often writes its answer (and settles) itself.
+    shared.dispatch(&mut st);
+    if !st.listeners_due.is_empty() {
+        run_listeners(st, listeners);
+        st = shared.lock();
+    }
     shared.settle(&mut st, now);
-    run_listeners(st, listeners);
+    drop(st);
     if shared.ack_waiters.load(Ordering::Relaxed) > 0 {
         shared.acknowledgements.notify_waiters();
     }

@@ -12,12 +12,15 @@
 //!
 //! - a stalled reader: the send lateness of a `go2::LowLevel` client's 500 Hz LowCmd stream
 //!   (`set_joints` latched once, nothing else) while a RELIABLE reader of `rt/lowcmd`, a process
-//!   of its own (this program run again), is healthy; stops taking samples for 1 s (rustdds still
-//!   acknowledges what arrives: its acknowledgements come from its event loop, not from takes);
-//!   is stopped (`SIGSTOP`: it neither reads nor acknowledges) for 1 s; is stopped long enough to
-//!   fill rustdds's reliable send window (8192 unacknowledged samples, 16.4 s at 500 Hz) and
-//!   1 s beyond, when the writer drops what it cannot admit. The stream's lateness is its wake-up
-//!   lateness on each tick (a write that waited would make the next ticks late).
+//!   of its own (this program run again), is healthy; stops taking samples for 1 s (its
+//!   participant still acknowledges what arrives: acknowledgements come from its background
+//!   thread, not from takes); is stopped (`SIGSTOP`: it neither reads nor acknowledges) for 1 s;
+//!   is stopped for 5 s (2500 samples). The client's writer (`Qos::STREAM_WRITER`, keep last 1)
+//!   never waits: a reader that does not acknowledge holds back at most the newest sample, and
+//!   there is no send window to fill however long it stalls. The stream's lateness is its
+//!   wake-up lateness on each tick (a write that waited would make the next ticks late); beside
+//!   it, a bare `clock_nanosleep` loop at the same rate on the same CPU in the same run (what the
+//!   VM itself does to a sleeping thread's wake-ups).
 //!
 //! - with MuJoCo (feature `mujoco`): the Go2 round trip with the simulator's 500 Hz stream on,
 //!   its body the kinematic joint model, then physics (1 kHz MuJoCo on the stream's thread).
@@ -274,9 +277,9 @@ fn one_way(seconds: u32) -> Vec<f64> {
 const READER_ENV: &str = "ROBOWIRE_BENCH_DDS_RELIABLE_READER";
 /// The reader's QoS: reliable (it acknowledges, so the writer keeps what it has not), keep last 1.
 const RELIABLE_READER: Qos = Qos { reliable: true, ..Qos::READER };
-/// rustdds 0.15.1's reliable send window without ResourceLimits (`DEFAULT_WRITER_MAX_SAMPLES`):
-/// unacknowledged samples a reliable writer holds before it admits no more.
-const RUSTDDS_WINDOW_SAMPLES: u32 = 8192;
+/// The long stall: far more samples than any send window would hold (2500 at 500 Hz); the
+/// writer keeps the newest only.
+const LONG_STALL: Duration = Duration::from_secs(5);
 /// The Go2's LowCmd period.
 const LOWCMD_PERIOD: Duration = Duration::from_millis(2);
 
@@ -456,24 +459,53 @@ fn lowcmd_stream_recorded(stall: Stall, before: Duration, stall_for: Duration, a
     })
 }
 
+/// The baseline: a bare thread on the client's CPU sleeping with
+/// `clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME)` to each deadline of a `period` grid for
+/// `run`, its lateness as the stream's is summarised.
+fn bare_loop(period: Duration, run: Duration) -> Value {
+    let summary_of = std::thread::spawn(move || {
+        robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
+        robowire_rt::set_fine_timer_slack();
+        let mut ring: Box<robowire_core::timing::LatenessRing<4096>> =
+            Box::new(robowire_core::timing::LatenessRing::new());
+        let start = robowire_rt::now();
+        let end = start + run;
+        let mut next = start + period;
+        while next < end {
+            let ns = next.as_nanos();
+            let at =
+                rustix::time::Timespec { tv_sec: (ns / 1_000_000_000) as i64, tv_nsec: (ns % 1_000_000_000) as i64 };
+            let _ = rustix::thread::clock_nanosleep_absolute(rustix::thread::ClockId::Monotonic, &at);
+            ring.record(robowire_rt::stats::micros(robowire_rt::now().saturating_duration_since(next)));
+            next = next + period;
+        }
+        ring.summary()
+    })
+    .join()
+    .expect("the baseline loop");
+    let lateness = summary(&summary_of);
+    println!("bare clock_nanosleep loop, 500 Hz, {run:?}: {lateness}");
+    json!({"run_s": run.as_secs_f64(), "lateness": lateness})
+}
+
 /// The stalled-reader cases, each against a fresh client and reader: healthy, stops taking 1 s,
-/// stopped 1 s (each over `seconds`), stopped until the send window is full and 1 s beyond.
+/// stopped 1 s (each over `seconds`), stopped [`LONG_STALL`]; and a bare loop as long as a run.
 fn stalled_reader(seconds: u32) -> Value {
     let stall = Duration::from_secs(1);
     let side = (Duration::from_secs(u64::from(seconds)).saturating_sub(stall) / 2).max(Duration::from_secs(1));
     let healthy = lowcmd_stream(Stall::None, side, stall, side);
+    let bare = bare_loop(LOWCMD_PERIOD, side * 2 + stall);
     let recorded = lowcmd_stream_recorded(Stall::None, side, stall, side, true);
     let stop_taking = lowcmd_stream(Stall::StopTaking, side, stall, side);
     let stopped = lowcmd_stream(Stall::StopProcess, side, stall, side);
-    let to_fill = LOWCMD_PERIOD * RUSTDDS_WINDOW_SAMPLES + Duration::from_secs(1);
-    let window_full = lowcmd_stream(Stall::StopProcess, Duration::from_secs(1), to_fill, Duration::from_secs(2));
+    let stopped_long = lowcmd_stream(Stall::StopProcess, Duration::from_secs(1), LONG_STALL, Duration::from_secs(2));
     json!({
-        "window_samples": RUSTDDS_WINDOW_SAMPLES,
         "healthy": healthy,
+        "bare_loop": bare,
         "healthy_recorded": recorded,
         "stops_taking": stop_taking,
         "stopped": stopped,
-        "window_full": window_full,
+        "stopped_long": stopped_long,
     })
 }
 
