@@ -6,6 +6,9 @@ use serde_json::Value;
 
 use crate::bench::Row;
 
+/// The bridge's `cmd_vel` → datagram against the sum of its legs (p50).
+const CMD_VEL_LEGS_RATIO: f64 = 1.2;
+
 /// The ROS 2 bridge: `cmd_vel` → the ZSL-1 datagram, beside its two legs measured in the same run.
 pub(crate) fn ros2_row(meta: &Value) -> anyhow::Result<Row> {
     let us = |key: &str| meta[key].as_f64().with_context(|| format!("ros2 meta {key}"));
@@ -16,8 +19,8 @@ pub(crate) fn ros2_row(meta: &Value) -> anyhow::Result<Row> {
         figure: format!("p50 {p50:.1} µs, p99 {p99:.1} µs"),
         baseline: format!("its legs: DDS Twist delivery p50 {dds:.1} µs + move_velocity() → wire p50 {call:.1} µs"),
         ratio: format!("{:.2}× the legs", p50 / (dds + call)),
-        target: "–".into(),
-        met: None,
+        target: format!("p50 ≤ {CMD_VEL_LEGS_RATIO}× the legs"),
+        met: Some(p50 / (dds + call) <= CMD_VEL_LEGS_RATIO),
     })
 }
 
