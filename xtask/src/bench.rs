@@ -347,7 +347,8 @@ pub(crate) fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         let stall = c["stall_s"].as_f64().with_context(|| format!("dds meta stalled_reader.{key}.stall_s"))?;
         Ok((p50, p99, max, dropped, run, stall))
     };
-    let window = meta["window_samples"].as_u64().context("dds meta stalled_reader.window_samples")?;
+    let (b50, b99, bmax) = percentiles_us(&meta["bare_loop"]["lateness"])?;
+    let bare = format!("bare clock_nanosleep loop, same rate and CPU: p50 {b50} µs, p99 {b99} µs, max {bmax} µs");
     let (h50, h99, hmax, hdropped, hrun, _) = case("healthy")?;
     let figure = |p50: u64, p99: u64, max: u64, dropped: u64| {
         format!("p50 {p50} µs, p99 {p99} µs, max {max} µs; {dropped} dropped")
@@ -355,7 +356,7 @@ pub(crate) fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     let mut rows = vec![Row {
         path: format!("Go2 LowCmd stream (500 Hz) send lateness, a healthy RELIABLE reader of rt/lowcmd ({hrun:.0} s)"),
         figure: figure(h50, h99, hmax, hdropped),
-        baseline: "–".into(),
+        baseline: bare.clone(),
         ratio: "–".into(),
         target: format!("max ≤ {} ms", STALLED_MAX_US / 1000),
         met: Some(hmax <= STALLED_MAX_US),
@@ -373,17 +374,16 @@ pub(crate) fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     for (key, what) in [
         ("stops_taking", "stops taking samples (its participant still acknowledges)"),
         ("stopped", "is stopped (SIGSTOP: neither reads nor acknowledges)"),
-        ("window_full", "is stopped until rustdds's send window is full, then 1 s more"),
+        ("stopped_long", "is stopped (SIGSTOP) far longer than any send window lasts; keep last 1: nothing fills"),
     ] {
         let (p50, p99, max, dropped, run, stall) = case(key)?;
         let ratio = p99 as f64 / h99.max(1) as f64;
-        let window = if key == "window_full" { format!(" ({window} samples)") } else { String::new() };
         rows.push(Row {
             path: format!(
-                "Go2 LowCmd stream (500 Hz) send lateness, the reader {what}{window}: {stall:.1} s of a {run:.1} s run"
+                "Go2 LowCmd stream (500 Hz) send lateness, the reader {what}: {stall:.1} s of a {run:.1} s run"
             ),
             figure: figure(p50, p99, max, dropped),
-            baseline: format!("healthy reader: {}", figure(h50, h99, hmax, hdropped)),
+            baseline: format!("healthy reader: {}; {bare}", figure(h50, h99, hmax, hdropped)),
             ratio: format!("{ratio:.2}× (p99); max {:.2} ms", max as f64 / 1000.0),
             target: format!("p99 ≤ {STALLED_P99_RATIO}× healthy, max ≤ {} ms", STALLED_MAX_US / 1000),
             met: Some(ratio <= STALLED_P99_RATIO && max <= STALLED_MAX_US),
@@ -436,12 +436,12 @@ mod tests {
             })
         };
         let meta = serde_json::json!({
-            "window_samples": 8192,
+            "bare_loop": {"run_s": 3.0, "lateness": {"count": 1500, "p50_us": 50, "p99_us": 90, "max_us": 1200}},
             "healthy": case(40, 900, 0),
             "healthy_recorded": case(30, 800, 0),
             "stops_taking": case(60, 1000, 0),
             "stopped": case(61, 500, 0),
-            "window_full": case(50, 1001, 700),
+            "stopped_long": case(50, 1001, 0),
         });
         let rows = stalled_reader_rows(&meta).unwrap();
         assert_eq!(rows.len(), 5);
@@ -449,11 +449,16 @@ mod tests {
         assert_eq!(rows[1].baseline, "not recorded: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
         assert_eq!((rows[1].ratio.as_str(), rows[1].met), ("p99 -10 µs", None));
         assert_eq!(rows[2].figure, "p50 0 µs, p99 60 µs, max 1000 µs; 0 dropped");
-        assert_eq!(rows[2].baseline, "healthy reader: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped");
+        assert_eq!(
+            rows[2].baseline,
+            "healthy reader: p50 0 µs, p99 40 µs, max 900 µs; 0 dropped; \
+             bare clock_nanosleep loop, same rate and CPU: p50 50 µs, p99 90 µs, max 1200 µs"
+        );
         assert_eq!((rows[2].ratio.as_str(), rows[2].met), ("1.50× (p99); max 1.00 ms", Some(true)));
         assert_eq!(rows[3].met, Some(false), "p99 above 1.5× healthy");
         assert_eq!(rows[4].met, Some(false), "a send later than 1 ms");
-        assert!(rows[4].path.contains("8192 samples") && rows[4].figure.ends_with("700 dropped"));
+        assert!(rows[4].path.contains("nothing fills") && rows[4].figure.ends_with("0 dropped"));
+        assert!(rows[0].baseline.starts_with("bare clock_nanosleep loop"));
         assert!(stalled_reader_rows(&serde_json::json!({})).is_err(), "missing keys are errors");
     }
 }

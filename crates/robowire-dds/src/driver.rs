@@ -65,6 +65,8 @@ pub(crate) struct State {
     pub(crate) incompatible: HashMap<EntityId, Vec<Incompatible>>,
     /// Room for one datagram to send.
     pub(crate) buf: Vec<u8>,
+    /// Listened readers with samples, for the background thread to run once the lock is let go.
+    pub(crate) listeners_due: Vec<Arc<ReaderSlot>>,
 }
 
 impl Shared {
@@ -76,6 +78,7 @@ impl Shared {
                 readers: HashMap::new(),
                 incompatible: HashMap::new(),
                 buf: vec![0; MAX_DATAGRAM],
+                listeners_due: Vec::new(),
             }),
             sockets,
             wake,
@@ -126,8 +129,12 @@ impl Shared {
             match e {
                 Event::Sample(sample) => match st.readers.get(&sample.info.reader) {
                     Some(slot) => {
-                        if let Some(replaced) = slot.push(sample) {
+                        let (replaced, listen) = slot.push(sample);
+                        if let Some(replaced) = replaced {
                             st.core.recycle(replaced);
+                        }
+                        if listen {
+                            st.listeners_due.push(slot.clone());
                         }
                     }
                     None => st.core.recycle(sample.payload),
@@ -160,20 +167,51 @@ impl Shared {
     }
 }
 
-fn recv_all(shared: &Shared, socket: &UdpSocket, destination: Destination, rx: &mut [u8]) {
+/// The background thread's buffers: a datagram received, the listeners to run.
+struct Scratch {
+    rx: Vec<u8>,
+    listeners: Vec<Arc<ReaderSlot>>,
+}
+
+/// Lets the lock go, then runs the listeners of the readers that got samples.
+fn run_listeners(mut st: MutexGuard<'_, State>, spare: &mut Vec<Arc<ReaderSlot>>) {
+    if st.listeners_due.is_empty() {
+        return;
+    }
+    std::mem::swap(&mut st.listeners_due, spare);
+    drop(st);
+    for slot in spare.drain(..) {
+        slot.run_listener();
+    }
+}
+
+fn recv_all(shared: &Shared, socket: &UdpSocket, destination: Destination, scratch: &mut Scratch) {
     loop {
-        match socket.recv_from(rx) {
-            Ok((n, from)) => handle(shared, from, destination, &rx[..n]),
+        match socket.recv_from(&mut scratch.rx) {
+            Ok((n, from)) => handle(shared, from, destination, &scratch.rx[..n], &mut scratch.listeners),
             Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
             Err(_) => return, // WouldBlock: drained (other errors: ICMP reports, ignored)
         }
     }
 }
 
-fn handle(shared: &Shared, from: SocketAddr, destination: Destination, datagram: &[u8]) {
+fn handle(
+    shared: &Shared,
+    from: SocketAddr,
+    destination: Destination,
+    datagram: &[u8],
+    listeners: &mut Vec<Arc<ReaderSlot>>,
+) {
     let now = robowire_rt::now();
     let mut st = shared.lock();
     st.core.handle_datagram(now, from, destination, datagram);
+    // A listened sample first: what else the datagram made due (an acknowledgement, a new
+    // deadline) goes out after the listener, which often writes its answer (and settles) itself.
+    shared.dispatch(&mut st);
+    if !st.listeners_due.is_empty() {
+        run_listeners(st, listeners);
+        st = shared.lock();
+    }
     shared.settle(&mut st, now);
     drop(st);
     if shared.ack_waiters.load(Ordering::Relaxed) > 0 {
@@ -183,7 +221,7 @@ fn handle(shared: &Shared, from: SocketAddr, destination: Destination, datagram:
 
 /// The background thread: receives, and runs the core's timers.
 pub(crate) fn run(shared: Arc<Shared>) {
-    let mut rx = vec![0u8; MAX_DATAGRAM];
+    let mut scratch = Scratch { rx: vec![0u8; MAX_DATAGRAM], listeners: Vec::new() };
     while !shared.stop.load(Ordering::Relaxed) {
         let deadline = {
             let st = shared.lock();
@@ -212,13 +250,13 @@ pub(crate) fn run(shared: Arc<Shared>) {
             let _ = rustix::io::read(&shared.wake, &mut b);
         }
         if ready[0] {
-            recv_all(&shared, &s.user, Destination::Unicast, &mut rx);
+            recv_all(&shared, &s.user, Destination::Unicast, &mut scratch);
         }
         if ready[1] {
-            recv_all(&shared, &s.meta, Destination::Unicast, &mut rx);
+            recv_all(&shared, &s.meta, Destination::Unicast, &mut scratch);
         }
         if ready[2] {
-            recv_all(&shared, &s.spdp, Destination::Multicast, &mut rx);
+            recv_all(&shared, &s.spdp, Destination::Multicast, &mut scratch);
         }
         let now = robowire_rt::now();
         let mut st = shared.lock();
@@ -226,6 +264,7 @@ pub(crate) fn run(shared: Arc<Shared>) {
             st.core.handle_timeout(now);
         }
         shared.settle(&mut st, now);
+        run_listeners(st, &mut scratch.listeners);
     }
     // Leaving: tell the others at once rather than letting the lease run out.
     let mut st = shared.lock();

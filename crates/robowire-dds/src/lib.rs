@@ -16,7 +16,7 @@ mod writer;
 pub use driver::Incompatible;
 pub use error::DdsError;
 pub use participant::{DiscoveredEndpoint, DiscoveredParticipant, DiscoveredTopic, Participant, ParticipantOptions};
-pub use reader::Reader;
+pub use reader::{Listener, Reader};
 #[doc(hidden)]
 pub use sample::fuzz_check_sample;
 pub use sample::{RawSample, Sample, SampleIdentity, StatsHandle, TopicStats};

@@ -1,7 +1,8 @@
 //! [`Reader`]: a topic's samples for one task, from a slot the background thread fills.
 
 use std::marker::PhantomData;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll};
 
 use crossbeam_queue::ArrayQueue;
@@ -15,29 +16,64 @@ use crate::DdsError;
 use crate::driver::Shared;
 use crate::sample::{Counters, Sample, SampleIdentity, StatsHandle, TopicStats, decode};
 
+/// What a listened reader runs on the background thread: takes its slot's samples.
+type Listen = Box<dyn FnMut() + Send>;
+
 /// Where the background thread puts a reader's samples: the newest `depth` (keep last), and the
-/// waker of the task that waits for them.
-#[derive(Debug)]
+/// waker of the task that waits for them, or the listener that takes them on the background
+/// thread.
 pub(crate) struct ReaderSlot {
     queue: ArrayQueue<Arrived>,
     waker: AtomicWaker,
     counters: Arc<Counters>,
+    /// A listener is installed: the background thread runs it instead of waking a task.
+    listened: AtomicBool,
+    /// Samples arrived that the listener has not been run for (the slot is in the background
+    /// thread's list to run).
+    due: AtomicBool,
+    /// The listener; taken only by the background thread and by the [`Listener`]'s drop.
+    listener: Mutex<Option<Listen>>,
+}
+
+impl std::fmt::Debug for ReaderSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ReaderSlot").field("kept", &self.queue.len()).finish_non_exhaustive()
+    }
 }
 
 impl ReaderSlot {
     pub(crate) fn new(depth: usize, counters: Arc<Counters>) -> Self {
-        Self { queue: ArrayQueue::new(depth.max(1)), waker: AtomicWaker::new(), counters }
+        Self {
+            queue: ArrayQueue::new(depth.max(1)),
+            waker: AtomicWaker::new(),
+            counters,
+            listened: AtomicBool::new(false),
+            due: AtomicBool::new(false),
+            listener: Mutex::new(None),
+        }
     }
 
     /// Keeps `sample` (replacing the oldest when full: its buffer is returned) and wakes the
-    /// reader's task.
-    pub(crate) fn push(&self, sample: Arrived) -> Option<Vec<u8>> {
+    /// reader's task; with a listener, whether the listener is to be run (the first sample since
+    /// it last ran).
+    pub(crate) fn push(&self, sample: Arrived) -> (Option<Vec<u8>>, bool) {
         let replaced = self.queue.force_push(sample).map(|old| {
             Counters::bump(&self.counters.dropped);
             old.payload
         });
+        if self.listened.load(Ordering::Acquire) {
+            return (replaced, !self.due.swap(true, Ordering::AcqRel));
+        }
         self.waker.wake();
-        replaced
+        (replaced, false)
+    }
+
+    /// The background thread, without the core's lock: runs the listener on what arrived.
+    pub(crate) fn run_listener(&self) {
+        self.due.store(false, Ordering::Release);
+        if let Some(listen) = robowire_rt::lock(&self.listener).as_mut() {
+            listen();
+        }
     }
 }
 
@@ -117,6 +153,29 @@ impl<T: CdrType + 'static> Reader<T> {
         }
     }
 
+    /// Hands every sample that decodes to `on_sample` on the participant's background thread, as it
+    /// arrives (as a CycloneDDS listener): no task to wake, no hop. `on_sample` runs without the
+    /// participant's lock and may write (to this participant too); it must not block, since the
+    /// participant receives nothing else meanwhile. The reader lives until the [`Listener`] is
+    /// dropped. Samples kept before the call are handed over at the next arrival.
+    pub fn listen(mut self, mut on_sample: impl FnMut(Sample<T>) + Send + 'static) -> Listener
+    where
+        T: Send,
+    {
+        let slot = self.slot.clone();
+        let listen: Listen = Box::new(move || {
+            while let Some(arrived) = self.slot.queue.pop() {
+                if let Some(sample) = self.take(arrived) {
+                    Counters::bump(&self.counters.samples);
+                    on_sample(sample);
+                }
+            }
+        });
+        *robowire_rt::lock(&slot.listener) = Some(listen);
+        slot.listened.store(true, Ordering::Release);
+        Listener { slot }
+    }
+
     /// Decodes one arrived sample (counting a failure) and gives its buffer back.
     fn take(&mut self, arrived: Arrived) -> Option<Sample<T>> {
         let info = arrived.info;
@@ -181,6 +240,28 @@ impl<T: CdrType + 'static> Reader<T> {
     /// A handle on the counters.
     pub fn stats_handle(&self) -> StatsHandle {
         StatsHandle(self.counters.clone())
+    }
+}
+
+/// A reader whose samples a function takes on the participant's background thread
+/// ([`Reader::listen`]); dropping it deletes the reader (not from within the function).
+pub struct Listener {
+    slot: Arc<ReaderSlot>,
+}
+
+impl std::fmt::Debug for Listener {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Listener").finish_non_exhaustive()
+    }
+}
+
+impl Drop for Listener {
+    fn drop(&mut self) {
+        self.slot.listened.store(false, Ordering::Release);
+        // The reader (inside the function) is dropped once the lock is let go: its drop takes
+        // the participant's lock.
+        let listen = robowire_rt::lock(&self.slot.listener).take();
+        drop(listen);
     }
 }
 

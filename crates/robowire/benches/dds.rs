@@ -12,12 +12,15 @@
 //!
 //! - a stalled reader: the send lateness of a `go2::LowLevel` client's 500 Hz LowCmd stream
 //!   (`set_joints` latched once, nothing else) while a RELIABLE reader of `rt/lowcmd`, a process
-//!   of its own (this program run again), is healthy; stops taking samples for 1 s (rustdds still
-//!   acknowledges what arrives: its acknowledgements come from its event loop, not from takes);
-//!   is stopped (`SIGSTOP`: it neither reads nor acknowledges) for 1 s; is stopped long enough to
-//!   fill rustdds's reliable send window (8192 unacknowledged samples, 16.4 s at 500 Hz) and
-//!   1 s beyond, when the writer drops what it cannot admit. The stream's lateness is its wake-up
-//!   lateness on each tick (a write that waited would make the next ticks late).
+//!   of its own (this program run again), is healthy; stops taking samples for 1 s (its
+//!   participant still acknowledges what arrives: acknowledgements come from its background
+//!   thread, not from takes); is stopped (`SIGSTOP`: it neither reads nor acknowledges) for 1 s;
+//!   is stopped for 5 s (2500 samples). The client's writer (`Qos::STREAM_WRITER`, keep last 1)
+//!   never waits: a reader that does not acknowledge holds back at most the newest sample, and
+//!   there is no send window to fill however long it stalls. The stream's lateness is its
+//!   wake-up lateness on each tick (a write that waited would make the next ticks late); beside
+//!   it, a bare `clock_nanosleep` loop at the same rate on the same CPU in the same run (what the
+//!   VM itself does to a sleeping thread's wake-ups).
 //!
 //! - with MuJoCo (feature `mujoco`): the Go2 round trip with the simulator's 500 Hz stream on,
 //!   its body the kinematic joint model, then physics (1 kHz MuJoCo on the stream's thread).
@@ -67,8 +70,10 @@ fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
     (at(50), at(99))
 }
 
-/// `ddsperf ping size SIZE` against `ddsperf pong` for `seconds`: the medians of its per-second
-/// p50 and p99 lines, µs (its figures: half the round trip).
+/// `ddsperf ping size SIZE` (CPU 0) against `ddsperf pong` (CPU 1) for `seconds`: the medians of
+/// its per-second p50 and p99 lines, µs (its figures: half the round trip). An unpinned ping
+/// wanders onto the pong's CPU, where a round trip costs no cross-CPU wake-up (half of it ~9 µs
+/// on the development VM against ~20-35 µs across CPUs): both are pinned, as ours are.
 fn ddsperf(seconds: u32, size: usize) -> (f64, f64) {
     let mut pong = Command::new("taskset")
         .args(["-c", &PEER_CPU.to_string(), "ddsperf", "-D", &(seconds + 3).to_string(), "pong"])
@@ -76,8 +81,8 @@ fn ddsperf(seconds: u32, size: usize) -> (f64, f64) {
         .spawn()
         .expect("ddsperf (apt install cyclonedds-tools)");
     std::thread::sleep(Duration::from_millis(300));
-    let out = Command::new("ddsperf")
-        .args(["-D", &seconds.to_string(), "ping", "size", &size.to_string()])
+    let out = Command::new("taskset")
+        .args(["-c", &CLIENT_CPU.to_string(), "ddsperf", "-D", &seconds.to_string(), "ping", "size", &size.to_string()])
         .output()
         .expect("ddsperf");
     let _ = pong.kill();
@@ -111,16 +116,16 @@ fn tagged(tag: u32) -> LowCmd {
 }
 
 /// Round trips through the simulated Go2, its state stream at 1 Hz.
-async fn go2_round_trips(seconds: u32) -> Vec<f64> {
-    go2_round_trips_beside(seconds, Go2SimConfig { state_period: STATE_PERIOD, ..Go2SimConfig::default() }).await
+async fn go2_round_trips(seconds: u32, taker: Taker) -> Vec<f64> {
+    go2_round_trips_beside(seconds, taker, Go2SimConfig { state_period: STATE_PERIOD, ..Go2SimConfig::default() }).await
 }
 
 /// Round trips through the simulated Go2 of `config` (its participant and answers set here).
-async fn go2_round_trips_beside(seconds: u32, config: Go2SimConfig) -> Vec<f64> {
+async fn go2_round_trips_beside(seconds: u32, taker: Taker, config: Go2SimConfig) -> Vec<f64> {
     let participant = ParticipantOptions::new(0, Some("lo"));
     let config = Go2SimConfig { participant, answer_lowcmd: true, ..config };
     let _sim = on_cpu(PEER_CPU, || Go2Sim::spawn(config).expect("simulator"));
-    round_trips::<LowCmd, LowState>(seconds, tagged, |s| s.reserve.get()).await
+    round_trips::<LowCmd, LowState>(seconds, taker, tagged, |s| s.reserve.get()).await
 }
 
 /// With MuJoCo (feature `mujoco`): round trips through the Go2 with its 500 Hz stream on, its
@@ -128,10 +133,11 @@ async fn go2_round_trips_beside(seconds: u32, config: Go2SimConfig) -> Vec<f64> 
 /// the physics costs a client.
 #[cfg(feature = "mujoco")]
 async fn go2_physics_round_trips(seconds: u32) -> Value {
-    let kinematic = percentiles(go2_round_trips_beside(seconds, Go2SimConfig::default()).await);
+    let kinematic = percentiles(go2_round_trips_beside(seconds, Taker::Listener, Go2SimConfig::default()).await);
     let physics = Some(robowire_sim::physics::PhysicsOptions::default());
-    let physics =
-        percentiles(go2_round_trips_beside(seconds, Go2SimConfig { physics, ..Go2SimConfig::default() }).await);
+    let physics = percentiles(
+        go2_round_trips_beside(seconds, Taker::Listener, Go2SimConfig { physics, ..Go2SimConfig::default() }).await,
+    );
     println!(
         "Go2 round trip, 500 Hz stream: kinematic p50 {:.1} p99 {:.1} µs, physics p50 {:.1} p99 {:.1} µs",
         kinematic.0, kinematic.1, physics.0, physics.1
@@ -150,12 +156,17 @@ async fn g1_round_trips(seconds: u32) -> Vec<f64> {
         cmd.reserve[0] = tag.into();
         cmd
     };
-    round_trips::<HgLowCmd, HgLowState>(seconds, tagged, |s| s.reserve[0].get()).await
+    round_trips::<HgLowCmd, HgLowState>(seconds, Taker::Listener, tagged, |s| s.reserve[0].get()).await
 }
 
 /// After ReleaseMode, `seconds` of round trips one at a time: the command `tagged(n)` published,
-/// the first state with `tag_of(state) >= n` received.
-async fn round_trips<C, S>(seconds: u32, tagged: impl Fn(u32) -> C, tag_of: impl Fn(&S) -> u32) -> Vec<f64>
+/// the first state with `tag_of(state) >= n` taken by `taker`.
+async fn round_trips<C, S>(
+    seconds: u32,
+    taker: Taker,
+    tagged: impl Fn(u32) -> C,
+    tag_of: impl Fn(&S) -> u32 + Send + 'static,
+) -> Vec<f64>
 where
     C: Message + CdrType + Send + Sync + 'static,
     S: Message + CdrType + Send + Sync + 'static,
@@ -165,14 +176,69 @@ where
     let released = switcher.call(motion_switcher::RELEASE_MODE, "{}", Duration::from_secs(20)).await.unwrap();
     assert_eq!(released.code, 0);
     let writer = us.writer::<C>(C::TOPIC, Qos::WRITER).unwrap();
-    let mut reader = us.reader::<S>(S::TOPIC, Qos::READER).unwrap();
-    let mut samples = Vec::new();
+    let reader = us.reader::<S>(S::TOPIC, Qos::READER).unwrap();
     let end = Instant::now() + Duration::from_secs(u64::from(seconds));
+    match taker {
+        Taker::Listener => {
+            let (arrivals, arrived) = mpsc::sync_channel(64);
+            let _listener = reader.listen(move |s| {
+                let _ = arrivals.try_send((tag_of(&s.value), Instant::now()));
+            });
+            timed(end, |tag| writer.write(tagged(tag)).unwrap(), &arrived)
+        }
+        Taker::Task => task_round_trips(end, |tag| writer.write(tagged(tag)).unwrap(), reader, tag_of).await,
+    }
+}
+
+/// Who takes the answers: a listener on the participant's background thread, which notes the
+/// time the answer is handed over (as `ddsperf ping`'s listener does), or a task woken by it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Taker {
+    Listener,
+    Task,
+}
+
+/// Until `end`, one at a time: `send(n)`, then the first `(tag, time)` with `tag >= n` from
+/// `arrived` (a listener's); the times between, µs. The first 50 are lost to discovery, and a
+/// lost one (200 ms without) is not a sample.
+fn timed(end: Instant, send: impl Fn(u32), arrived: &mpsc::Receiver<(u32, Instant)>) -> Vec<f64> {
+    let mut samples = Vec::new();
     let mut tag = 0u32;
     while Instant::now() < end {
         tag += 1;
         let sent = Instant::now();
-        writer.write(tagged(tag)).unwrap();
+        send(tag);
+        let deadline = sent + Duration::from_millis(200);
+        let at = loop {
+            match arrived.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                Ok((t, at)) if t >= tag => break Some(at),
+                Ok(_) => {}
+                Err(_) => break None,
+            }
+        };
+        if let Some(at) = at
+            && tag > 50
+        {
+            samples.push(at.duration_since(sent).as_secs_f64() * 1e6);
+        }
+    }
+    samples
+}
+
+/// As [`timed`], the answers taken by this task with `Reader::recv` (the background thread
+/// wakes it).
+async fn task_round_trips<S: CdrType + Send + 'static>(
+    end: Instant,
+    send: impl Fn(u32),
+    mut reader: robowire_dds::Reader<S>,
+    tag_of: impl Fn(&S) -> u32,
+) -> Vec<f64> {
+    let mut samples = Vec::new();
+    let mut tag = 0u32;
+    while Instant::now() < end {
+        tag += 1;
+        let sent = Instant::now();
+        send(tag);
         let answered = tokio::time::timeout(Duration::from_millis(200), async {
             loop {
                 match reader.recv().await {
@@ -191,41 +257,29 @@ where
     samples
 }
 
-async fn one_way(seconds: u32) -> Vec<f64> {
+/// A LowCmd written → decoded and verified at a listener of another participant (the time it is
+/// handed over, as `ddsperf`'s listener notes it).
+fn one_way(seconds: u32) -> Vec<f64> {
     let lo = ParticipantOptions::new(0, Some("lo"));
     let a = Participant::new(lo.clone()).unwrap();
     let b = on_cpu(PEER_CPU, || Participant::new(lo).unwrap());
     let writer = a.writer::<LowCmd>(LowCmd::TOPIC, Qos::WRITER).unwrap();
-    let mut reader = b.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER).unwrap();
-    let mut samples = Vec::new();
+    let reader = b.reader::<LowCmd>(LowCmd::TOPIC, Qos::READER).unwrap();
+    let (arrivals, arrived) = mpsc::sync_channel(64);
+    let _listener = reader.listen(move |s| {
+        let _ = arrivals.try_send((s.value.reserve.get(), Instant::now()));
+    });
     let end = Instant::now() + Duration::from_secs(u64::from(seconds));
-    let mut tag = 0u32;
-    while Instant::now() < end {
-        tag += 1;
-        let sent = Instant::now();
-        writer.write(tagged(tag)).unwrap();
-        let arrived = tokio::time::timeout(Duration::from_millis(200), async {
-            loop {
-                if reader.recv().await.is_ok_and(|s| s.value.reserve.get() == tag) {
-                    return;
-                }
-            }
-        })
-        .await;
-        if arrived.is_ok() && tag > 50 {
-            samples.push(sent.elapsed().as_secs_f64() * 1e6);
-        }
-    }
-    samples
+    timed(end, |tag| writer.write(tagged(tag)).unwrap(), &arrived)
 }
 
 /// Set in the environment of this program run again as the reliable LowCmd reader.
 const READER_ENV: &str = "ROBOWIRE_BENCH_DDS_RELIABLE_READER";
 /// The reader's QoS: reliable (it acknowledges, so the writer keeps what it has not), keep last 1.
 const RELIABLE_READER: Qos = Qos { reliable: true, ..Qos::READER };
-/// rustdds 0.15.1's reliable send window without ResourceLimits (`DEFAULT_WRITER_MAX_SAMPLES`):
-/// unacknowledged samples a reliable writer holds before it admits no more.
-const RUSTDDS_WINDOW_SAMPLES: u32 = 8192;
+/// The long stall: far more samples than any send window would hold (2500 at 500 Hz); the
+/// writer keeps the newest only.
+const LONG_STALL: Duration = Duration::from_secs(5);
 /// The Go2's LowCmd period.
 const LOWCMD_PERIOD: Duration = Duration::from_millis(2);
 
@@ -405,24 +459,53 @@ fn lowcmd_stream_recorded(stall: Stall, before: Duration, stall_for: Duration, a
     })
 }
 
+/// The baseline: a bare thread on the client's CPU sleeping with
+/// `clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME)` to each deadline of a `period` grid for
+/// `run`, its lateness as the stream's is summarised.
+fn bare_loop(period: Duration, run: Duration) -> Value {
+    let summary_of = std::thread::spawn(move || {
+        robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
+        robowire_rt::set_fine_timer_slack();
+        let mut ring: Box<robowire_core::timing::LatenessRing<4096>> =
+            Box::new(robowire_core::timing::LatenessRing::new());
+        let start = robowire_rt::now();
+        let end = start + run;
+        let mut next = start + period;
+        while next < end {
+            let ns = next.as_nanos();
+            let at =
+                rustix::time::Timespec { tv_sec: (ns / 1_000_000_000) as i64, tv_nsec: (ns % 1_000_000_000) as i64 };
+            let _ = rustix::thread::clock_nanosleep_absolute(rustix::thread::ClockId::Monotonic, &at);
+            ring.record(robowire_rt::stats::micros(robowire_rt::now().saturating_duration_since(next)));
+            next = next + period;
+        }
+        ring.summary()
+    })
+    .join()
+    .expect("the baseline loop");
+    let lateness = summary(&summary_of);
+    println!("bare clock_nanosleep loop, 500 Hz, {run:?}: {lateness}");
+    json!({"run_s": run.as_secs_f64(), "lateness": lateness})
+}
+
 /// The stalled-reader cases, each against a fresh client and reader: healthy, stops taking 1 s,
-/// stopped 1 s (each over `seconds`), stopped until the send window is full and 1 s beyond.
+/// stopped 1 s (each over `seconds`), stopped [`LONG_STALL`]; and a bare loop as long as a run.
 fn stalled_reader(seconds: u32) -> Value {
     let stall = Duration::from_secs(1);
     let side = (Duration::from_secs(u64::from(seconds)).saturating_sub(stall) / 2).max(Duration::from_secs(1));
     let healthy = lowcmd_stream(Stall::None, side, stall, side);
+    let bare = bare_loop(LOWCMD_PERIOD, side * 2 + stall);
     let recorded = lowcmd_stream_recorded(Stall::None, side, stall, side, true);
     let stop_taking = lowcmd_stream(Stall::StopTaking, side, stall, side);
     let stopped = lowcmd_stream(Stall::StopProcess, side, stall, side);
-    let to_fill = LOWCMD_PERIOD * RUSTDDS_WINDOW_SAMPLES + Duration::from_secs(1);
-    let window_full = lowcmd_stream(Stall::StopProcess, Duration::from_secs(1), to_fill, Duration::from_secs(2));
+    let stopped_long = lowcmd_stream(Stall::StopProcess, Duration::from_secs(1), LONG_STALL, Duration::from_secs(2));
     json!({
-        "window_samples": RUSTDDS_WINDOW_SAMPLES,
         "healthy": healthy,
+        "bare_loop": bare,
         "healthy_recorded": recorded,
         "stops_taking": stop_taking,
         "stopped": stopped,
-        "window_full": window_full,
+        "stopped_long": stopped_long,
     })
 }
 
@@ -437,9 +520,10 @@ fn main() {
         let (hg_half50, hg_half99) = ddsperf(seconds, 1000);
         robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
-        let trips = runtime.block_on(go2_round_trips(seconds));
+        let trips = runtime.block_on(go2_round_trips(seconds, Taker::Listener));
+        let task_trips = runtime.block_on(go2_round_trips(seconds, Taker::Task));
         let g1_trips = runtime.block_on(g1_round_trips(seconds));
-        let ways = runtime.block_on(one_way(seconds));
+        let ways = one_way(seconds);
         let stalled = stalled_reader(seconds);
         #[cfg(feature = "mujoco")]
         let physics = runtime.block_on(go2_physics_round_trips(seconds));
@@ -447,6 +531,8 @@ fn main() {
         let physics = Value::Null;
         let ((r50, r99), (w50, w99)) = (percentiles(trips.clone()), percentiles(ways.clone()));
         let (g50, g99) = percentiles(g1_trips.clone());
+        let (t50, t99) = percentiles(task_trips.clone());
+        println!("round trip, the answer taken by a task: p50 {t50:.1} p99 {t99:.1} µs ({} samples)", task_trips.len());
         println!(
             "G1 round trip p50 {g50:.1} p99 {g99:.1} µs ({} samples); ddsperf 1000 B half round trip p50 {hg_half50:.1} p99 {hg_half99:.1} µs",
             g1_trips.len()
@@ -458,6 +544,7 @@ fn main() {
         json!({
             "seconds": seconds,
             "round_trip_us": {"p50": r50, "p99": r99, "count": trips.len()},
+            "round_trip_task_us": {"p50": t50, "p99": t99, "count": task_trips.len()},
             "one_way_us": {"p50": w50, "p99": w99, "count": ways.len()},
             "ddsperf_half_round_trip_us": {"p50": half50, "p99": half99},
             "g1_round_trip_us": {"p50": g50, "p99": g99, "count": g1_trips.len()},

@@ -2,7 +2,6 @@
 //! `rt/arm_sdk` (accepted frames go to the state stream through seqlocks) and answers
 //! `motion_switcher`, the loco service (`sport`) and the arm actions (`arm`) like the robot.
 
-use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 
@@ -11,6 +10,7 @@ use lowcmd_proto::g1::{G1Variant, ModePr};
 use lowcmd_proto::{HgLowCmd, HgLowState};
 use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
+use robowire_rt::lock;
 use serde_json::{Value, json};
 
 use super::{ArmSdkFrame, G1Robot, has_disabled_motor};
@@ -162,7 +162,7 @@ pub(super) async fn run(
     endpoints: Endpoints,
     rules: Rules,
 ) {
-    let Endpoints { lowcmd: mut lowcmd_reader, arm_sdk: mut arm_sdk_reader, answers, switcher, loco, arm, battery } =
+    let Endpoints { lowcmd: lowcmd_reader, arm_sdk: mut arm_sdk_reader, answers, switcher, loco, arm, battery } =
         endpoints;
     let loco_state = Loco {
         fsm_id: super::BOOT_FSM_ID,
@@ -171,31 +171,33 @@ pub(super) async fn run(
         stand_height_m: 0.75,
         velocity: [0.0; 3],
     };
-    let services = RefCell::new(Services {
+    let services = Arc::new(Mutex::new(Services {
         handover: handover.clone(),
         owner: Owner::new(report),
         rules,
         loco: loco_state,
         mode_machine_logged: false,
         arm_sdk_logged: false,
-    });
+    }));
     let answered = &handover.requests_answered;
-    let lowcmds = async {
-        while let Ok(sample) = lowcmd_reader.recv().await {
+    // Each LowCmd is taken on the participant's background thread as it arrives: no task to wake
+    // between the datagram and the stream's seqlock (or the answer's `sendto`).
+    let _lowcmds = lowcmd_reader.listen({
+        let (services, handover) = (services.clone(), handover.clone());
+        move |sample| {
             let cmd = &sample.value;
-            if services.borrow_mut().on_lowcmd(cmd, robowire_rt::now()) {
+            if lock(&services).on_lowcmd(cmd, robowire_rt::now()) {
                 // robowire's simulator only: the command's `reserve` echoed, to match a state to it.
                 answer_at_once(&handover.state, answers.as_ref(), |state| state.reserve = cmd.reserve);
             }
         }
-    };
+    });
     let arm_sdk = async {
         while let Ok(sample) = arm_sdk_reader.recv().await {
-            services.borrow_mut().on_arm_sdk(&sample.value, robowire_rt::now());
+            lock(&services).on_arm_sdk(&sample.value, robowire_rt::now());
         }
     };
     tokio::select! {
-        () = lowcmds => {}
         () = arm_sdk => {}
         () = serve(switcher, &services, answered, answer_motion_switcher) => {}
         () = serve(loco, &services, answered, answer_loco) => {}

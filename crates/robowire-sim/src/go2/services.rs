@@ -1,14 +1,15 @@
-//! The Go2's services thread (on the shared skeleton of `crate::unitree`): reads `rt/lowcmd` (an
-//! accepted LowCmd goes to the state stream through a seqlock, and is answered at once if asked
-//! for) and answers `motion_switcher` and `sport` like the robot.
+//! The Go2's services thread (on the shared skeleton of `crate::unitree`): takes `rt/lowcmd` on
+//! the participant's background thread as each arrives (an accepted LowCmd goes to the state
+//! stream through a seqlock, and is answered at once if asked for) and answers `motion_switcher`
+//! and `sport` like the robot.
 
-use std::cell::RefCell;
 use std::sync::{Arc, Mutex};
 
 use lowcmd_proto::api::{self, ApiRequest, sport, status};
 use lowcmd_proto::{LowCmd, LowState};
 use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
+use robowire_rt::lock;
 
 use super::{Go2Robot, head_ok};
 use crate::unitree::{Handover, Owner, Report, ServiceServer, answer_at_once, serve};
@@ -48,20 +49,22 @@ impl Services {
 
 /// Runs until the simulator stops.
 pub(super) async fn run(handover: Arc<Handover<Go2Robot>>, report: Arc<Mutex<Report>>, endpoints: Endpoints) {
-    let Endpoints { lowcmd: mut reader, answers, switcher, sport } = endpoints;
-    let services = RefCell::new(Services { handover: handover.clone(), owner: Owner::new(report) });
+    let Endpoints { lowcmd: reader, answers, switcher, sport } = endpoints;
+    let services = Arc::new(Mutex::new(Services { handover: handover.clone(), owner: Owner::new(report) }));
     let answered = &handover.requests_answered;
-    let commands = async {
-        while let Ok(sample) = reader.recv().await {
+    // Each LowCmd is taken on the participant's background thread as it arrives: no task to wake
+    // between the datagram and the stream's seqlock (or the answer's `sendto`).
+    let _commands = reader.listen({
+        let (services, handover) = (services.clone(), handover.clone());
+        move |sample| {
             let cmd = &sample.value;
-            if services.borrow_mut().on_lowcmd(cmd, robowire_rt::now()) {
+            if lock(&services).on_lowcmd(cmd, robowire_rt::now()) {
                 // What the body reports once it follows the command: its `reserve` echoed.
                 answer_at_once(&handover.state, answers.as_ref(), |state| state.reserve = cmd.reserve);
             }
         }
-    };
+    });
     tokio::select! {
-        () = commands => {}
         () = serve(switcher, &services, answered, |s, request| s.owner.answer(request)) => {}
         () = serve(sport, &services, answered, answer_sport) => {}
     }

@@ -3,7 +3,6 @@
 //! `/response`; `motion_switcher`'s state ([`Owner`]); and the hand-over of accepted commands to
 //! the state stream ([`CommandInbox`], a seqlock).
 
-use std::cell::RefCell;
 use std::future::Future;
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -63,12 +62,12 @@ where
 /// Answers every request of one service with `answer`, counting them in `answered`.
 pub(crate) async fn serve<S>(
     mut server: ServiceServer,
-    services: &RefCell<S>,
+    services: &Mutex<S>,
     answered: &Counter,
     answer: fn(&mut S, &ApiRequest) -> (i32, String),
 ) {
     while let Ok(request) = server.next_request().await {
-        let (code, data) = answer(&mut services.borrow_mut(), &request);
+        let (code, data) = answer(&mut lock(services), &request);
         answered.add(1);
         // A lost answer: the client writes its request again. No answer when none is asked for.
         if !request.header.noreply {
