@@ -175,7 +175,8 @@ pub(crate) struct Handover<B: StreamBody> {
     pub(crate) requests_answered: Counter,
     /// The body's simulated time, µs.
     pub(crate) sim_time_us: Counter,
-    /// Where the base is (physics only), as the stream last stepped it.
+    /// Where the base is (physics only), as the stream last stepped it (as the body started,
+    /// before its first step).
     pub(crate) base: Latest<BasePose>,
 }
 
@@ -325,6 +326,11 @@ impl<B: StreamBody> Sim<B> {
             base: Latest::new(),
         });
         handover.published.write(robowire_rt::now(), &body.published());
+        // The base as the body starts, so that a snapshot taken before the stream's first step
+        // (a participant is ready at once) shows it.
+        if let Some(pose) = body.base_pose() {
+            handover.base.write(robowire_rt::now(), &pose);
+        }
         let report = Arc::new(Mutex::new(report));
         // The stream's writers never wait: a full send window is a dropped sample, counted.
         let qos = stream_qos(options.clock);
@@ -417,7 +423,8 @@ impl<B: StreamBody> Sim<B> {
         lock(&self.report).mode.clone()
     }
 
-    /// Where the base is (physics only), as the stream last stepped it.
+    /// Where the base is (physics only), as the stream last stepped it (as the body started,
+    /// before its first step).
     pub(crate) fn base(&self) -> Option<BasePose> {
         self.handover.base.read().map(|(_, pose)| pose)
     }
