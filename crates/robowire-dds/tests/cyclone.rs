@@ -558,8 +558,13 @@ fn incompatible_qos(python: &Path) {
             let endpoints = ours.discovered_endpoints();
             endpoints.iter().any(|e| e.guid == their_reader) && endpoints.iter().any(|e| e.guid == their_writer)
         });
-        // Give a wrong match time to happen.
-        std::thread::sleep(Duration::from_millis(500));
+        // robowire reports both pairs incompatible, at the discovery that would have matched them.
+        until("robowire reports the incompatible pairs", || {
+            !writer.incompatible_readers().is_empty() && !reader.incompatible_writers().is_empty()
+        });
+        for why in [writer.incompatible_readers(), reader.incompatible_writers()] {
+            assert!(why.len() == 1 && why[0].reason.contains("reliab"), "{why:?}");
+        }
         assert_eq!(writer.matched_readers(), 0, "our best-effort writer is not matched to a reliable reader");
         assert_eq!(reader.matched_writers(), 0, "our reliable reader is not matched to a best-effort writer");
         peer.finish();
