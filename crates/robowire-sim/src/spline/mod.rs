@@ -319,6 +319,9 @@ impl Job for DaemonLoop {
         // Fresh, repeated or cleared: the daemon's command is what the motors get. (Region
         // errors cannot happen: the object is ours and large enough.)
         let _update: Result<CommandUpdate, _> = self.daemon.take_command();
+        // Counted before the state it produces can be read: a client that sees the state sees
+        // the command counted.
+        h.daemon.write(now, &self.daemon.counters().into());
         self.model.step_command(self.daemon.command(), self.dt_s);
         let state = self.model.state(self.daemon.command(), &self.fault_bits);
         let _ = self.daemon.publish_state(&state);
