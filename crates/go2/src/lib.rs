@@ -47,7 +47,8 @@ where
     M: lowcmd_proto::Message + robowire_core::cdr::CdrType + std::fmt::Debug + Eq,
 {
     let Some(sample) = robowire_dds::fuzz_check_sample::<M>(payload) else { return };
-    match (sample, M::decode_cdr_unverified(payload)) {
+    // The codec sees what the reader decodes: the payload without the padding its options announce.
+    match (sample, M::decode_cdr_unverified(robowire_dds::unpadded(payload))) {
         (Ok(message), Ok((unverified, _))) => {
             assert!(unverified.crc.is_ok() || cfg!(fuzzing), "a message with a wrong CRC was read");
             assert_eq!(message, unverified.message);

@@ -17,7 +17,7 @@ pub use driver::Incompatible;
 pub use error::DdsError;
 pub use participant::{DiscoveredEndpoint, DiscoveredParticipant, DiscoveredTopic, Participant, ParticipantOptions};
 pub use reader::{Listener, Reader};
-#[doc(hidden)]
-pub use sample::fuzz_check_sample;
 pub use sample::{RawSample, Sample, SampleIdentity, StatsHandle, TopicStats};
+#[doc(hidden)]
+pub use sample::{fuzz_check_sample, unpadded};
 pub use writer::{WriteRefused, Writer};
