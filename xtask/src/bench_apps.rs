@@ -156,7 +156,9 @@ const DDS_ROUND_TRIP_RATIO: f64 = 1.0;
 /// Rows of the DDS bench: round trip and one way, beside `ddsperf` with the same payload.
 pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     let us = |path: [&str; 2]| meta[path[0]][path[1]].as_f64().with_context(|| format!("dds meta {path:?}"));
-    let seconds = meta["seconds"].as_f64().context("dds meta seconds")?;
+    let trip_s = meta["round_trip_seconds"].as_f64().context("dds meta round_trip_seconds")?;
+    let rounds = meta["round_trip_rounds"].as_f64().context("dds meta round_trip_rounds")?;
+    let turns = format!("{trip_s:.0} s in {rounds:.0} turns with ddsperf");
     let (half50, half99) = (us(["ddsperf_half_round_trip_us", "p50"])?, us(["ddsperf_half_round_trip_us", "p99"])?);
     let mut rows = Vec::new();
     for pct in ["p50", "p99"] {
@@ -164,7 +166,7 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         let ratio = trip / (2.0 * half);
         rows.push(Row {
             path: format!(
-                "Go2 LowCmd → LowState answer via the simulator, DDS on loopback, taken by a listener, {pct} ({seconds:.0} s)"
+                "Go2 LowCmd → LowState answer via the simulator, DDS on loopback, taken by a listener, {pct} ({turns})"
             ),
             figure: format!("{trip:.1} µs"),
             baseline: format!("CycloneDDS ddsperf ping/pong, 812 B, round trip: {:.1} µs", 2.0 * half),
@@ -180,7 +182,7 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         let ratio = trip / (2.0 * half);
         rows.push(Row {
             path: format!(
-                "G1 LowCmd → LowState answer via the simulator, DDS on loopback, taken by a listener, {pct} ({seconds:.0} s)"
+                "G1 LowCmd → LowState answer via the simulator, DDS on loopback, taken by a listener, {pct} ({turns})"
             ),
             figure: format!("{trip:.1} µs"),
             baseline: format!("CycloneDDS ddsperf ping/pong, 1000 B, round trip: {:.1} µs", 2.0 * half),
@@ -191,9 +193,15 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     }
     let (t50, t99) = (us(["round_trip_task_us", "p50"])?, us(["round_trip_task_us", "p99"])?);
     rows.push(Row {
-        path: format!("Go2 LowCmd → LowState answer via the simulator, the answer taken by a task (`Reader::recv`) ({seconds:.0} s)"),
+        path: format!(
+            "Go2 LowCmd → LowState answer via the simulator, the answer taken by a task (`Reader::recv`) ({turns})"
+        ),
         figure: format!("p50 {t50:.1} µs, p99 {t99:.1} µs"),
-        baseline: format!("taken by a listener: p50 {:.1} µs, p99 {:.1} µs", us(["round_trip_us", "p50"])?, us(["round_trip_us", "p99"])?),
+        baseline: format!(
+            "taken by a listener: p50 {:.1} µs, p99 {:.1} µs",
+            us(["round_trip_us", "p50"])?,
+            us(["round_trip_us", "p99"])?
+        ),
         ratio: format!("{:.2}× (p50)", t50 / us(["round_trip_us", "p50"])?),
         target: "–".into(),
         met: None,

@@ -1,9 +1,9 @@
 //! `cmd_vel` → the command on the device's wire, through `robowire ros2`'s bridge, where loopback
 //! carries multicast (`robowire_dds::netns`): a Twist written by a ROS 2 publisher (robowire-dds,
 //! another participant) → the HighLevel datagram carrying its vx at a socket standing in for a ZSL-1;
-//! beside, in the same run, the two legs it is made of: the Twist's DDS delivery alone (writer →
-//! reader in another participant) and the facade's `move_velocity()` call → wire. Figures to
-//! `ROBOWIRE_BENCH_META_ROS2` for `cargo xtask bench`.
+//! beside, sample by sample in the same run, the two legs it is made of: the Twist's DDS delivery
+//! alone (writer → a listener in another participant, as the bridge takes it) and the facade's
+//! `move_velocity()` call → wire. Figures to `ROBOWIRE_BENCH_META_ROS2` for `cargo xtask bench`.
 
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
@@ -84,7 +84,10 @@ fn main() {
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         let lo = ParticipantOptions::new(0, Some("lo"));
         let dog = Dog::bind();
-        let speeds = [0.5f32, 0.6];
+        // The three paths are measured in turn, sample by sample, so that the machine's slow
+        // and fast moments fall on all three alike. Each has its own speeds, since the two ZSL-1
+        // clients stream their latched commands to the one dog.
+        let (bridged_speeds, direct_speeds) = ([0.5f32, 0.6], [0.7f32, 0.8]);
 
         // 1. Through the bridge: Twist written → datagram at the dog.
         let (stop_tx, stop) = tokio::sync::watch::channel(false);
@@ -96,68 +99,61 @@ fn main() {
         let bridge = runtime.spawn(robowire_ros2::run(options, stop, |_| {}));
         let bridge_client = dog.greet(None);
         let publisher = Participant::new(lo.clone()).unwrap();
-        let writer = publisher.writer::<Twist>("rt/cmd_vel", Qos::ROS_DEFAULT).unwrap();
-        let deadline = Instant::now() + Duration::from_secs(10);
-        while writer.matched_readers() == 0 {
-            assert!(Instant::now() < deadline, "the bridge's cmd_vel reader was not discovered");
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        let mut bridged = Vec::with_capacity(n);
-        for i in 0..n + 50 {
-            let vx = speeds[i % 2];
-            let start = Instant::now();
-            writer.write(twist(vx)).unwrap();
-            dog.wait_for_vx(vx);
-            if i >= 50 {
-                bridged.push(start.elapsed().as_secs_f64() * 1e6);
-            }
-            if i % 100 == 0 {
-                dog.keep_alive(bridge_client);
-            }
-        }
-        stop_tx.send(true).unwrap();
-        runtime.block_on(bridge).unwrap().unwrap();
+        let cmd_vel = publisher.writer::<Twist>("rt/cmd_vel", Qos::ROS_DEFAULT).unwrap();
 
-        // 2. The DDS leg alone: Twist written → read in another participant.
+        // 2. The DDS leg alone: Twist written → handed to a listener in another participant (as
+        // the bridge takes it) → this thread.
         let subscriber = Participant::new(lo).unwrap();
-        let mut reader = subscriber.reader::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
-        let writer = publisher.writer::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
-        while writer.matched_readers() == 0 {
+        let reader = subscriber.reader::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
+        let (arrived, take) = std::sync::mpsc::sync_channel(1);
+        let _listener = reader.listen(move |_| {
+            let _ = arrived.try_send(());
+        });
+        let bench_twist = publisher.writer::<Twist>("rt/bench_twist", Qos::ROS_DEFAULT).unwrap();
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while cmd_vel.matched_readers() == 0 || bench_twist.matched_readers() == 0 {
+            assert!(Instant::now() < deadline, "the readers of cmd_vel and bench_twist were not discovered");
             std::thread::sleep(Duration::from_millis(10));
         }
-        let mut dds = Vec::with_capacity(n);
-        runtime.block_on(async {
-            for i in 0..n + 50 {
-                let start = Instant::now();
-                writer.write(twist(speeds[i % 2])).unwrap();
-                reader.recv().await.unwrap();
-                if i >= 50 {
-                    dds.push(start.elapsed().as_secs_f64() * 1e6);
-                }
-            }
-        });
 
         // 3. The device leg alone: move_velocity() → datagram at the dog.
-        let mut direct = Vec::with_capacity(n);
-        runtime.block_on(async {
-            let options = ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
-            let robot = HighLevel::open(options).unwrap();
-            let client = dog.greet(Some(bridge_client));
-            assert!(robot.wait_connected(Duration::from_secs(2)).await);
-            for i in 0..n + 50 {
-                let vx = speeds[i % 2];
+        let options = ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
+        let robot = {
+            let _in_runtime = runtime.enter();
+            HighLevel::open(options).unwrap()
+        };
+        let direct_client = dog.greet(Some(bridge_client));
+        assert!(runtime.block_on(robot.wait_connected(Duration::from_secs(2))));
+
+        let (mut bridged, mut dds, mut direct) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..n + 50 {
+            let time = |samples: &mut Vec<f64>, path: &mut dyn FnMut()| {
                 let start = Instant::now();
-                robot.move_velocity(vx, 0.0, 0.0).unwrap();
-                dog.wait_for_vx(vx);
+                path();
                 if i >= 50 {
-                    direct.push(start.elapsed().as_secs_f64() * 1e6);
+                    samples.push(start.elapsed().as_secs_f64() * 1e6);
                 }
-                if i % 100 == 0 {
-                    dog.keep_alive(client);
-                }
+            };
+            time(&mut bridged, &mut || {
+                cmd_vel.write(twist(bridged_speeds[i % 2])).unwrap();
+                dog.wait_for_vx(bridged_speeds[i % 2]);
+            });
+            time(&mut dds, &mut || {
+                bench_twist.write(twist(0.1)).unwrap();
+                take.recv_timeout(Duration::from_secs(2)).expect("the twist within 2 s");
+            });
+            time(&mut direct, &mut || {
+                robot.move_velocity(direct_speeds[i % 2], 0.0, 0.0).unwrap();
+                dog.wait_for_vx(direct_speeds[i % 2]);
+            });
+            if i % 100 == 0 {
+                dog.keep_alive(bridge_client);
+                dog.keep_alive(direct_client);
             }
-            robot.close();
-        });
+        }
+        robot.close();
+        stop_tx.send(true).unwrap();
+        runtime.block_on(bridge).unwrap().unwrap();
         let (b50, b99) = percentiles(bridged);
         let (d50, d99) = percentiles(dds);
         let (c50, c99) = percentiles(direct);

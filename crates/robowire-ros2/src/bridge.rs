@@ -167,7 +167,7 @@ pub async fn run(
         .zip(spaces)
         .map(|(address, namespace)| BridgedDevice { address: address.clone(), namespace, report: Arc::default() })
         .collect();
-    let mut opened: Vec<AnyDevice> = Vec::new();
+    let mut opened: Vec<Arc<AnyDevice>> = Vec::new();
     for device in &devices {
         let failed = |source| BridgeError::Device { address: device.address.clone(), source };
         // A device's own links are recorded under its namespace (`kmc0/kmc/serial`), beside its
@@ -182,7 +182,7 @@ pub async fn run(
                 .map(|r| if namespace.is_empty() { r.clone() } else { r.under(namespace) }),
             ..OpenOptions::default()
         };
-        opened.push(robowire_devices::open(&device.address, &open_options).map_err(failed)?);
+        opened.push(Arc::new(robowire_devices::open(&device.address, &open_options).map_err(failed)?));
     }
     let ids: Vec<_> = devices.iter().map(|d| graph.add_node(&d.namespace)).collect();
     started(&devices);
@@ -206,8 +206,8 @@ pub async fn run(
                     record: options.record.clone(),
                 },
             };
-            let report = &*device.report;
-            let run: DeviceFuture<'_> = Box::pin(crate::device::run(node, open, report, stopped(stop.clone())));
+            let report = device.report.clone();
+            let run: DeviceFuture<'_> = Box::pin(crate::device::run(node, open.clone(), report, stopped(stop.clone())));
             run
         })
         .collect();
@@ -217,6 +217,11 @@ pub async fn run(
     // first; then the nodes leave the graph.
     for device in opened {
         let address = device.address().clone();
+        // The runs, and the `cmd_vel` listeners with them, are gone: each device is held here only.
+        let Ok(device) = Arc::try_unwrap(device) else {
+            eprintln!("{address}: still in use at close; dropped without its close");
+            continue;
+        };
         if let Err(e) = device.close() {
             eprintln!("{address}: closing: {}", robowire_devices::error_chain(&e));
         }

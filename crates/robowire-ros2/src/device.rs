@@ -4,7 +4,10 @@
 //! by a velocity, through the guard; the device's named services are `std_srvs/Trigger`
 //! services, each request acted on once. Nothing here knows which device it is.
 
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
+
+use tokio::sync::Notify;
 
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, RawSample, Writer};
@@ -66,11 +69,56 @@ struct Topics {
     passthrough: Option<(Writer<RawSample>, RateLimiter)>,
 }
 
+/// A driven device's `cmd_vel`: its guard, shared by the reader's listener (on the participant's
+/// receive thread: the twist reaches the device with no task to wake) and the deadman timer (in
+/// the device loop). The lock is held across the device call, so a deadman stop and a new twist
+/// never interleave.
+struct Drive {
+    cmd_vel: Mutex<CmdVel>,
+    device: Arc<AnyDevice>,
+    report: Arc<DeviceReport>,
+    /// Told when a twist makes a command live, so that the loop arms its deadman timer.
+    live: Notify,
+}
+
+impl Drive {
+    /// A twist from the network, on the listener's thread.
+    fn on_twist(&self, sample: &robowire_dds::Sample<Twist>) {
+        let now = Instant::now();
+        let mut cmd_vel = robowire_rt::lock(&self.cmd_vel);
+        let idle = cmd_vel.guard.deadline().is_none();
+        if let Some((vx_mps, vy_mps, yaw_rate_radps)) = cmd_vel.receive(now, sample) {
+            cmd_vel.outcome(now, self.device.drive(vx_mps, vy_mps, yaw_rate_radps));
+        }
+        self.report.set_guard(cmd_vel.guard.counters());
+        if idle && cmd_vel.guard.deadline().is_some() {
+            self.live.notify_one();
+        }
+    }
+
+    /// When the live command goes stale, if one is live.
+    fn deadline(&self) -> Option<Instant> {
+        robowire_rt::lock(&self.cmd_vel).guard.deadline()
+    }
+
+    /// The deadman timer fired: stops the device if the command is stale by now.
+    fn on_deadline(&self, namespace: &str, deadman: std::time::Duration) {
+        let mut cmd_vel = robowire_rt::lock(&self.cmd_vel);
+        if cmd_vel.guard.on_tick(Instant::now()) {
+            if let Err(e) = self.device.stop_motion() {
+                eprintln!("{namespace}/cmd_vel: the deadman stop was refused: {}", robowire_devices::error_chain(&e));
+            }
+            eprintln!("{namespace}/cmd_vel: no twist for {deadman:?}, stopped");
+        }
+        self.report.set_guard(cmd_vel.guard.counters());
+    }
+}
+
 /// Bridges `device` until `stop` resolves.
 pub(crate) async fn run(
     node: Node<'_>,
-    device: &AnyDevice,
-    report: &DeviceReport,
+    device: Arc<AnyDevice>,
+    report: Arc<DeviceReport>,
     stop: impl Future<Output = ()>,
 ) -> Result<(), BridgeError> {
     let mut topics = Topics {
@@ -82,12 +130,23 @@ pub(crate) async fn run(
         diagnostics: Topic::new(&node),
         passthrough: None,
     };
-    let mut cmd_vel = if device.can_drive() {
+    let drive = if device.can_drive() {
         // The guard's deadman stops the robot; the device's own command timeout is set to it, so
         // that nothing needs to refresh a live command.
         let refused = |source| BridgeError::Device { address: device.address().clone(), source };
         device.set_drive_timeout(node.options.deadman).map_err(refused)?;
-        Some(node.reader::<Twist>("cmd_vel", Qos::ROS_DEFAULT)?)
+        let reader = node.reader::<Twist>("cmd_vel", Qos::ROS_DEFAULT)?;
+        let drive = Arc::new(Drive {
+            cmd_vel: Mutex::new(CmdVel::new(&node.options)),
+            device: device.clone(),
+            report: report.clone(),
+            live: Notify::new(),
+        });
+        let listener = reader.listen({
+            let drive = drive.clone();
+            move |sample| drive.on_twist(&sample)
+        });
+        Some((drive, listener))
     } else {
         None
     };
@@ -97,11 +156,10 @@ pub(crate) async fn run(
     for service in &services {
         report.watch_requests(service.requests_stats());
     }
-    let mut guard = CmdVel::new(&node.options);
     let mut observations = device.observations();
     tokio::pin!(stop);
     loop {
-        let deadman = guard.guard.deadline().map(tokio::time::Instant::from_std);
+        let deadman = drive.as_ref().and_then(|(d, _)| d.deadline()).map(tokio::time::Instant::from_std);
         tokio::select! {
             () = &mut stop => return Ok(()),
             observation = observations.next() => {
@@ -109,22 +167,11 @@ pub(crate) async fn run(
                 let published = publish(&node, &mut topics, &observation, stamp_now())?;
                 report.published(published);
             }
-            sample = async { cmd_vel.as_mut()?.recv().await.ok() }, if cmd_vel.is_some() => {
-                let Some(sample) = sample else { return Ok(()) };
-                let now = Instant::now();
-                if let Some((vx_mps, vy_mps, yaw_rate_radps)) = guard.receive(now, &sample) {
-                    guard.outcome(now, device.drive(vx_mps, vy_mps, yaw_rate_radps));
-                }
-                report.set_guard(guard.guard.counters());
-            }
+            () = made_live(drive.as_ref().map(|(d, _)| &**d)), if deadman.is_none() => {}
             () = async { tokio::time::sleep_until(deadman.unwrap_or_else(tokio::time::Instant::now)).await }, if deadman.is_some() => {
-                if guard.guard.on_tick(Instant::now()) {
-                    if let Err(e) = device.stop_motion() {
-                        eprintln!("{ns}/cmd_vel: the deadman stop was refused: {}", robowire_devices::error_chain(&e));
-                    }
-                    eprintln!("{ns}/cmd_vel: no twist for {:?}, stopped", node.options.deadman);
+                if let Some((drive, _)) = &drive {
+                    drive.on_deadline(&ns, node.options.deadman);
                 }
-                report.set_guard(guard.guard.counters());
             }
             (i, request) = next_request(&mut services), if !services.is_empty() => {
                 let caller = Caller::of(&request?);
@@ -141,6 +188,14 @@ pub(crate) async fn run(
                 }
             }
         }
+    }
+}
+
+/// A twist made a command live (never, for a device not driven).
+async fn made_live(drive: Option<&Drive>) {
+    match drive {
+        Some(drive) => drive.live.notified().await,
+        None => std::future::pending().await,
     }
 }
 

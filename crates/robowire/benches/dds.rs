@@ -1,13 +1,13 @@
 //! The Go2 and the G1 over DDS on loopback (a private network namespace), beside CycloneDDS's own
 //! `ddsperf` measured in the same run with a payload of the same size (812 bytes; 1000 for the
-//! G1's 1004-byte HG LowCmd):
+//! G1's 1004-byte HG LowCmd), the two taking turns (a slice each per round):
 //!
 //! - round trip: a LowCmd published → the LowState answer received, through the simulated Go2
 //!   or G1 (which answers each applied LowCmd at once; its periodic stream slowed to 1 Hz, as
 //!   ddsperf's pong has none), one at a time; beside `ddsperf ping size N`
 //!   against `ddsperf pong`, whose printed latency is half the round trip (it divides by 2), so
 //!   it is doubled here;
-//! - one way: a LowCmd written (encode, CRC, rustdds) → decoded and verified at a reader in
+//! - one way: a LowCmd written (encode, CRC, RTPS) → decoded and verified at a reader in
 //!   another participant, beside `ddsperf`'s half round trip.
 //!
 //! - a stalled reader: the send lateness of a `go2::LowLevel` client's 500 Hz LowCmd stream
@@ -70,11 +70,11 @@ fn percentiles(mut samples: Vec<f64>) -> (f64, f64) {
     (at(50), at(99))
 }
 
-/// `ddsperf ping size SIZE` (CPU 0) against `ddsperf pong` (CPU 1) for `seconds`: the medians of
-/// its per-second p50 and p99 lines, µs (its figures: half the round trip). An unpinned ping
+/// `ddsperf ping size SIZE` (CPU 0) against `ddsperf pong` (CPU 1) for `seconds`: its per-second
+/// p50 and p99 lines, µs (its figures: half the round trip). An unpinned ping
 /// wanders onto the pong's CPU, where a round trip costs no cross-CPU wake-up (half of it ~9 µs
 /// on the development VM against ~20-35 µs across CPUs): both are pinned, as ours are.
-fn ddsperf(seconds: u32, size: usize) -> (f64, f64) {
+fn ddsperf(seconds: u32, size: usize) -> (Vec<f64>, Vec<f64>) {
     let mut pong = Command::new("taskset")
         .args(["-c", &PEER_CPU.to_string(), "ddsperf", "-D", &(seconds + 3).to_string(), "pong"])
         .stdout(Stdio::null())
@@ -101,8 +101,11 @@ fn ddsperf(seconds: u32, size: usize) -> (f64, f64) {
         }
     }
     assert!(!p50s.is_empty(), "no ddsperf latency lines:\n{text}");
-    (percentiles(p50s).0, percentiles(p99s).0)
+    (p50s, p99s)
 }
+
+/// A round's slice of ddsperf, s: its first second is often lost to discovery.
+const DDSPERF_SLICE_S: u32 = 3;
 
 /// The simulators' settings for round trips: each applied LowCmd answered at once; the 500 Hz
 /// stream slowed to 1 Hz so that the round trip is the answer alone, as ddsperf's pong is.
@@ -514,15 +517,31 @@ fn main() {
     if std::env::var_os(READER_ENV).is_some() {
         return reliable_reader();
     }
-    let seconds = if std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some() { 3 } else { 10 };
+    let quick = std::env::var_os("ROBOWIRE_BENCH_QUICK").is_some();
+    let seconds = if quick { 3 } else { 10 };
+    // The round trips: `rounds` slices of `slice_s` each.
+    let (rounds, slice_s) = if quick { (3, 1) } else { (5, 2) };
     let meta = robowire_dds::netns::for_this_process().run(|| {
-        let (half50, half99) = ddsperf(seconds, 812);
-        let (hg_half50, hg_half99) = ddsperf(seconds, 1000);
         robowire_rt::pin_current_thread(CLIENT_CPU).expect("pinning (needs 2 CPUs)");
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
-        let trips = runtime.block_on(go2_round_trips(seconds, Taker::Listener));
-        let task_trips = runtime.block_on(go2_round_trips(seconds, Taker::Task));
-        let g1_trips = runtime.block_on(g1_round_trips(seconds));
+        // ddsperf and ours take turns, each of ours right after ddsperf's slice of its size, so
+        // that the machine's slow and fast moments fall on both alike.
+        let (mut half, mut hg_half) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
+        let (mut trips, mut task_trips, mut g1_trips) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..rounds {
+            let (p50s, p99s) = ddsperf(DDSPERF_SLICE_S, 812);
+            half.0.extend(p50s);
+            half.1.extend(p99s);
+            trips.extend(runtime.block_on(go2_round_trips(slice_s, Taker::Listener)));
+            let (p50s, p99s) = ddsperf(DDSPERF_SLICE_S, 1000);
+            hg_half.0.extend(p50s);
+            hg_half.1.extend(p99s);
+            g1_trips.extend(runtime.block_on(g1_round_trips(slice_s)));
+            task_trips.extend(runtime.block_on(go2_round_trips(slice_s, Taker::Task)));
+        }
+        let median = |lines: Vec<f64>| percentiles(lines).0;
+        let (half50, half99) = (median(half.0), median(half.1));
+        let (hg_half50, hg_half99) = (median(hg_half.0), median(hg_half.1));
         let ways = one_way(seconds);
         let stalled = stalled_reader(seconds);
         #[cfg(feature = "mujoco")]
@@ -543,6 +562,8 @@ fn main() {
         );
         json!({
             "seconds": seconds,
+            "round_trip_rounds": rounds,
+            "round_trip_seconds": rounds * slice_s,
             "round_trip_us": {"p50": r50, "p99": r99, "count": trips.len()},
             "round_trip_task_us": {"p50": t50, "p99": t99, "count": task_trips.len()},
             "one_way_us": {"p50": w50, "p99": w99, "count": ways.len()},

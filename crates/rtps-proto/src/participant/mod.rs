@@ -108,13 +108,16 @@ pub struct ParticipantConfig {
     pub heartbeat_response_delay: Duration,
     /// Samples longer than this go as DATA_FRAG fragments of this size.
     pub fragment_size: u16,
+    /// A datagram carries as many fragments of a sample as fit in this many bytes (at least one).
+    pub max_message_size: usize,
     /// The memory bounds.
     pub limits: Limits,
 }
 
 impl ParticipantConfig {
     /// Defaults for `domain_id`: 3 s announcements, a 20 s lease, 100 ms heartbeats, immediate
-    /// responses, 1344-byte fragments (CycloneDDS's), the default [`Limits`]. Locators are the
+    /// responses, 1344-byte fragments in datagrams of up to 14720 bytes (CycloneDDS's), the
+    /// default [`Limits`]. Locators are the
     /// caller's to fill (the transport knows its sockets).
     pub fn new(guid_prefix: GuidPrefix, domain_id: u32) -> Self {
         Self {
@@ -134,6 +137,7 @@ impl ParticipantConfig {
             nack_response_delay: Duration::ZERO,
             heartbeat_response_delay: Duration::ZERO,
             fragment_size: 1344,
+            max_message_size: 14720,
             limits: Limits::default(),
         }
     }

@@ -247,6 +247,11 @@ impl Participant {
 
     fn poll_writer(&mut self, now: Time, w: usize, buf: &mut [u8]) -> Option<Transmit> {
         let fragment_size = usize::from(self.config.fragment_size);
+        // Fragments fill a datagram up to the message size (one at least: headers aside, a
+        // fragment and its submessage header take under 256 bytes more than its data).
+        let message_size = self.config.max_message_size.max(fragment_size + 256);
+        let len = buf.len().min(message_size);
+        let buf = &mut buf[..len];
         let prefix = self.config.guid_prefix;
         let header = self.header();
         let writer = &mut self.writers[w];
@@ -332,13 +337,17 @@ impl Participant {
                     if let Some(ts) = c.source_timestamp {
                         m.push(&Submessage::InfoTs(InfoTs { timestamp: Some(ts) })).ok()?;
                     }
-                    push_fragment(&mut m, reader.entity, id, c, fragment.max(1), fragment_size).ok()?;
-                    if fragment.max(1) >= total {
+                    let mut n = fragment.max(1);
+                    push_fragment(&mut m, reader.entity, id, c, n, fragment_size).ok()?;
+                    while n < total && push_fragment(&mut m, reader.entity, id, c, n + 1, fragment_size).is_ok() {
+                        n += 1;
+                    }
+                    if n >= total {
                         p.next_unsent = SequenceNumber(c.sequence.0 + 1);
                         p.next_fragment = 1;
                     } else {
                         p.next_unsent = c.sequence;
-                        p.next_fragment = fragment.max(1) + 1;
+                        p.next_fragment = n + 1;
                     }
                 }
                 Some(c) => {

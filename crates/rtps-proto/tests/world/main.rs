@@ -10,6 +10,7 @@ use rtps_proto::discovery::{Durability, History, Qos, Reliability};
 use rtps_proto::endpoint::{SampleIdentity, WriteError, WriteMode, WriteOptions};
 use rtps_proto::participant::{Event, LostReason, MatchError, Written};
 use rtps_proto::types::DdsDuration;
+use rtps_proto::wire::{Message, Submessage};
 use rtps_proto::{EntityId, Guid, SequenceNumber, Timestamp};
 
 const TOPIC: &str = "rt/lowstate";
@@ -149,7 +150,8 @@ fn fragmented_samples_are_reassembled_when_fragments_are_lost_and_reordered() {
 }
 
 fn fragments_with_seed(seed: u64) {
-    let mut w = World::new(2, seed);
+    // Two fragments to a datagram, so that a sample can arrive in part.
+    let mut w = World::configured(2, seed, |c| c.max_message_size = 3000);
     let now = w.now;
     let writer = w.nodes[0].participant.create_writer(now, TOPIC, TYPE, reliable(16)).unwrap();
     let reader = w.nodes[1].participant.create_reader(now, TOPIC, TYPE, reliable(16)).unwrap();
@@ -170,6 +172,34 @@ fn fragments_with_seed(seed: u64) {
         w.nodes[1].participant.reader_counters(reader),
     );
     assert_eq!(samples(&w, 1, reader), sent);
+}
+
+#[test]
+fn a_fragmented_sample_goes_in_as_few_datagrams_as_the_message_size_allows() {
+    for (max_message_size, datagrams) in [(14720, vec![3]), (3000, vec![2, 1])] {
+        let mut w = World::configured(2, 1, |c| c.max_message_size = max_message_size);
+        let now = w.now;
+        let writer = w.nodes[0].participant.create_writer(now, TOPIC, TYPE, reliable(4)).unwrap();
+        let reader = w.nodes[1].participant.create_reader(now, TOPIC, TYPE, reliable(4)).unwrap();
+        assert!(w.run(Duration::from_secs(5), |w| matched(w, 0, writer) == 1 && matched(w, 1, reader) == 1));
+        // An HG LowState's size: three 1344-byte fragments.
+        let sample = payload(1, 2096 + 1344);
+        let mut buf = vec![0u8; 65_536];
+        let now = w.now;
+        let written = w.nodes[0].participant.write(now, writer, &sample, &WriteOptions::default(), &mut buf).unwrap();
+        assert!(written.transmit.is_none());
+        let mut fragments_per_datagram = Vec::new();
+        while let Some(t) = w.nodes[0].participant.poll_transmit(now, &mut buf) {
+            let message = Message::parse(&buf[..t.len]).unwrap();
+            let fragments = message.submessages().filter(|s| matches!(s, Ok(Submessage::DataFrag(_)))).count();
+            if fragments > 0 {
+                fragments_per_datagram.push(fragments);
+            }
+            w.inject(0, &buf[..t.len], t.destinations());
+        }
+        assert_eq!(fragments_per_datagram, datagrams, "max message size {max_message_size}");
+        assert!(w.run(Duration::from_secs(1), |w| samples(w, 1, reader) == [sample.clone()]));
+    }
 }
 
 #[test]

@@ -91,6 +91,11 @@ pub(crate) fn config(i: usize) -> ParticipantConfig {
 
 impl World {
     pub(crate) fn new(n: usize, seed: u64) -> Self {
+        Self::configured(n, seed, |_| {})
+    }
+
+    /// As [`new`](Self::new), each participant's configuration changed by `change`.
+    pub(crate) fn configured(n: usize, seed: u64, change: impl Fn(&mut ParticipantConfig)) -> Self {
         let mut w = Self {
             now: Time::from_nanos(1_000_000_000),
             nodes: Vec::new(),
@@ -102,7 +107,9 @@ impl World {
             buf: vec![0; 65_536],
         };
         for i in 0..n {
-            w.add(config(i));
+            let mut c = config(i);
+            change(&mut c);
+            w.add(c);
         }
         w
     }
