@@ -1,5 +1,5 @@
-//! `docs/architecture.md` checked against the workspace: its layer table names every crate, once,
-//! and nothing else.
+//! `docs/architecture.md` and the README checked against the workspace: the layer table names
+//! every crate, once, and nothing else; the README's crate map names every crate and no other.
 
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -34,6 +34,18 @@ pub fn documented_crates(architecture: &str) -> anyhow::Result<Vec<String>> {
     Ok(crates)
 }
 
+/// The crate-like names of the README's crate map: the words of the first code block under
+/// `## The crates`.
+pub fn readme_map_words(readme: &str) -> anyhow::Result<BTreeSet<String>> {
+    let section = readme.split("\n## The crates\n").nth(1).context("no `## The crates` section")?;
+    let block = section.split("```").nth(1).context("no crate map under `## The crates`")?;
+    Ok(block
+        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+        .filter(|w| !w.is_empty())
+        .map(str::to_owned)
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -49,6 +61,18 @@ mod tests {
         let missing: Vec<_> = packages.difference(&unique).collect();
         let unknown: Vec<_> = unique.difference(&packages).collect();
         assert!(missing.is_empty() && unknown.is_empty(), "not in the table: {missing:?}; not crates: {unknown:?}");
+    }
+
+    #[test]
+    fn the_readme_crate_map_names_every_crate_and_no_other() {
+        let root = crate::workspace_root();
+        let words = readme_map_words(&std::fs::read_to_string(root.join("README.md")).unwrap()).unwrap();
+        let packages = workspace_packages(&root).unwrap();
+        let missing: Vec<_> = packages.iter().filter(|p| !words.contains(*p)).collect();
+        // Anything that looks like a crate name must be one.
+        let crate_like = |w: &&String| w.starts_with("robowire") || w.ends_with("-proto");
+        let unknown: Vec<_> = words.iter().filter(crate_like).filter(|w| !packages.contains(*w)).collect();
+        assert!(missing.is_empty() && unknown.is_empty(), "not in the map: {missing:?}; not crates: {unknown:?}");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! `cargo xtask bench`: runs the criterion benchmarks and prints one table, each figure beside
 //! its baseline measured in the same run, with the ratio and the target from the issues.
-//! Writes the table to `target/bench-report.md` and `target/bench-report.json`.
+//! Writes the table to `target/bench-report.md` and `target/bench-report.json`, and the page
+//! `docs/performance.md` ([`crate::bench_report`]).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -13,7 +14,7 @@ use crate::workspace_root;
 
 /// A criterion bench target to run: package and bench name.
 /// The latency and loop-jitter programs among them write their figures to `bench-meta-*.json`.
-const BENCHES: &[(&str, &str)] = &[
+pub(crate) const BENCHES: &[(&str, &str)] = &[
     ("kmc-proto", "codec"),
     ("kmc", "serial"),
     ("lowcmd-proto", "lowcmd"),
@@ -173,11 +174,13 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     };
     rows.extend(crate::bench_apps::physics_rows(physics.as_ref(), &dds)?);
 
-    let markdown = to_markdown(&rows);
+    let markdown = crate::bench_report::to_markdown(&rows);
     println!("\n{markdown}");
     std::fs::write(target.join("bench-report.md"), &markdown)?;
     std::fs::write(target.join("bench-report.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
-    println!("written: {} and bench-report.json", target.join("bench-report.md").display());
+    let page = root.join(crate::bench_report::PAGE);
+    std::fs::write(&page, crate::bench_report::page(&rows, quick))?;
+    println!("written: {}, bench-report.json and {}", target.join("bench-report.md").display(), page.display());
     Ok(rows)
 }
 
@@ -390,21 +393,6 @@ pub(crate) fn stalled_reader_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         });
     }
     Ok(rows)
-}
-
-/// The table as Markdown.
-pub fn to_markdown(rows: &[Row]) -> String {
-    let mut out =
-        String::from("| path | figure | baseline (same run) | ratio | target | met |\n|---|---|---|---|---|---|\n");
-    for r in rows {
-        let met = match r.met {
-            Some(true) => "yes",
-            Some(false) => "**no**",
-            None => "–",
-        };
-        out.push_str(&format!("| {} | {} | {} | {} | {} | {met} |\n", r.path, r.figure, r.baseline, r.ratio, r.target));
-    }
-    out
 }
 
 #[cfg(test)]

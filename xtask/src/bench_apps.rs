@@ -52,7 +52,6 @@ pub(crate) fn record_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         )?,
         paced_row(&meta["paced_1m_raw"], "Recorder at 1 M frames/s: 560-byte frames, raw")?,
         paced_row(&meta["paced_1m_raw_64b"], "Recorder at 1 M frames/s: 64-byte frames, raw")?,
-        paced_row(&meta["paced_1m_raw_deep"], "Recorder at 1 M frames/s: 560-byte frames, raw, a 16384-slot ring")?,
         paced_row(&meta["links_100_at_1khz"], "Recorder: 100 links × 1 kHz (560-byte frames), with JSON")?,
         paced_row(&meta["links_100_at_1khz_zstd"], "Recorder: 100 links × 1 kHz, with JSON, zstd chunks")?,
     ])

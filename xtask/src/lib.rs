@@ -6,6 +6,7 @@ pub mod architecture;
 pub mod bench;
 mod bench_apps;
 mod bench_lowcmd;
+pub mod bench_report;
 mod bench_rtps;
 pub mod fuzz;
 pub mod golden;

@@ -23,12 +23,7 @@ use robowire_dds::{Participant, ParticipantOptions};
 
 mod common;
 use common::{WAIT, pattern};
-
-/// One robot at a time (two cores).
-fn one_at_a_time() -> MutexGuard<'static, ()> {
-    static TURN: Mutex<()> = Mutex::new(());
-    robowire_rt::lock(&TURN)
-}
+use robowire_fixtures::wait::{one_at_a_time, until_async};
 
 /// What the robot's services hold.
 #[derive(Debug)]
@@ -264,14 +259,6 @@ where
     });
 }
 
-async fn until(what: &str, mut done: impl FnMut() -> bool) {
-    let start = Instant::now();
-    while !done() {
-        assert!(start.elapsed() < WAIT, "not within {WAIT:?}: {what}");
-        tokio::time::sleep(Duration::from_millis(2)).await;
-    }
-}
-
 fn refused(result: Result<(), G1Error>) -> CommandError {
     match result {
         Err(G1Error::Command(e)) => e,
@@ -296,7 +283,7 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
         assert_eq!((g1.mode_machine(), g1.variant()), (Some(5), Some(G1Variant::Dof29)));
         assert!((g1.joint_positions().unwrap()[3] - 0.03).abs() < 1e-6);
         // rt/lf/bmsstate beside it: the latest, and its topic's counters.
-        until("rt/lf/bmsstate", || g1.battery().is_some()).await;
+        until_async(WAIT, "rt/lf/bmsstate", || g1.battery().is_some()).await;
         let battery = g1.battery_handle().latest().unwrap();
         assert_eq!((battery.soc, battery.current.get(), battery.cell_vol[12].get()), (87, -3200, 4012));
         assert_eq!(battery.cell_vol[13].get(), 0);
@@ -305,7 +292,7 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
 
         // Damping before any command: the robot's mode_machine, its 29 joints.
         g1.damp().unwrap();
-        until("damping on rt/lowcmd", || !robot.received().lowcmd.is_empty()).await;
+        until_async(WAIT, "damping on rt/lowcmd", || !robot.received().lowcmd.is_empty()).await;
         let damping = robot.received().lowcmd[0];
         assert_eq!((damping.mode_machine, damping.mode_pr), (5, 0));
         for (i, m) in damping.motor_cmd.iter().enumerate() {
@@ -316,7 +303,7 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
 
         // A command: field for field as set, with the robot's mode_machine.
         let joints = pattern();
-        until("the pattern on rt/lowcmd", || {
+        until_async(WAIT, "the pattern on rt/lowcmd", || {
             g1.set_joints(&joints).unwrap();
             robot.received().lowcmd.last().is_some_and(|c| c.motor_cmd[0].kp.get() == 40.0)
         })
@@ -340,7 +327,7 @@ fn commands_wait_for_the_robots_mode_machine_and_damping_keeps_it() {
 
         // Silence from the controller: damping, mode_machine kept.
         let before = robot.received().lowcmd.len();
-        until("damping after the command went stale", || {
+        until_async(WAIT, "damping after the command went stale", || {
             robot.received().lowcmd[before..].iter().any(|c| c.motor_cmd[0].kp.get() == 0.0)
         })
         .await;
@@ -452,7 +439,7 @@ fn arm_sdk_weight_ramps_up_and_out_never_jumping_and_arm_actions_are_refused_typ
         let pose = arm_pose();
         g1.set_arm_joints(&pose).unwrap();
         g1.set_arm_weight(1.0).unwrap();
-        until("weight 1 on rt/arm_sdk", || {
+        until_async(WAIT, "weight 1 on rt/arm_sdk", || {
             g1.set_arm_joints(&pose).unwrap();
             robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[slot::ARM_SDK_WEIGHT].q.get() == 1.0)
         })
@@ -468,7 +455,10 @@ fn arm_sdk_weight_ramps_up_and_out_never_jumping_and_arm_actions_are_refused_typ
 
         // No refresh: stale after 500 ms, ramped out to 0, then idle.
         let from = robot.received().arm_sdk.len();
-        until("ramped out", || robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[29].q.get() == 0.0)).await;
+        until_async(WAIT, "ramped out", || {
+            robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[29].q.get() == 0.0)
+        })
+        .await;
         let down = weights(&robot, from - 1);
         assert!(down.len() > 100, "1 → 0 in steps of 0.01: {} frames", down.len());
         assert_eq!(g1.stats().arm_sdk_command_timeouts, 1);
@@ -477,14 +467,16 @@ fn arm_sdk_weight_ramps_up_and_out_never_jumping_and_arm_actions_are_refused_typ
         // Blend in again, then close: the weight ramps to 0 before the last frame.
         let from = robot.received().arm_sdk.len();
         g1.set_arm_joints(&pose).unwrap();
-        until("weight 0.3 again", || {
+        until_async(WAIT, "weight 0.3 again", || {
             g1.set_arm_joints(&pose).unwrap();
             robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[29].q.get() >= 0.3)
         })
         .await;
         tokio::task::spawn_blocking(move || g1.close()).await.unwrap();
-        until("the last frame", || robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[29].q.get() == 0.0))
-            .await;
+        until_async(WAIT, "the last frame", || {
+            robot.received().arm_sdk.last().is_some_and(|c| c.motor_cmd[29].q.get() == 0.0)
+        })
+        .await;
         let closing = weights(&robot, from);
         assert_eq!(*closing.last().unwrap(), 0.0);
         assert!(closing.iter().any(|&w| w >= 0.3) && closing.len() > 60, "up to 0.3 and down: {closing:?}");

@@ -3,21 +3,15 @@
 //! commands, the watchdog, CRC faults on the wire. Conditions are awaited with a generous
 //! timeout; nothing here measures time (the stream's timing is `lowcmd-proto`'s fake-clock tests).
 
-use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
 
 use go2::{Connection, Device, Go2, Go2Error, JointCommand, LowLevel, LowLevelOptions, STAND_POSE_RAD};
 use robowire_dds::netns::with_loopback_multicast;
+use robowire_fixtures::wait::{one_at_a_time, until_async};
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 const WAIT: Duration = Duration::from_secs(20);
-
-/// One 500 Hz simulator at a time (two cores).
-fn one_at_a_time() -> MutexGuard<'static, ()> {
-    static TURN: Mutex<()> = Mutex::new(());
-    robowire_rt::lock(&TURN)
-}
 
 /// `scenario` with a simulated Go2 and a connected client, in a fresh namespace.
 fn with_go2<F>(scenario: impl FnOnce(Go2Sim, LowLevel<Go2>) -> F + Send)
@@ -39,14 +33,6 @@ where
     });
 }
 
-async fn until(what: &str, mut done: impl FnMut() -> bool) {
-    let start = std::time::Instant::now();
-    while !done() {
-        assert!(start.elapsed() < WAIT, "not within {WAIT:?}: {what}");
-        tokio::time::sleep(Duration::from_millis(2)).await;
-    }
-}
-
 fn stand() -> [JointCommand; 12] {
     std::array::from_fn(|i| JointCommand::hold(STAND_POSE_RAD[i % 3], 60.0, 5.0))
 }
@@ -58,7 +44,7 @@ fn release_then_stand_up_then_damping_when_the_command_goes_stale() {
         assert_eq!(robot.connection(), Connection::Connected);
         // Before the release the robot ignores LowCmds, and says so.
         robot.set_joints(&stand()).unwrap();
-        until("a LowCmd ignored", || sim.snapshot().lowcmd.ignored_sport_mode > 0).await;
+        until_async(WAIT, "a LowCmd ignored", || sim.snapshot().lowcmd.ignored_sport_mode > 0).await;
         assert!(sim.take_log().iter().any(|l| l.contains("LowCmd ignored")));
         assert_eq!(robot.sport_mode().await.unwrap(), "normal");
         assert_eq!(robot.release_sport_mode().await.unwrap(), 1, "one ReleaseMode");
@@ -66,7 +52,7 @@ fn release_then_stand_up_then_damping_when_the_command_goes_stale() {
         assert_eq!(robot.release_sport_mode().await.unwrap(), 0, "nothing left to release");
 
         // Stand up: keep the command fresh until every joint is at the stand pose.
-        until("standing", || {
+        until_async(WAIT, "standing", || {
             robot.set_joints(&stand()).unwrap();
             robot
                 .joint_positions()
@@ -79,7 +65,7 @@ fn release_then_stand_up_then_damping_when_the_command_goes_stale() {
         assert!(sim.snapshot().lowcmd.accepted > 0 && sim.snapshot().lowcmd.bad_crc == 0);
 
         // Silence from the controller: damping takes over (kp 0): the joints are no longer held.
-        until("damping after the timeout", || robot.stats().damping_sent > 10).await;
+        until_async(WAIT, "damping after the timeout", || robot.stats().damping_sent > 10).await;
         assert_eq!(robot.stats().command_timeouts, 1);
     });
 }
@@ -114,7 +100,7 @@ fn the_watchdog_and_faults_on_the_wire() {
         assert_eq!((robot.stats().disconnects, robot.stats().reconnects), (1, 1));
 
         sim.inject(Go2Fault::BitFlips { every: 5 });
-        until("CRC errors counted", || robot.stats().lowstate.checksum_errors >= 5).await;
+        until_async(WAIT, "CRC errors counted", || robot.stats().lowstate.checksum_errors >= 5).await;
         assert_eq!(robot.stats().lowstate.decode_errors, 0, "a flipped bit is a CRC error, not garbage");
         sim.clear_faults();
 

@@ -2,12 +2,13 @@
 //! what goes over the line. Rates, the command timeout's length and the stop burst's timing are
 //! `kmc-proto`'s fake-clock tests (`kmc-proto/tests/stream.rs`); nothing here measures time.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use kmc::{
     ChassisFrame, Connection, Device, Driver, DriverOptions, KmcError, LinkState, NonFinite, Placement, RtError,
 };
 use kmc_proto::{HostFrame, PcControl};
+use robowire_fixtures::wait::until;
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 
 /// Generous: a condition that does not hold within this is a failure, not slowness.
@@ -33,30 +34,20 @@ fn controls(sim: &ChassisSim) -> Vec<PcControl> {
         .collect()
 }
 
-/// Polls `condition` every millisecond until it holds; panics with `what` after [`WATCHDOG`].
-#[track_caller]
-fn wait_until(what: &str, mut condition: impl FnMut() -> bool) {
-    let start = Instant::now();
-    while !condition() {
-        assert!(start.elapsed() < WATCHDOG, "not within {WATCHDOG:?}: {what}");
-        std::thread::sleep(Duration::from_millis(1));
-    }
-}
-
 #[test]
 fn streams_the_latched_command_and_speed_requests() {
     let sim = sim();
     let driver = Driver::open(sim.path(), never_stale()).unwrap();
     let command = PcControl::from_yaw_rate(0.5, 0.2).unwrap(); // curvature 0.4 1/m
     driver.set_command(0.5, 0.2).unwrap();
-    wait_until("50 frames of the command", || controls(&sim).iter().filter(|c| **c == command).count() >= 50);
+    until(WATCHDOG, "50 frames of the command", || controls(&sim).iter().filter(|c| **c == command).count() >= 50);
     let stats = driver.stats();
     assert!(stats.speed_requests_sent > 0);
     assert_eq!(stats.control_lateness.count, stats.control_frames_sent, "every tick measured");
     assert_eq!((stats.command_timeouts, stats.write_errors), (0, 0));
     driver.close().unwrap();
     // The stop burst is the sentinel: once it has arrived, so has everything sent before it.
-    wait_until("the stop burst after the command", || {
+    until(WATCHDOG, "the stop burst after the command", || {
         controls(&sim).ends_with(&[command, PcControl::STOP, PcControl::STOP, PcControl::STOP])
     });
     let frames = controls(&sim);
@@ -82,7 +73,7 @@ fn a_stale_command_becomes_stop_without_a_call() {
             frames[first..].iter().skip_while(|c| **c == drive).take_while(|c| **c == PcControl::STOP).count()
         })
     };
-    wait_until("20 stops after the command", || stops_after_the_command(&controls(&sim)) >= 20);
+    until(WATCHDOG, "20 stops after the command", || stops_after_the_command(&controls(&sim)) >= 20);
     let frames = controls(&sim);
     let first = frames.iter().position(|c| *c == drive).unwrap();
     let moving = frames[first..].iter().take_while(|c| **c == drive).count();
@@ -101,16 +92,16 @@ fn close_sends_the_burst_and_frees_the_port() {
     assert!(driver.is_running());
     assert_eq!(driver.link_state(), LinkState::Connected);
     driver.set_command(1.0, 0.0).unwrap();
-    wait_until("the command on the line", || controls(&sim).iter().any(|c| c.velocity_mps == 1.0));
+    until(WATCHDOG, "the command on the line", || controls(&sim).iter().any(|c| c.velocity_mps == 1.0));
     driver.close().unwrap();
     let drive = PcControl { velocity_mps: 1.0, curvature_per_m: 0.0 };
     let burst = [drive, PcControl::STOP, PcControl::STOP, PcControl::STOP];
-    wait_until("the burst after the command", || controls(&sim).ends_with(&burst));
+    until(WATCHDOG, "the burst after the command", || controls(&sim).ends_with(&burst));
     // The port is free again at once: a new driver opens it, and dropping it stops it too.
     let again = Driver::open(sim.path(), DriverOptions::default()).unwrap();
     assert_eq!(again.link_state(), LinkState::Connected);
     drop(again);
-    wait_until("the dropped driver's burst", || controls(&sim).ends_with(&[PcControl::STOP; 6]));
+    until(WATCHDOG, "the dropped driver's burst", || controls(&sim).ends_with(&[PcControl::STOP; 6]));
 }
 
 #[test]
@@ -119,16 +110,16 @@ fn unplug_is_reported_and_the_driver_reconnects() {
     let sim = ChassisSim::spawn(ChassisSimConfig { link: Some(link.clone()), ..Default::default() }).unwrap();
     let driver = Driver::open(&link, never_stale()).unwrap();
     driver.set_command(0.3, 0.0).unwrap();
-    wait_until("the command on the line", || sim.state().commanded_velocity_mps == 0.3);
+    until(WATCHDOG, "the command on the line", || sim.state().commanded_velocity_mps == 0.3);
     sim.inject(Fault::HangUp);
-    wait_until("the disconnect reported", || driver.link_state() == LinkState::Disconnected);
+    until(WATCHDOG, "the disconnect reported", || driver.link_state() == LinkState::Disconnected);
     assert_eq!(driver.stats().disconnects, 1);
     assert!(driver.is_running(), "the driver waits for the device instead of dying");
 
     sim.replug().unwrap();
-    wait_until("reconnected after the re-plug", || driver.link_state() == LinkState::Connected);
+    until(WATCHDOG, "reconnected after the re-plug", || driver.link_state() == LinkState::Connected);
     let before = sim.stats().control_frames;
-    wait_until("the stream resumed on the new line", || sim.stats().control_frames > before + 5);
+    until(WATCHDOG, "the stream resumed on the new line", || sim.stats().control_frames > before + 5);
     assert_eq!(sim.state().commanded_velocity_mps, 0.3, "with the latched command");
     assert_eq!(driver.stats().link.reopens, 1);
     driver.close().unwrap();
@@ -142,7 +133,7 @@ fn polls_and_one_shot_requests_deliver_messages() {
     driver.set_command(0.8, 0.0).unwrap();
     let (mut speeds, mut batteries, mut states) = (Vec::new(), 0, [0; 2]);
     // First-order response: the speed rises towards 0.8 m/s.
-    wait_until("speed near 0.8 m/s, the battery and all-state of both motors", || {
+    until(WATCHDOG, "speed near 0.8 m/s, the battery and all-state of both motors", || {
         while let Some(frame) = driver.try_pop_message() {
             match frame {
                 ChassisFrame::VehicleSpeed(v) => speeds.push(v.speed_mps),
@@ -160,7 +151,7 @@ fn polls_and_one_shot_requests_deliver_messages() {
     // Polls only ever ask motor 0 for the battery: an answer from motor 1 is the one-shot's.
     driver.request_battery_once(1).unwrap();
     let mut one_shot = None;
-    wait_until("the one-shot battery read answered", || {
+    until(WATCHDOG, "the one-shot battery read answered", || {
         one_shot = std::iter::from_fn(|| driver.try_pop_message())
             .find(|f| matches!(f, ChassisFrame::BatteryVoltage(b) if b.motor_id == 1));
         one_shot.is_some()
@@ -179,11 +170,11 @@ fn full_queue_drops_the_oldest_and_counts() {
     let sim = sim();
     let options = DriverOptions { max_queue: 4, vehicle_speed_rate_hz: 200.0, ..Default::default() };
     let driver = Driver::open(sim.path(), options).unwrap();
-    wait_until("frames dropped from the full queue", || driver.stats().queue_dropped > 10);
+    until(WATCHDOG, "frames dropped from the full queue", || driver.stats().queue_dropped > 10);
     // The chassis falls silent; once everything it sent has arrived, the counts stand still.
     sim.inject(Fault::DropResponses { count: u32::MAX });
-    wait_until("a response swallowed", || sim.stats().responses_dropped > 0);
-    wait_until("every response sent received", || driver.stats().frames_received == sim.stats().responses_sent);
+    until(WATCHDOG, "a response swallowed", || sim.stats().responses_dropped > 0);
+    until(WATCHDOG, "every response sent received", || driver.stats().frames_received == sim.stats().responses_sent);
     let stats = driver.stats();
     let queued = std::iter::from_fn(|| driver.try_pop_message()).count() as u64;
     assert_eq!(queued, 4, "the queue holds max_queue frames");
@@ -203,7 +194,7 @@ fn invalid_arguments_are_refused_before_anything_is_sent() {
     // A finite yaw rate so large that omega / v overflows is refused too.
     assert!(driver.set_command(0.0011, f32::MAX).is_err());
     let after = driver.stats().control_frames_sent;
-    wait_until("five more ticks", || controls(&sim).len() as u64 > after + 5);
+    until(WATCHDOG, "five more ticks", || controls(&sim).len() as u64 > after + 5);
     let frames = controls(&sim);
     assert!(frames.iter().all(|c| c.velocity_mps.is_finite() && c.curvature_per_m.is_finite()));
     assert_eq!(frames.last().unwrap().velocity_mps, 0.2, "the previous command stays");
@@ -256,11 +247,11 @@ fn a_longer_command_timeout_keeps_a_command_alive_without_refreshes() {
     driver.set_command_timeout(Duration::from_secs(10)).unwrap();
     driver.set_command(0.4, 0.0).unwrap();
     let drive = PcControl { velocity_mps: 0.4, curvature_per_m: 0.0 };
-    wait_until("100 frames of the one command", || controls(&sim).iter().filter(|c| **c == drive).count() >= 100);
+    until(WATCHDOG, "100 frames of the one command", || controls(&sim).iter().filter(|c| **c == drive).count() >= 100);
     assert_eq!(driver.stats().command_timeouts, 0, "never stale");
     // Shortened again: the same command goes stale, and (0, 0) follows.
     driver.set_command_timeout(Duration::from_millis(20)).unwrap();
-    wait_until("a stop after the timeout", || driver.stats().command_timeouts == 1);
+    until(WATCHDOG, "a stop after the timeout", || driver.stats().command_timeouts == 1);
     driver.close().unwrap();
 }
 
@@ -272,8 +263,8 @@ fn a_silent_chassis_is_noticed_and_its_return_reconnects() {
     assert!(driver.wait_state(WATCHDOG, |s| s.speed_mps.is_some()).is_some(), "speed reports arrive");
     assert_eq!(driver.connection(), Connection::Connected);
     sim.inject(Fault::DropResponses { count: 100 });
-    wait_until("disconnected", || driver.stats().state_timeouts == 1);
-    wait_until("reconnected when the chassis answers again", || driver.connection() == Connection::Connected);
+    until(WATCHDOG, "disconnected", || driver.stats().state_timeouts == 1);
+    until(WATCHDOG, "reconnected when the chassis answers again", || driver.connection() == Connection::Connected);
     assert_eq!(driver.link_state(), LinkState::Connected, "the port itself never went away");
     driver.close().unwrap();
 }

@@ -25,6 +25,7 @@ use robowire_core::cdr::CdrType;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
+use robowire_fixtures::wait::{runtime, until};
 use serde_json::{Value, json};
 
 /// Any one step's bound (discovery, a burst, an exit).
@@ -52,10 +53,6 @@ fn options() -> ParticipantOptions {
     ParticipantOptions::new(0, Some("lo"))
 }
 
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
-}
-
 /// The reader's next sample within `within`.
 fn recv<T: CdrType + 'static>(
     rt: &tokio::runtime::Runtime,
@@ -66,15 +63,6 @@ fn recv<T: CdrType + 'static>(
         let s = s.expect("a sample");
         (s.value, s.writer)
     })
-}
-
-/// Waits for `condition`, failing with `what` after [`WAIT`].
-fn until(what: &str, mut condition: impl FnMut() -> bool) {
-    let began = Instant::now();
-    while !condition() {
-        assert!(began.elapsed() < WAIT, "{what} within {WAIT:?}");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 /// `peer.py` running: its JSON lines as they come, its stdin for the words it waits for.
@@ -276,7 +264,7 @@ fn discovery(python: &Path) {
         );
 
         // We see Cyclone's participant with its USER_DATA, and its endpoints.
-        until("Cyclone's participant and endpoints discovered", || {
+        until(WAIT, "Cyclone's participant and endpoints discovered", || {
             let endpoints = ours.discovered_endpoints();
             let has = |guid: [u8; 16], is_writer: bool, topic: &str, type_name: &str| {
                 endpoints
@@ -293,7 +281,7 @@ fn discovery(python: &Path) {
         assert!(them.unicast.iter().all(|a| a.ip().is_loopback()) && !them.unicast.is_empty(), "{:?}", them.unicast);
         assert_eq!(&their_writer[..12], &their_participant[..12]);
         // Compatible QoS (Cyclone's defaults: writer reliable, reader best effort): matched.
-        until("matched both ways", || writer.reader_matched(their_reader) && reader.matched_writers() == 1);
+        until(WAIT, "matched both ways", || writer.reader_matched(their_reader) && reader.matched_writers() == 1);
         peer.finish();
     });
 }
@@ -382,7 +370,7 @@ fn exchange<Out: Message + CdrType + 'static, In: Message + CdrType + 'static>(
     let mut peer = Peer::start(python, &args);
     let matched = peer.expect("matched");
     let their_reader = guid_of(&matched["reader"]);
-    until("our writer and reader matched to Cyclone's", || {
+    until(WAIT, "our writer and reader matched to Cyclone's", || {
         writer.reader_matched(their_reader) && reader.matched_writers() == 1
     });
     if x.loss {
@@ -554,12 +542,12 @@ fn incompatible_qos(python: &Path) {
             );
         }
         assert_eq!((report["reader_matched"].as_u64(), report["writer_matched"].as_u64()), (Some(0), Some(0)));
-        until("Cyclone's endpoints discovered", || {
+        until(WAIT, "Cyclone's endpoints discovered", || {
             let endpoints = ours.discovered_endpoints();
             endpoints.iter().any(|e| e.guid == their_reader) && endpoints.iter().any(|e| e.guid == their_writer)
         });
         // robowire reports both pairs incompatible, at the discovery that would have matched them.
-        until("robowire reports the incompatible pairs", || {
+        until(WAIT, "robowire reports the incompatible pairs", || {
             !writer.incompatible_readers().is_empty() && !reader.incompatible_writers().is_empty()
         });
         for why in [writer.incompatible_readers(), reader.incompatible_writers()] {
@@ -614,7 +602,7 @@ fn leave_and_return(python: &Path) {
         // A peer that leaves cleanly is forgotten at once (its participant's dispose).
         let (first, first_guid) = flowing(python, &rt, &writer, &mut reader);
         first.finish();
-        until("the departed peer forgotten", || forgotten(&ours, &first_guid[..12]));
+        until(WAIT, "the departed peer forgotten", || forgotten(&ours, &first_guid[..12]));
         assert_eq!((writer.matched_readers(), reader.matched_writers()), (0, 0));
 
         // A new process: samples flow again.
@@ -625,7 +613,7 @@ fn leave_and_return(python: &Path) {
         // A peer killed says nothing: forgotten when its lease runs out.
         second.child.kill().unwrap();
         let killed = Instant::now();
-        until("the killed peer forgotten after its lease", || forgotten(&ours, &second_guid[..12]));
+        until(WAIT, "the killed peer forgotten after its lease", || forgotten(&ours, &second_guid[..12]));
         let after = killed.elapsed();
         assert!(after >= CYCLONE_LEASE / 2, "forgotten after {after:?}: by its lease, not before");
         eprintln!("a killed CycloneDDS peer forgotten after {after:?} (its lease: {CYCLONE_LEASE:?})");

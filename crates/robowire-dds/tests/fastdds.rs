@@ -25,6 +25,7 @@ use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
 use robowire_fixtures::interop;
+use robowire_fixtures::wait::{runtime, until};
 use serde_json::Value;
 
 /// How long anything may take to happen.
@@ -422,10 +423,6 @@ fn assert_hg_lowstate(got: &Value, sent: &HgLowState) {
 // ---------------------------------------------------------------------------------------------
 // robowire's side.
 
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
-}
-
 fn participant(domain: u16) -> Participant {
     Participant::new(ParticipantOptions::new(domain, Some("lo"))).unwrap()
 }
@@ -433,15 +430,6 @@ fn participant(domain: u16) -> Participant {
 /// The next sample of `reader` within `timeout`.
 fn recv<T: CdrType + 'static>(rt: &tokio::runtime::Runtime, reader: &mut Reader<T>, timeout: Duration) -> Option<T> {
     rt.block_on(async { tokio::time::timeout(timeout, reader.recv()).await }).ok().map(|s| s.unwrap().value)
-}
-
-/// Waits until `cond` holds; panics with `what` after [`WAIT`].
-fn wait_until(what: &str, mut cond: impl FnMut() -> bool) {
-    let began = Instant::now();
-    while !cond() {
-        assert!(began.elapsed() < WAIT, "never: {what}");
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -485,14 +473,14 @@ fn discovery_both_ways() {
             v["event"] == "publication_matched" && v["current"] == 1 && v["reader"] == reader_guid.as_str()
         });
 
-        wait_until("robowire discovers the Fast DDS endpoints", || {
+        until(WAIT, "robowire discovers the Fast DDS endpoints", || {
             knows_endpoint(&robowire, &prefix, true, LowState::TOPIC, LowState::DDS_TYPE_NAME)
                 && knows_endpoint(&robowire, &prefix, false, LowCmd::TOPIC, LowCmd::DDS_TYPE_NAME)
         });
         let fastdds = robowire.discovered_participants().into_iter().find(|p| hex(&p.guid_prefix) == prefix).unwrap();
         assert_eq!(fastdds.vendor, ([1, 0x0f], Some("eProsima Fast DDS")));
         assert!(!fastdds.unicast.is_empty(), "{fastdds:?}");
-        wait_until("robowire matches both", || commands.matched_readers() == 1 && states.matched_writers() == 1);
+        until(WAIT, "robowire matches both", || commands.matched_readers() == 1 && states.matched_writers() == 1);
         let topics = robowire.discovered_topics();
         assert!(topics.iter().any(|t| t.name == LowState::TOPIC && t.writers == 1), "{topics:?}");
         assert!(topics.iter().any(|t| t.name == LowCmd::TOPIC && t.readers == 1), "{topics:?}");
@@ -554,7 +542,7 @@ fn lowcmd_to_fastdds_reliable() {
             "sub",
             &args(&[("domain", &domain), ("type", &"go2_lowcmd"), ("depth", &20), ("expect", &20)]),
         );
-        wait_until("robowire's writer matches Fast DDS's reader", || writer.matched_readers() == 1);
+        until(WAIT, "robowire's writer matches Fast DDS's reader", || writer.matched_readers() == 1);
         for tag in 1..=20 {
             writer.write(fill_lowcmd(tag)).unwrap();
         }
@@ -647,7 +635,7 @@ fn fragmented_hg_lowstate_to_fastdds_reliable() {
             "sub",
             &args(&[("domain", &domain), ("type", &"hg_lowstate"), ("depth", &5), ("expect", &5)]),
         );
-        wait_until("robowire's writer matches Fast DDS's reader", || writer.matched_readers() == 1);
+        until(WAIT, "robowire's writer matches Fast DDS's reader", || writer.matched_readers() == 1);
         for i in 0..5 {
             writer.write(fill_hg_lowstate(i)).unwrap();
         }
@@ -786,7 +774,7 @@ fn best_effort_fastdds_writer_and_reliable_robowire_reader_do_not_match() {
         let prefix = peer.event("ready")["guid_prefix"].as_str().unwrap().to_owned();
         let incompatible = peer.event("offered_incompatible_qos");
         assert_eq!(int(&incompatible["policy"]), 11, "RELIABILITY_QOS_POLICY_ID: {incompatible}");
-        wait_until("robowire discovers the Fast DDS writer", || {
+        until(WAIT, "robowire discovers the Fast DDS writer", || {
             knows_endpoint(&robowire, &prefix, true, LowState::TOPIC, LowState::DDS_TYPE_NAME)
         });
         peer.wait("writes", |v| v["event"] == "written" && int(&v["index"]) >= 20);

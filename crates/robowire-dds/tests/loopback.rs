@@ -9,6 +9,7 @@ use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::rpc::{RpcClient, RpcServer, Service};
 use robowire_dds::{Participant, ParticipantOptions, Reader};
+use robowire_fixtures::wait::runtime;
 
 const WAIT: Duration = Duration::from_secs(20);
 
@@ -24,10 +25,6 @@ impl Service for Api {
     fn answer_id(answer: &ApiResponse) -> i64 {
         answer.id
     }
-}
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap()
 }
 
 #[test]

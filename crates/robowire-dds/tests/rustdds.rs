@@ -18,6 +18,7 @@ use robowire_core::cdr::CdrType;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader};
+use robowire_fixtures::wait::{runtime, some_async};
 use rustdds::bytes::Bytes;
 use rustdds::no_key::{DataWriter, Decode, DefaultDecoder, DeserializerAdapter, SerializerAdapter, SimpleDataReader};
 use rustdds::policy::{Durability, History, Reliability};
@@ -129,7 +130,7 @@ fn rustdds_reader<M: CdrType>(dp: &DomainParticipant, topic: &str, qos: Qos) -> 
 
 /// Waits for rustdds's writer to report matching the reader `guid`.
 async fn rustdds_writer_matched(writer: &RawWriter, guid: [u8; 16]) {
-    until("rustdds's writer matched", || {
+    some_async(WAIT, "rustdds's writer matched", || {
         std::iter::from_fn(|| writer.try_recv_status())
             .any(|s| matches!(s, DataWriterStatus::PublicationMatched { reader, .. } if reader.to_bytes() == guid))
             .then_some(())
@@ -143,25 +144,9 @@ fn take(reader: &RawReader) -> Option<(Payload, [u8; 16])> {
     Some((change.sample.clone(), change.writer_guid().to_bytes()))
 }
 
-/// Polls `f` until it gives a value; fails the test after [`WAIT`].
-async fn until<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
-    let began = Instant::now();
-    loop {
-        if let Some(value) = f() {
-            return value;
-        }
-        assert!(began.elapsed() < WAIT, "{what}: not within {WAIT:?}");
-        tokio::time::sleep(Duration::from_millis(10)).await;
-    }
-}
-
 /// The next sample of a robowire reader within [`WAIT`].
 async fn recv<T: CdrType + 'static>(reader: &mut Reader<T>, what: &str) -> robowire_dds::Sample<T> {
     tokio::time::timeout(WAIT, reader.recv()).await.unwrap_or_else(|_| panic!("{what}: nothing")).unwrap()
-}
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
 }
 
 /// A robowire participant on `lo` in `domain`.
@@ -217,13 +202,13 @@ fn discovery_both_ways() {
             let (w, r) = (cmd_writer.guid().to_bytes(), state_reader.guid().to_bytes());
 
             // robowire sees rustdds's participant, its writer and its reader.
-            let rustdds = until("robowire discovers the rustdds participant", || {
+            let rustdds = some_async(WAIT, "robowire discovers the rustdds participant", || {
                 robowire.discovered_participants().into_iter().find(|p| p.guid_prefix == prefix(w))
             })
             .await;
             assert_eq!(rustdds.vendor, ([0x01, 0x12], Some("Atostek RustDDS")));
             assert!(!rustdds.unicast.is_empty(), "{rustdds:?}");
-            until("robowire discovers rustdds's writer and reader", || {
+            some_async(WAIT, "robowire discovers rustdds's writer and reader", || {
                 (robowire_sees::<LowCmd>(&robowire, w, true, LowCmd::TOPIC)
                     && robowire_sees::<LowState>(&robowire, r, false, LowState::TOPIC))
                 .then_some(())
@@ -231,7 +216,7 @@ fn discovery_both_ways() {
             .await;
 
             // rustdds sees robowire's writer and reader, with their topics and type names.
-            until("rustdds discovers robowire's writer", || {
+            some_async(WAIT, "rustdds discovers robowire's writer", || {
                 dp.discovered_writers()
                     .iter()
                     .any(|d| {
@@ -244,7 +229,7 @@ fn discovery_both_ways() {
                     .then_some(())
             })
             .await;
-            until("rustdds discovers robowire's reader", || {
+            some_async(WAIT, "rustdds discovers robowire's reader", || {
                 dp.discovered_readers()
                     .iter()
                     .any(|d| {
@@ -257,12 +242,12 @@ fn discovery_both_ways() {
             .await;
 
             // Both sides match (Unitree's QoS: a reliable writer, a best-effort reader).
-            until("robowire's endpoints match rustdds's", || {
+            some_async(WAIT, "robowire's endpoints match rustdds's", || {
                 (state_writer.matched_readers() == 1 && cmd_reader.matched_writers() == 1).then_some(())
             })
             .await;
             let mut matched = (false, false);
-            until("rustdds's endpoints report the match", || {
+            some_async(WAIT, "rustdds's endpoints report the match", || {
                 while let Some(status) = cmd_writer.try_recv_status() {
                     if let DataWriterStatus::PublicationMatched { reader, .. } = status {
                         matched.0 |= reader.to_bytes() == cmd_reader.guid();
@@ -296,11 +281,13 @@ fn lowcmd_and_lowstate_both_ways(reliable: bool) {
         let cmd_writer = rustdds_writer::<LowCmd>(&dp, LowCmd::TOPIC, qos);
         let state_reader = rustdds_reader::<LowState>(&dp, LowState::TOPIC, qos);
 
-        until("matched", || (state_writer.matched_readers() == 1 && cmd_reader.matched_writers() == 1).then_some(()))
-            .await;
+        some_async(WAIT, "matched", || {
+            (state_writer.matched_readers() == 1 && cmd_reader.matched_writers() == 1).then_some(())
+        })
+        .await;
 
         // robowire → rustdds: written until one arrives (rustdds may match a moment later).
-        let (first, from) = until("a LowState at rustdds", || {
+        let (first, from) = some_async(WAIT, "a LowState at rustdds", || {
             state_writer.write(lowstate(0)).unwrap();
             take(&state_reader)
         })
@@ -310,7 +297,7 @@ fn lowcmd_and_lowstate_both_ways(reliable: bool) {
         assert_eq!(first.representation, [0x00, 0x01], "XCDR1 little endian");
 
         // rustdds → robowire.
-        let sample = until("a LowCmd at robowire", || {
+        let sample = some_async(WAIT, "a LowCmd at robowire", || {
             cmd_writer.write(Payload::of(&lowcmd(0)), None).unwrap();
             cmd_reader.recv().now_or_never()
         })
@@ -330,7 +317,7 @@ fn lowcmd_and_lowstate_both_ways(reliable: bool) {
             }
             let mut ticks = Vec::new();
             while ticks.last() != Some(&BURST) {
-                let (payload, _) = until("the LowState burst at rustdds", || take(&state_reader)).await;
+                let (payload, _) = some_async(WAIT, "the LowState burst at rustdds", || take(&state_reader)).await;
                 let tick = LowState::decode_cdr(&[&payload.representation[..], &[0, 0], &payload.body].concat())
                     .unwrap()
                     .0
@@ -496,14 +483,14 @@ fn a_fragmented_hg_lowstate_both_ways() {
             let raw_reader = rustdds_reader::<HgLowState>(&dp, HgLowState::TOPIC, qos);
             let expected = Payload::of(&hg_lowstate(7));
             assert_eq!(expected.body.len() + 4, 2092, "{}", expected.body.len());
-            until("matched", || {
+            some_async(WAIT, "matched", || {
                 (state_writer.matched_readers() == 1 && state_reader.matched_writers() == 1).then_some(())
             })
             .await;
             rustdds_writer_matched(&raw_writer, state_reader.guid()).await;
 
             state_writer.write(hg_lowstate(7)).unwrap();
-            let (got, from) = until("the HG LowState at rustdds", || take(&raw_reader)).await;
+            let (got, from) = some_async(WAIT, "the HG LowState at rustdds", || take(&raw_reader)).await;
             assert_eq!(from, state_writer.guid());
             assert_eq!(got, expected, "reassembled by rustdds, byte for byte");
 
@@ -558,7 +545,7 @@ fn transient_local_late_joiners_both_ways() {
             // Late: rustdds's reader joins robowire's writer, robowire's reader rustdds's writer.
             let state_reader = rustdds_reader::<LowState>(&dp, LowState::TOPIC, qos);
             let (got, from) =
-                until("robowire's kept LowState at the late rustdds reader", || take(&state_reader)).await;
+                some_async(WAIT, "robowire's kept LowState at the late rustdds reader", || take(&state_reader)).await;
             assert_eq!((got, from), (Payload::of(&lowstate(42)), state_writer.guid()), "the newest kept (depth 1)");
             let mut cmd_reader = robowire.reader::<LowCmd>(LowCmd::TOPIC, qos).unwrap();
             let sample = recv(&mut cmd_reader, "rustdds's kept LowCmd at the late robowire reader").await;
@@ -591,7 +578,7 @@ fn a_reliable_reader_and_a_best_effort_writer_do_not_match() {
             let cmd_writer = rustdds_writer::<LowCmd>(&dp, LowCmd::TOPIC, best_effort);
 
             let (mut requested, mut offered) = (None, None);
-            until("rustdds reports both incompatibilities", || {
+            some_async(WAIT, "rustdds reports both incompatibilities", || {
                 while let Some(status) = state_reader.try_recv_status() {
                     match status {
                         DataReaderStatus::RequestedIncompatibleQos { writer, last_policy_id, .. } => {
@@ -625,7 +612,7 @@ fn a_reliable_reader_and_a_best_effort_writer_do_not_match() {
 
             // robowire knows both rustdds endpoints and matches neither.
             let (w, r) = (cmd_writer.guid().to_bytes(), state_reader.guid().to_bytes());
-            until("robowire discovers rustdds's endpoints", || {
+            some_async(WAIT, "robowire discovers rustdds's endpoints", || {
                 (robowire_sees::<LowCmd>(&robowire, w, true, LowCmd::TOPIC)
                     && robowire_sees::<LowState>(&robowire, r, false, LowState::TOPIC))
                 .then_some(())
@@ -665,17 +652,17 @@ fn the_rustdds_participant_leaves_and_comes_back() {
                 let cmd_writer = rustdds_writer::<LowCmd>(&dp, LowCmd::TOPIC, qos);
                 let state_reader = rustdds_reader::<LowState>(&dp, LowState::TOPIC, qos);
                 let rustdds = prefix(cmd_writer.guid().to_bytes());
-                until("matched", || {
+                some_async(WAIT, "matched", || {
                     (state_writer.matched_readers() == 1 && cmd_reader.matched_writers() == 1).then_some(())
                 })
                 .await;
-                let (got, _) = until("a LowState at rustdds", || {
+                let (got, _) = some_async(WAIT, "a LowState at rustdds", || {
                     state_writer.write(lowstate(round)).unwrap();
                     take(&state_reader)
                 })
                 .await;
                 assert_eq!(got, Payload::of(&lowstate(round)), "round {round}");
-                let sample = until("a LowCmd at robowire", || {
+                let sample = some_async(WAIT, "a LowCmd at robowire", || {
                     cmd_writer.write(Payload::of(&lowcmd(round)), None).unwrap();
                     cmd_reader.recv().now_or_never()
                 })
@@ -687,7 +674,7 @@ fn the_rustdds_participant_leaves_and_comes_back() {
                 let began = Instant::now();
                 drop((cmd_writer, state_reader));
                 drop(dp);
-                until("robowire forgets the rustdds participant", || {
+                some_async(WAIT, "robowire forgets the rustdds participant", || {
                     let gone = !robowire.discovered_participants().iter().any(|p| p.guid_prefix == rustdds)
                         && !robowire.discovered_endpoints().iter().any(|e| prefix(e.guid) == rustdds);
                     (gone && state_writer.matched_readers() == 0 && cmd_reader.matched_writers() == 0).then_some(())

@@ -4,6 +4,7 @@
 pub mod interop;
 pub mod peers;
 pub mod rtps;
+pub mod wait;
 pub mod zsl1;
 
 use std::path::PathBuf;

@@ -1,5 +1,5 @@
-"""The READMEs' Python examples run as written, each in a fresh interpreter: the repository's
-Python section, and the recording example of the package's own README."""
+"""The Python examples of the docs run as written, each in a fresh interpreter: the repository
+README's, `docs/python.md`'s, and the recording example of the package's own README."""
 
 import re
 import subprocess
@@ -10,17 +10,16 @@ import pytest
 from conftest import REPO
 
 
-def python_blocks():
-    readme = (REPO / "README.md").read_text()
-    section = readme.split("\n## Python\n", 1)[1].split("\n## ", 1)[0]
-    return re.findall(r"```python\n(.*?)```", section, flags=re.S)
+def python_blocks(path):
+    return re.findall(r"```python\n(.*?)```", (REPO / path).read_text(), flags=re.S)
 
 
-BLOCKS = python_blocks()
+DEVICE_BLOCKS = python_blocks("docs/python.md")
+BLOCKS = python_blocks("README.md") + DEVICE_BLOCKS
 
 
-def test_the_readme_has_an_example_per_device():
-    text = "".join(BLOCKS)
+def test_the_python_docs_have_an_example_per_device():
+    text = "".join(DEVICE_BLOCKS)
     for module in ["robowire.zsl1", "robowire.kmc", "robowire.go2", "robowire.g1", "robowire.unitree", "robowire.spline"]:
         assert module in text, module
 

@@ -143,9 +143,6 @@ fn main() {
     let unpaced_json = throughput(&state, frames, 1, None, true);
     let million = throughput(&state, 2_000_000, 1, Some(1e6), false);
     let million_small = throughput(&state[..64], 2_000_000, 1, Some(1e6), false);
-    // A ring four times the default's (38 MB): 16 ms of 1 M frames/s for the writer to stall by.
-    let deep = RecorderOptions { ring_slots: 16_384, json: false, ..Default::default() };
-    let million_deep = throughput_with(&state, 2_000_000, 1, Some(1e6), deep);
     let hundred_links = throughput(&state, if quick { 100_000 } else { 1_000_000 }, 100, Some(100e3), true);
     let zstd = RecorderOptions { compression: Compression::Zstd, ..Default::default() };
     let hundred_links_zstd = throughput_with(&state, if quick { 100_000 } else { 1_000_000 }, 100, Some(100e3), zstd);
@@ -154,7 +151,7 @@ fn main() {
         "lateness_recorded_p50_us": median(&mut recorded, |r| r.0), "lateness_recorded_p99_us": median(&mut recorded, |r| r.1),
         "stream_frames_dropped": dropped,
         "frame_bytes": state.len(), "kmc_stream": kmc, "spline_stream": spline,
-        "unpaced_raw": unpaced_raw, "unpaced_json": unpaced_json, "paced_1m_raw": million, "paced_1m_raw_64b": million_small, "paced_1m_raw_deep": million_deep, "links_100_at_1khz": hundred_links, "links_100_at_1khz_zstd": hundred_links_zstd,
+        "unpaced_raw": unpaced_raw, "unpaced_json": unpaced_json, "paced_1m_raw": million, "paced_1m_raw_64b": million_small, "links_100_at_1khz": hundred_links, "links_100_at_1khz_zstd": hundred_links_zstd,
     });
     println!("record: {meta}");
     if let Ok(path) = std::env::var("ROBOWIRE_BENCH_META_RECORD") {

@@ -17,15 +17,15 @@ use crate::channels::{Channels, Placed};
 use crate::json_thread::{JsonMessage, JsonThread};
 
 /// How long the writer sleeps when the ring is empty: at 1 M frames/s, 1 000 frames arrive
-/// meanwhile (a quarter of the default ring).
+/// meanwhile (a sixteenth of the default ring).
 const POLL: Duration = Duration::from_millis(1);
 
 /// How a recorder is set up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RecorderOptions {
-    /// Slots of the taps' ring, each [`robowire_tap::SLOT_BYTES`] (the default 4096: about 9.6 MB,
-    /// 4 ms of 1 M frames/s, or 4 s of a 500 Hz link both ways, for the writer to fall behind by
-    /// before frames are dropped).
+    /// Slots of the taps' ring, each [`robowire_tap::SLOT_BYTES`] (the default 16384: about 38 MB,
+    /// 16 ms of 1 M frames/s, or 16 s of a 500 Hz link both ways, for the writer to fall behind by
+    /// before frames are dropped: enough for the page cache's stalls of the writer at 1 M frames/s).
     pub ring_slots: usize,
     /// Writes each frame's JSON message beside its raw bytes (default on); off, a capture has the
     /// raw channels only, and `robowire decode --mcap` reads them.
@@ -43,7 +43,7 @@ pub struct RecorderOptions {
 
 impl Default for RecorderOptions {
     fn default() -> Self {
-        Self { ring_slots: 4096, json: true, compression: Compression::None, profile: "", wire_only: false }
+        Self { ring_slots: 16_384, json: true, compression: Compression::None, profile: "", wire_only: false }
     }
 }
 

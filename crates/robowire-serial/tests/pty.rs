@@ -8,15 +8,12 @@ use kmc_proto::{
     AfFrame, BatteryVoltage, ChassisFrame, ChassisFrameDecoder, HostFrame, HostFrameDecoder, MAX_FRAME_LEN,
     VehicleSpeed,
 };
+use robowire_fixtures::wait::runtime;
 use robowire_serial::{Backoff, Pty, PtyDevice, SerialError, SerialLink, SerialPortOptions};
 
 /// Every test bounds its own waiting, so a broken link fails the test instead of hanging it.
 const WATCHDOG: Duration = Duration::from_secs(5);
 const POLL: Duration = Duration::from_millis(5);
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
-}
 
 fn bytes_of(frame: ChassisFrame) -> Vec<u8> {
     let mut buf = [0u8; MAX_FRAME_LEN];

@@ -6,15 +6,12 @@ mod hammer;
 use std::time::Duration;
 
 use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME_LEN, PcControl};
+use robowire_fixtures::wait::runtime;
 use robowire_serial::{Backoff, SerialError, SerialLink, SerialPortOptions};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
 
 /// Every wait is bounded, so a broken simulator fails the test instead of hanging it.
 const WATCHDOG: Duration = Duration::from_secs(5);
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
-}
 
 async fn send(link: &mut SerialLink<ChassisFrameDecoder>, frame: HostFrame) {
     let mut buf = [0u8; MAX_FRAME_LEN];

@@ -6,17 +6,12 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::{Mutex, MutexGuard};
 
 use robowire_dds::ParticipantOptions;
 use robowire_dds::netns::with_loopback_multicast;
+use robowire_fixtures::wait::one_at_a_time;
 use robowire_sim::go2::{Go2Sim, Go2SimConfig, LYING_POSE_RAD, STAND_POSE_RAD};
 use serde_json::Value;
-
-fn one_at_a_time() -> MutexGuard<'static, ()> {
-    static TURN: Mutex<()> = Mutex::new(());
-    robowire_rt::lock(&TURN)
-}
 
 /// The peers' Python, made (with the network) before entering a namespace; `None`: skipped.
 fn interop_python() -> Option<PathBuf> {

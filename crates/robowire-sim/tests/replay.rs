@@ -4,16 +4,13 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
+use robowire_fixtures::wait::runtime;
 use robowire_sim::replay::{DatagramReplay, Pace, ReplayError};
 use zsl_proto::codec::HighLevelDogCodec;
 use zsl_proto::udp::{HighLevelCommand, Model};
 
 /// Every wait is bounded, so a broken player fails the test instead of hanging it.
 const WATCHDOG: Duration = Duration::from_secs(10);
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
-}
 
 /// Frames of different lengths and contents, `step` apart.
 fn frames(count: u8, step: Duration) -> Vec<(Duration, Vec<u8>)> {

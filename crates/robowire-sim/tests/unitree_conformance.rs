@@ -15,11 +15,12 @@ mod unitree_wire;
 
 use std::time::{Duration, Instant};
 
-use conformance::{Body, Client, Simulator, State, wait_until};
+use conformance::{Body, Client, Simulator, State};
 use lowcmd_proto::Message;
 use lowcmd_proto::api::{self, motion_switcher, status};
 use lowcmd_proto::robot::Robot;
 use robowire_dds::netns::with_loopback_multicast;
+use robowire_fixtures::wait::until;
 use robowire_sim::g1::G1Sim;
 use robowire_sim::go2::{AdvanceError, Go2Fault as Fault, Go2Sim, SimClock};
 use unitree_wire::{Unsealed, WAIT};
@@ -133,8 +134,8 @@ fn faults<S: Simulator>(body: Body) {
     sim.inject(Fault::Silence);
     let silent = sim.counts();
     // The states on their way when it fell silent arrive at once; then none for 0.5 s.
-    wait_until("a 0.5 s without LowState", || c.state_within(Duration::from_millis(500)).is_none());
-    wait_until("the silent stream running 250 ticks", || sim.counts().ticks_run >= silent.ticks_run + 250);
+    until(WAIT, "a 0.5 s without LowState", || c.state_within(Duration::from_millis(500)).is_none());
+    until(WAIT, "the silent stream running 250 ticks", || sim.counts().ticks_run >= silent.ticks_run + 250);
     assert!(c.state_within(Duration::ZERO).is_none(), "a LowState while silent");
     let counts = sim.counts();
     assert_eq!(counts.lowstate.samples, silent.lowstate.samples, "written while silent");

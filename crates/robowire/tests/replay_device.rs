@@ -11,6 +11,7 @@ use std::process::Stdio;
 use std::time::Duration;
 
 use robowire_dds::netns::with_loopback_multicast;
+use robowire_fixtures::wait::runtime;
 use robowire_record::{Direction, RecordedFrame};
 use support::{Running, robowire};
 
@@ -47,10 +48,6 @@ fn record_demo(device: &str, capture: &Path) -> Vec<RecordedFrame> {
     ]
     .concat();
     robowire_record::read_frames(&std::fs::read(capture).unwrap(), &descriptions).unwrap()
-}
-
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap()
 }
 
 #[test]

@@ -2,21 +2,15 @@
 //! PD loop that moves the legs. Order and content only: the stall bound's timing is
 //! `spline_heap.rs`'s fake-clock test. One 1 kHz simulator at a time (two cores).
 
-use std::sync::{Mutex, MutexGuard};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use robowire_fixtures::wait::{one_at_a_time, until};
 use robowire_sim::spline::{STANDING_POSE_RAD, SplineSim, SplineSimConfig};
 use zsl::spline::{ImuReader, SplineError};
 use zsl::{JointControl, JointFlags, JointIndex, Leg, SplineClient, SplineCommandBlock};
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 const WATCHDOG: Duration = Duration::from_secs(20);
-
-/// Held while a simulator runs: the tests of this binary take turns.
-fn one_at_a_time() -> MutexGuard<'static, ()> {
-    static TURN: Mutex<()> = Mutex::new(());
-    robowire_rt::lock(&TURN)
-}
 
 fn sim(tag: &str) -> SplineSim {
     SplineSim::spawn(SplineSimConfig::private(tag)).expect("simulator")
@@ -27,15 +21,6 @@ fn sim(tag: &str) -> SplineSim {
 /// these tests are about.
 fn client(sim: &SplineSim, stall_after: Duration) -> SplineClient {
     SplineClient::open(&sim.config().spline_name).unwrap().with_stall_after(stall_after)
-}
-
-#[track_caller]
-fn wait_until(what: &str, mut done: impl FnMut() -> bool) {
-    let start = Instant::now();
-    while !done() {
-        assert!(start.elapsed() < WATCHDOG, "not within {WATCHDOG:?}: {what}");
-        std::thread::sleep(Duration::from_millis(1));
-    }
 }
 
 fn hold(pose: [f32; 3], kp: f32, kd: f32) -> SplineCommandBlock {
@@ -86,11 +71,11 @@ fn a_vanished_client_makes_the_daemon_clear_the_command() {
     let mut client = client(&sim, WATCHDOG);
     client.write_command(&hold(STANDING_POSE_RAD, 40.0, 1.0)).unwrap();
     let hip_enabled = |leg| JointFlags(sim.state().joint(leg, JointIndex::Hip).flags.get()).enabled();
-    wait_until("the command in force", || Leg::ALL.iter().all(|&leg| hip_enabled(leg)));
+    until(WATCHDOG, "the command in force", || Leg::ALL.iter().all(|&leg| hip_enabled(leg)));
     drop(client);
-    wait_until("the command cleared", || sim.stats().daemon.clears == 1);
+    until(WATCHDOG, "the command cleared", || sim.stats().daemon.clears == 1);
     // Cleared: the motors go limp (kp = kd = 0: disabled) in the next published state.
-    wait_until("every hip disabled", || Leg::ALL.iter().all(|&leg| !hip_enabled(leg)));
+    until(WATCHDOG, "every hip disabled", || Leg::ALL.iter().all(|&leg| !hip_enabled(leg)));
     let stats = sim.stats();
     assert_eq!(stats.daemon.clears, 1, "{stats:?}");
     assert!(stats.daemon.fresh >= 1 && stats.daemon.repeated >= 9, "ten cycles without a command: {stats:?}");
@@ -119,13 +104,13 @@ fn a_pd_loop_moves_the_legs_to_the_stand_pose() {
     // A read that finds the record being written (its version 0 while the daemon, preempted,
     // is between the two stores) is no sample this time, not a failure: read again.
     let mut sample = None;
-    wait_until("an IMU sample", || {
+    until(WATCHDOG, "an IMU sample", || {
         sample = imu.read().ok();
         sample.is_some()
     });
     let sample = sample.unwrap();
     assert_eq!(sample.acc_mps2[2], 9.81);
-    wait_until("a newer IMU sample", || imu.read().is_ok_and(|s| s.timestamp_ns > sample.timestamp_ns));
+    until(WATCHDOG, "a newer IMU sample", || imu.read().is_ok_and(|s| s.timestamp_ns > sample.timestamp_ns));
     assert!(sim.stats().cycles >= 800);
 }
 
@@ -154,9 +139,9 @@ fn a_monitor_sees_every_state_and_a_stall_without_taking_the_controllers_flag() 
     controller.wait_state(WATCHDOG).expect("the controller's own flag is still raised for it");
     assert_eq!(monitor.connection(), Connection::Connected);
     sim.pause(true);
-    wait_until("the stall noticed", || monitor.connection() == Connection::Disconnected);
+    until(WATCHDOG, "the stall noticed", || monitor.connection() == Connection::Disconnected);
     sim.pause(false);
-    wait_until("the daemon back", || monitor.connection() == Connection::Connected);
+    until(WATCHDOG, "the daemon back", || monitor.connection() == Connection::Connected);
     let stats = monitor.stats();
     assert_eq!((stats.disconnects, stats.reconnects), (1, 1), "{stats:?}");
     assert!(matches!(
@@ -186,8 +171,8 @@ fn the_daemon_and_a_monitor_record_the_same_states_and_the_daemon_each_command_t
     let mut controller = client(&sim, WATCHDOG);
     let command = hold(STANDING_POSE_RAD, 20.0, 1.0);
     controller.write_command(&command).unwrap();
-    wait_until("the command taken", || sim.stats().daemon.fresh == 1);
-    wait_until("a few states monitored", || monitor.stats().states >= 5);
+    until(WATCHDOG, "the command taken", || sim.stats().daemon.fresh == 1);
+    until(WATCHDOG, "a few states monitored", || monitor.stats().states >= 5);
     monitor.close();
     drop(sim);
 

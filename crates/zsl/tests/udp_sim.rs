@@ -7,6 +7,7 @@
 use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
+use robowire_fixtures::wait::until_async;
 use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
 use zsl::udp::{
     CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, LowLevel, MotorCommand, Placement,
@@ -30,16 +31,11 @@ async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
     assert!(matches!(mode, ControlMode::LieDown | ControlMode::Passive), "the simulated dog lies: {mode:?}");
     client.stand_up().unwrap();
     assert!(client.wait_for_mode(ControlMode::Stand, WAIT).await.is_some());
-    wait_until(|| sim.snapshot().dog.activity() == Activity::Standing).await;
+    until_async(WAIT, "sim.snapshot().dog.activity() == Activity::Standing", || {
+        sim.snapshot().dog.activity() == Activity::Standing
+    })
+    .await;
     client
-}
-
-async fn wait_until(done: impl Fn() -> bool) {
-    let start = std::time::Instant::now();
-    while !done() {
-        assert!(start.elapsed() < WAIT, "condition not reached within {WAIT:?}");
-        tokio::time::sleep(Duration::from_millis(1)).await;
-    }
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -71,7 +67,10 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 
     client.lie_down().unwrap();
     assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());
-    wait_until(|| sim.snapshot().dog.activity() == Activity::Lying).await;
+    until_async(WAIT, "sim.snapshot().dog.activity() == Activity::Lying", || {
+        sim.snapshot().dog.activity() == Activity::Lying
+    })
+    .await;
     let body = client.body().unwrap();
     assert!(body.battery_percent <= 100 && body.error.is_none());
     let stats = client.stats();
@@ -133,7 +132,7 @@ async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
     assert_eq!(latched.control_mode(), ControlMode::Move, "same mode");
     assert_eq!((latched.vx.get(), latched.yaw_rate.get()), (0.0, 0.0), "the latched motion became a stop");
     let sent = client.stats().link.sent;
-    wait_until(|| client.stats().link.sent > sent + 5).await; // the stop keeps streaming while disconnected
+    until_async(WAIT, "client.stats().link.sent > sent + 5", || client.stats().link.sent > sent + 5).await; // the stop keeps streaming while disconnected
 
     sim.clear_faults();
     tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
@@ -177,7 +176,10 @@ async fn spoofed_state_from_another_ip_is_dropped_and_never_feeds_the_watchdog()
         spoofed += 1;
         let _ = tokio::time::timeout(Duration::from_millis(20), events.changed()).await;
     }
-    wait_until(|| client.stats().link.foreign_dropped == spoofed).await;
+    until_async(WAIT, "client.stats().link.foreign_dropped == spoofed", || {
+        client.stats().link.foreign_dropped == spoofed
+    })
+    .await;
     assert_eq!(client.state(), None, "a spoofed state never lands");
     assert_eq!(client.connection(), Connection::Disconnected, "nor keeps the connection alive");
     assert_eq!(client.stats().states, 0);
@@ -207,7 +209,7 @@ async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
     let merged = client.wait_for_state(WAIT, move |s| s.body.imu.quaternion_wxyz[0] == 1.0).await.unwrap();
     assert_eq!(merged.body.mode, ControlMode::Move, "the rest of the state is kept");
     dog.send_to(&[0u8; 561], to).unwrap();
-    wait_until(|| client.stats().link.decode_errors == 1).await; // longer than the state is an error
+    until_async(WAIT, "client.stats().link.decode_errors == 1", || client.stats().link.decode_errors == 1).await; // longer than the state is an error
     let stats = client.stats();
     assert_eq!((stats.states, stats.short_states, stats.header_anomalies), (3, 2, 1), "{stats:?}");
     assert_eq!(stats.link.decode_errors, 1, "longer than the state is an error");
@@ -222,8 +224,14 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     assert!(client.wait_for_state(WAIT, move |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
     assert!(matches!(client.jump(), Err(CallError::Refused(Refusal::SelfCheck(ReturnCode::MotorFault)))));
     // The stream forces passive.
-    wait_until(|| client.wire_command().control_mode() == ControlMode::Passive).await;
-    wait_until(|| sim.snapshot().dog.mode() == ControlMode::Passive).await;
+    until_async(WAIT, "client.wire_command().control_mode() == ControlMode::Passive", || {
+        client.wire_command().control_mode() == ControlMode::Passive
+    })
+    .await;
+    until_async(WAIT, "sim.snapshot().dog.mode() == ControlMode::Passive", || {
+        sim.snapshot().dog.mode() == ControlMode::Passive
+    })
+    .await;
     sim.clear_faults();
 
     sim.inject(DogFault::Garbage);
@@ -237,12 +245,13 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
 
     sim.inject(DogFault::SdkMismatch);
     assert!(client.wait_for_state(WAIT, move |s| s.sdk_mismatch).await.is_some());
-    wait_until(|| client.halted()).await; // the stream stops for good, like the vendor's
+    until_async(WAIT, "client.halted()", || client.halted()).await; // the stream stops for good, like the vendor's
     assert!(matches!(client.stand_up(), Err(CallError::SdkMismatch)));
     // Halted, the stream's schedule has no next deadline and its thread ends after the run that
     // halted it (the flag is set after that run's sends): nothing can be sent from now on.
     let sent = client.stats().link.sent;
-    wait_until(|| sim.snapshot().high_level.commands == sent).await; // everything sent arrived
+    until_async(WAIT, "sim.snapshot().high_level.commands == sent", || sim.snapshot().high_level.commands == sent)
+        .await; // everything sent arrived
     assert_eq!(client.stats().link.sent, sent);
 }
 

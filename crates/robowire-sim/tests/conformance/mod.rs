@@ -16,6 +16,7 @@ use robowire_sim::g1::{G1Sim, G1SimConfig};
 use robowire_sim::go2::{AdvanceError, BasePose, Go2Fault as Fault, Go2Sim, Go2SimConfig, SimClock};
 
 use crate::unitree_wire::{ServiceClient, Unsealed, WAIT};
+use robowire_fixtures::wait::until;
 
 /// What moves the simulated robot's joints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -215,15 +216,6 @@ pub(crate) fn recv_within<T: CdrType + 'static>(
     runtime.block_on(async { tokio::time::timeout(bound, reader.recv()).await.ok().map(|s| s.unwrap().value) })
 }
 
-/// Waits until `done` holds, looking every millisecond; fails after [`WAIT`] naming `what`.
-pub(crate) fn wait_until(what: &str, mut done: impl FnMut() -> bool) {
-    let start = Instant::now();
-    while !done() {
-        assert!(start.elapsed() < WAIT, "{what}: not within {WAIT:?}");
-        std::thread::sleep(Duration::from_millis(1));
-    }
-}
-
 /// The other end of the wire: Unitree's side of one simulator.
 pub(crate) struct Client<S: Simulator> {
     pub(crate) runtime: tokio::runtime::Runtime,
@@ -283,7 +275,7 @@ impl<S: Simulator> Client<S> {
     /// the reader, announced before the answer's reader).
     pub(crate) fn wait_matched(&mut self) {
         let topic = <State<S> as Message>::TOPIC;
-        wait_until("the rt/lowstate writer discovered", || {
+        until(WAIT, "the rt/lowstate writer discovered", || {
             self.participant.discovered_endpoints().iter().any(|e| e.writer && e.topic == topic)
         });
         assert_eq!(self.call(api::API_VERSION_ID, "{}").0, status::OK);

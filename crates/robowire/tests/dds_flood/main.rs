@@ -75,6 +75,7 @@ mod datagrams;
 use datagrams::{
     GROUP, Rng, SPDP_WRITER, bit_flipped, near_valid_rtps, one_datagram_each, rustdds_0_15_1_trusts, submessages,
 };
+use robowire_fixtures::wait::runtime_two_workers;
 
 /// What a flood sent.
 #[derive(Debug, Default)]
@@ -489,10 +490,6 @@ fn in_private_network(body: impl FnOnce() + Send) {
     });
 }
 
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap()
-}
-
 /// Whether a new reader of `rt/lowstate` on `participant` receives states whose tick goes on.
 async fn lowstate_goes_on(participant: &Participant) -> Result<(), String> {
     let mut lowstate = participant.reader::<LowState>(LowState::TOPIC, Qos::READER).unwrap();
@@ -517,7 +514,7 @@ fn flood_a_go2(trusted_fields: bool) {
     drop(listener);
     // The simulator serves this test's participant: it has matched the participant's builtin
     // endpoints, which the flood then speaks as.
-    runtime().block_on(lowstate_goes_on(&discovery.other)).unwrap();
+    runtime_two_workers().block_on(lowstate_goes_on(&discovery.other)).unwrap();
     let before = sim.running_memory();
     let peak_reset = sim.reset_peak();
     let captured = &discovery.datagrams;
@@ -525,7 +522,7 @@ fn flood_a_go2(trusted_fields: bool) {
     let flooded = sim.running_memory();
     print_counters("this test's participant (domain 0's multicast share of the flood)", &discovery.other);
 
-    runtime().block_on(async {
+    runtime_two_workers().block_on(async {
         if let Err(stopped) = lowstate_goes_on(&participant()).await {
             let cpu = sim.cpu_by_thread();
             panic!("after the flood, {stopped}; the simulator's CPU by thread: {cpu}; it said {}", sim.output());
@@ -592,14 +589,16 @@ fn one_datagram_that_rustdds_0_15_1_trusts_does_not_silence_a_go2() {
             drop(listener);
             // Once the simulator serves this test's participant, it has matched its builtin
             // endpoints: the datagram then reaches their state, not "unmatched".
-            runtime().block_on(lowstate_goes_on(&discovery.other)).expect("rt/lowstate before the datagram");
+            runtime_two_workers()
+                .block_on(lowstate_goes_on(&discovery.other))
+                .expect("rt/lowstate before the datagram");
             let socket = UdpSocket::bind((Ipv4Addr::LOCALHOST, 0)).unwrap();
             // As each participant, to the simulator's metatraffic port (participant 0).
             for prefix in &discovery.prefixes {
                 let (_, datagram) = one_datagram_each(*prefix).into_iter().find(|(f, _)| *f == field).unwrap();
                 socket.send_to(&datagram, (Ipv4Addr::LOCALHOST, PARTICIPANT_0_PORTS[0])).unwrap();
             }
-            let streaming = runtime().block_on(lowstate_goes_on(&discovery.other));
+            let streaming = runtime_two_workers().block_on(lowstate_goes_on(&discovery.other));
             let memory = sim.memory().map_or("ended".into(), |m| m.to_string());
             println!("{field}: {streaming:?}; simulator {memory}");
             if let Err(stopped) = streaming {
@@ -620,7 +619,7 @@ fn a_flooded_ros2_bridge_still_publishes_odom_and_obeys_cmd_vel() {
         let discovery = capture_discovery(&listener);
         drop(listener);
         // The bridge serves this test's participant (it has matched its builtin endpoints).
-        runtime().block_on(async {
+        runtime_two_workers().block_on(async {
             let mut odom = discovery.other.reader::<Odometry>(&ros2_proto::topic("", "odom"), Qos::READER).unwrap();
             tokio::time::timeout(WAIT, odom.recv()).await.expect("odom before the flood").unwrap();
         });
@@ -631,7 +630,7 @@ fn a_flooded_ros2_bridge_still_publishes_odom_and_obeys_cmd_vel() {
         let flooded = bridge.running_memory();
         print_counters("this test's participant (domain 0's multicast share of the flood)", &discovery.other);
 
-        let driven = runtime().block_on(async {
+        let driven = runtime_two_workers().block_on(async {
             let participant = participant();
             let mut odom = participant.reader::<Odometry>(&ros2_proto::topic("", "odom"), Qos::READER).unwrap();
             let cmd_vel = participant.writer::<Twist>(&ros2_proto::topic("", "cmd_vel"), Qos::ROS_DEFAULT).unwrap();

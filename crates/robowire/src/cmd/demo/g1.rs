@@ -117,19 +117,19 @@ async fn stream(
     let mut ticker = tokio::time::interval(Duration::from_millis(2));
     let started = Instant::now();
     let mut seen = Swing { min: f32::INFINITY, max: f32::NEG_INFINITY };
-    let mut ticks = 0u64;
     while started.elapsed() < length {
         ticker.tick().await;
         command(started.elapsed().as_secs_f32())?;
-        ticks += 1;
         let pitch = sim.snapshot().joints_rad[slot::LEFT_ANKLE_PITCH];
         seen = Swing { min: seen.min.min(pitch), max: seen.max.max(pitch) };
         if progress.due() {
+            // The rate shown is the LowCmd stream's (its own 500 Hz thread), across phases.
+            let stream = robot.stats().low_level;
             progress.show(&Status {
                 mode,
                 motion: format!("L ankle pitch {pitch:+.3} rad"),
-                loop_count: ticks,
-                lateness_us: (robot.stats().low_level.send_lateness.p99_us, "p99"),
+                loop_count: stream.commands_sent,
+                lateness_us: (stream.send_lateness.p99_us, "p99"),
             });
         }
     }
