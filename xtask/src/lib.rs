@@ -4,14 +4,10 @@
 
 pub mod architecture;
 pub mod bench;
-mod bench_apps;
-mod bench_lowcmd;
-pub mod bench_report;
-mod bench_rtps;
 pub mod fuzz;
 pub mod golden;
-pub mod physics;
-pub mod python;
+pub mod mujoco;
+pub mod test;
 
 use std::path::PathBuf;
 

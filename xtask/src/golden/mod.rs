@@ -32,3 +32,45 @@ impl Outcome {
 pub(crate) fn to_json<T: Serialize>(value: &T) -> anyhow::Result<Value> {
     Ok(serde_json::from_str(&serde_json::to_string(value)?)?)
 }
+
+/// `cargo xtask golden [--bless]`: every suite, a line per check; an error if any failed.
+pub fn run(bless: bool) -> anyhow::Result<()> {
+    let kmc_path = kmc::kmc_fixture_path();
+    let unitree_path = unitree::vectors_path();
+    let zsl1_path = zsl1::frames_path();
+    let rtps_path = rtps::fixtures_path();
+    let suites = [
+        ("kmc", kmc::check_kmc(&kmc_path, bless)?),
+        ("unitree", unitree::check(&unitree_path)?),
+        ("zsl1", zsl1::check(&zsl1_path)?),
+        ("rtps", rtps::check(&rtps_path)?),
+    ];
+    let mut failed = 0;
+    let mut total = 0;
+    for (suite, outcomes) in &suites {
+        for outcome in outcomes {
+            total += 1;
+            let status = if !outcome.problems.is_empty() {
+                failed += 1;
+                "FAIL"
+            } else if outcome.blessed {
+                "BLESSED"
+            } else {
+                "ok"
+            };
+            println!("{suite:<8} {:<48} {status}", outcome.name);
+            for problem in &outcome.problems {
+                println!("    {problem}");
+            }
+        }
+    }
+    anyhow::ensure!(failed == 0, "{failed} of {total} golden checks failed");
+    println!(
+        "{total} golden checks passed ({}, {}, {}, {})",
+        kmc_path.display(),
+        unitree_path.display(),
+        zsl1_path.display(),
+        rtps_path.display()
+    );
+    Ok(())
+}

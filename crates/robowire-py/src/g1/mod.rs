@@ -1,6 +1,8 @@
 //! `robowire.g1`: the Unitree G1 humanoid over DDS, over the `g1` facade (`rt/lowcmd` with the
 //! robot's `mode_machine`, `rt/arm_sdk` with a ramped weight, the loco and arm services).
 
+mod services;
+
 use std::future::Future;
 use std::sync::Arc;
 
@@ -18,6 +20,7 @@ use crate::runtime::{self, seconds};
 use crate::sim::topic;
 use crate::stats::{dict, lateness};
 use crate::unitree::{PyHgLowCmd, PyHgLowState};
+use services::{ArmActions, Loco};
 
 /// The G1 variants by their Python name and joint count (Unitree's names: "27-dof" is the
 /// 29-dof body with its waist locked, "14-dof" the dual-arm G1).
@@ -80,43 +83,6 @@ fn blocking<T: Send>(py: Python<'_>, call: impl Future<Output = Result<T, G1Erro
         Some(outcome) => outcome.map_err(raise),
         None => Err(error(Kind::Timeout, "the call did not end")),
     }
-}
-
-/// Runs `call` on the client's service that `service` picks (a clone: the client's lock is not
-/// held while it waits), with the GIL released.
-fn service_call<S: Clone, T: Send, F>(
-    py: Python<'_>,
-    shared: &Shared,
-    service: impl FnOnce(&G1) -> &S,
-    call: impl FnOnce(S) -> F,
-) -> PyResult<T>
-where
-    F: Future<Output = Result<T, G1Error>> + Send,
-{
-    // The client itself is not kept while the call waits: `close()` does not wait for it.
-    let service = service(&*client(shared)?).clone();
-    blocking(py, call(service))
-}
-
-/// `#[pyclass] struct $class` (a service of the client, `$pick` picks it: the facade's
-/// `$service`) and its `call`: runs a call on the service with the GIL released.
-macro_rules! service_class {
-    ($(#[$doc:meta])* $class:ident, $service:ty, $pick:path) => {
-        $(#[$doc])*
-        #[pyclass(module = "robowire.g1", frozen)]
-        pub(crate) struct $class {
-            client: Shared,
-        }
-
-        impl $class {
-            fn call<T: Send, F>(&self, py: Python<'_>, call: impl FnOnce($service) -> F) -> PyResult<T>
-            where
-                F: Future<Output = Result<T, G1Error>> + Send,
-            {
-                service_call(py, &self.client, $pick, call)
-            }
-        }
-    };
 }
 
 /// The client, shared by the `G1` object and its `loco` and `arm` objects until `close()`.
@@ -400,156 +366,6 @@ closeable!(
     "Ramps the arm weight to 0 (at most 2 s), sends damping last, leaves the domain, then finishes its own capture. \
      Idempotent."
 );
-
-service_class!(
-    /// The G1's locomotion service (service `sport`, Unitree's `LocoClient`). Arguments are checked
-    /// before anything is sent (`ArgumentError`); a refusal is a `ServiceError` with its `code`:
-    /// 7301 (locomotion unavailable after `G1.release()`, until `G1.select_mode()`), 7302 (no such
-    /// FSM id), 7303 (no such arm task). Every call waits at most the client's `service_timeout_s`.
-    Loco, g1::Loco, G1::loco
-);
-
-#[pymethods]
-impl Loco {
-    /// GetFsmId: the controller's state (0 zero torque, 1 damp, 2 squat, 3 sit, 4 stand up,
-    /// 500 walking, …).
-    fn fsm_id(&self, py: Python<'_>) -> PyResult<i64> {
-        self.call(py, |l| async move { l.fsm_id().await })
-    }
-
-    /// GetFsmMode.
-    fn fsm_mode(&self, py: Python<'_>) -> PyResult<i64> {
-        self.call(py, |l| async move { l.fsm_mode().await })
-    }
-
-    /// SetFsmId `fsm_id`.
-    fn set_fsm(&self, py: Python<'_>, fsm_id: i64) -> PyResult<()> {
-        self.call(py, |l| async move { l.set_fsm(fsm_id).await })
-    }
-
-    /// FSM 0: zero torque (the robot falls if not held).
-    fn zero_torque(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.zero_torque().await })
-    }
-
-    /// FSM 1: damping.
-    fn damp(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.damp().await })
-    }
-
-    /// FSM 2: squat.
-    fn squat(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.squat().await })
-    }
-
-    /// FSM 3: sit.
-    fn sit(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.sit().await })
-    }
-
-    /// FSM 4: stand up (locked standing).
-    fn stand_up(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.stand_up().await })
-    }
-
-    /// FSM 500: the walking controller (where `set_velocity`, arm actions and `rt/arm_sdk` work).
-    fn start(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.start().await })
-    }
-
-    /// SetVelocity: walk at `vx_mps` forward (|vx| ≤ 1 m/s), `vy_mps` left (|vy| ≤ 0.5 m/s),
-    /// `yaw_radps` counter-clockwise (|yaw| ≤ 1 rad/s) for `duration_s` (0..=864000 s). Raises
-    /// `ArgumentError` (nothing sent) for NaN or a value out of its bound.
-    #[pyo3(signature = (vx_mps, vy_mps, yaw_radps, duration_s = 1.0))]
-    fn set_velocity(&self, py: Python<'_>, vx_mps: f32, vy_mps: f32, yaw_radps: f32, duration_s: f32) -> PyResult<()> {
-        self.call(py, |l| async move { l.set_velocity(vx_mps, vy_mps, yaw_radps, duration_s).await })
-    }
-
-    /// Stops walking: velocity 0 for 1 s (Unitree's `StopMove`).
-    fn stop_move(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |l| async move { l.stop_move().await })
-    }
-
-    /// SetBalanceMode: 0 balance stand, 1 continuous gait. Raises `ArgumentError` for another.
-    fn set_balance_mode(&self, py: Python<'_>, mode: u8) -> PyResult<()> {
-        let mode = match mode {
-            0 => g1::BalanceMode::BalanceStand,
-            1 => g1::BalanceMode::ContinuousGait,
-            other => {
-                return Err(error(
-                    Kind::Argument,
-                    format!("balance mode {other}: 0 (balance stand) or 1 (continuous gait)"),
-                ));
-            }
-        };
-        self.call(py, |l| async move { l.set_balance_mode(mode).await })
-    }
-
-    /// GetBalanceMode: 0 balance stand, 1 continuous gait.
-    fn balance_mode(&self, py: Python<'_>) -> PyResult<u8> {
-        self.call(py, |l| async move { l.balance_mode().await.map(|m| m as u8) })
-    }
-
-    /// SetStandHeight, m (0..=2).
-    fn set_stand_height(&self, py: Python<'_>, height_m: f32) -> PyResult<()> {
-        self.call(py, |l| async move { l.set_stand_height(height_m).await })
-    }
-
-    /// GetStandHeight, m.
-    fn stand_height(&self, py: Python<'_>) -> PyResult<f32> {
-        self.call(py, |l| async move { l.stand_height().await })
-    }
-
-    /// SetSwingHeight, m (0..=2).
-    fn set_swing_height(&self, py: Python<'_>, height_m: f32) -> PyResult<()> {
-        self.call(py, |l| async move { l.set_swing_height(height_m).await })
-    }
-
-    /// GetSwingHeight, m.
-    fn swing_height(&self, py: Python<'_>) -> PyResult<f32> {
-        self.call(py, |l| async move { l.swing_height().await })
-    }
-
-    /// SetArmTask `task` (wave hand 0, turning wave 1, shake hand 2 and 3).
-    fn set_arm_task(&self, py: Python<'_>, task: i64) -> PyResult<()> {
-        self.call(py, |l| async move { l.set_arm_task(task).await })
-    }
-
-    fn __repr__(&self) -> String {
-        format!("Loco(open={})", self.client.is_open())
-    }
-}
-
-service_class!(
-    /// The G1's arm action service (service `arm`, Unitree's `G1ArmActionClient`). A refusal is a
-    /// `ServiceError` with its `code`: 7400 (`rt/arm_sdk` in use: ramp its weight to 0 first), 7401
-    /// (the arms hold an action: `release_arm()`), 7402 (no such action), 7404 (actions run only in
-    /// FSM 500, 501 and 801). Every call waits at most the client's `service_timeout_s`.
-    ArmActions, g1::ArmActions, G1::arm
-);
-
-#[pymethods]
-impl ArmActions {
-    /// ExecuteAction `action_id` (Unitree's ids: 99 release the arms, 11 two-hand kiss, 15
-    /// hands up, 17 clap, 18 high five, 19 hug, 20 heart, 26 high wave, 27 shake hand, …).
-    fn execute_action(&self, py: Python<'_>, action_id: i64) -> PyResult<()> {
-        self.call(py, |a| async move { a.execute_action(action_id).await })
-    }
-
-    /// Action 99: the arms let go of a held action.
-    fn release_arm(&self, py: Python<'_>) -> PyResult<()> {
-        self.call(py, |a| async move { a.release_arm().await })
-    }
-
-    /// GetActionList: the answer's data as the robot sends it (JSON text).
-    fn action_list(&self, py: Python<'_>) -> PyResult<String> {
-        self.call(py, |a| async move { a.action_list().await })
-    }
-
-    fn __repr__(&self) -> String {
-        format!("ArmActions(open={})", self.client.is_open())
-    }
-}
 
 /// Adds the classes and constants to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

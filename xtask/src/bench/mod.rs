@@ -1,7 +1,13 @@
 //! `cargo xtask bench`: runs the criterion benchmarks and prints one table, each figure beside
 //! its baseline measured in the same run, with the ratio and the target from the issues.
 //! Writes the table to `target/bench-report.md` and `target/bench-report.json`, and the page
-//! `docs/performance.md` ([`crate::bench_report`]).
+//! `docs/performance.md` ([`report`]).
+
+mod apps;
+mod lowcmd;
+mod python;
+pub mod report;
+mod rtps;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -77,7 +83,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     // With MuJoCo here, the DDS bench measures round trips with physics on too, and the physics
     // bench runs.
     let mujoco =
-        crate::physics::lib_dir(&target).inspect_err(|missing| println!("physics benchmarks skipped: {missing}")).ok();
+        crate::mujoco::lib_dir(&target).inspect_err(|missing| println!("physics benchmarks skipped: {missing}")).ok();
     let physics_meta_path = target.join("bench-meta-physics.json");
     let physics_bench: &[(&str, &str)] = if mujoco.is_some() { &[("robowire-sim", "physics")] } else { &[] };
     for &(package, bench) in BENCHES.iter().chain(physics_bench) {
@@ -147,39 +153,39 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
         None,
     )?);
 
-    rows.extend(crate::bench_lowcmd::rows(&criterion)?);
-    rows.extend(crate::bench_rtps::rows(&criterion)?);
+    rows.extend(lowcmd::rows(&criterion)?);
+    rows.extend(rtps::rows(&criterion)?);
     let spline: Value =
         serde_json::from_str(&std::fs::read_to_string(&spline_meta_path).context("spline bench metadata")?)?;
     rows.extend(spline_rows(&spline)?);
     let udp: Value =
         serde_json::from_str(&std::fs::read_to_string(&udp_meta_path).context("ZSL-1 UDP bench metadata")?)?;
     rows.extend(zsl_udp_rows(&criterion, &udp)?);
-    rows.extend(crate::python::bench_rows(quick, &udp)?);
+    rows.extend(python::rows(quick, &udp)?);
     let streams: Value =
         serde_json::from_str(&std::fs::read_to_string(&streams_meta_path).context("streams bench metadata")?)?;
     rows.extend(stream_rows(&streams)?);
     let dds: Value = serde_json::from_str(&std::fs::read_to_string(&dds_meta_path).context("DDS bench metadata")?)?;
-    rows.extend(crate::bench_apps::dds_rows(&dds)?);
+    rows.extend(apps::dds_rows(&dds)?);
     let ros2: Value = serde_json::from_str(&std::fs::read_to_string(&ros2_meta_path).context("ROS 2 bench metadata")?)?;
-    rows.push(crate::bench_apps::ros2_row(&ros2)?);
+    rows.push(apps::ros2_row(&ros2)?);
     let record: Value =
         serde_json::from_str(&std::fs::read_to_string(&record_meta_path).context("recording bench metadata")?)?;
-    rows.extend(crate::bench_apps::record_rows(&record)?);
+    rows.extend(apps::record_rows(&record)?);
     let physics: Option<Value> = match mujoco {
         Some(_) => {
             Some(serde_json::from_str(&std::fs::read_to_string(&physics_meta_path).context("physics bench metadata")?)?)
         }
         None => None,
     };
-    rows.extend(crate::bench_apps::physics_rows(physics.as_ref(), &dds)?);
+    rows.extend(apps::physics_rows(physics.as_ref(), &dds)?);
 
-    let markdown = crate::bench_report::to_markdown(&rows);
+    let markdown = report::to_markdown(&rows);
     println!("\n{markdown}");
     std::fs::write(target.join("bench-report.md"), &markdown)?;
     std::fs::write(target.join("bench-report.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
-    let page = root.join(crate::bench_report::PAGE);
-    std::fs::write(&page, crate::bench_report::page(&rows, quick))?;
+    let page = root.join(report::PAGE);
+    std::fs::write(&page, report::page(&rows, quick))?;
     println!("written: {}, bench-report.json and {}", target.join("bench-report.md").display(), page.display());
     Ok(rows)
 }
@@ -268,15 +274,13 @@ fn zsl_udp_rows(criterion: &Path, meta: &Value) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Send lateness of every periodic stream: p50 ≤ 20 µs, p99 ≤ 100 µs (issue 13).
+/// Send lateness of every periodic stream: p50 ≤ 20 µs, p99 ≤ 100 µs.
 const STREAM_P50_US: u64 = 20;
 const STREAM_P99_US: u64 = 100;
 /// A stream's p99 against the bare loop's.
 const STREAM_P99_RATIO: f64 = 1.5;
 /// The ZSL-1 command interval at the dog: |interval − 2 ms| p99 ≤ 150 µs.
 const INTERVAL_AT_DOG_P99_US: u64 = 150;
-/// The ZSL-1 HighLevel stream before issue 13 (tokio's 1 ms timer wheel, `robowire demo`).
-const ZSL_BEFORE: &str = "before (tokio interval): p50 1076 µs, p99 1474 µs";
 
 /// `p50 / p99 / max` of a lateness summary in the metadata.
 fn percentiles_us(summary: &Value) -> anyhow::Result<(u64, u64, u64)> {
@@ -294,13 +298,10 @@ fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
         let (p50, p99, max) = percentiles_us(&stream["lateness"])?;
         let (b50, b99, bmax) = percentiles_us(&stream["bare_loop"])?;
         let ratio = p99 as f64 / b99.max(1) as f64;
-        let before = if name.starts_with("ZSL-1 HighLevel") { format!("; {ZSL_BEFORE}") } else { String::new() };
         rows.push(Row {
             path: format!("{name}: send lateness over {seconds:.0} s"),
             figure: format!("p50 {p50} µs, p99 {p99} µs, max {max} µs"),
-            baseline: format!(
-                "bare clock_nanosleep loop, same rate: p50 {b50} µs, p99 {b99} µs, max {bmax} µs{before}"
-            ),
+            baseline: format!("bare clock_nanosleep loop, same rate: p50 {b50} µs, p99 {b99} µs, max {bmax} µs"),
             ratio: format!("{ratio:.2}× (p99)"),
             target: format!("p50 ≤ {STREAM_P50_US} µs, p99 ≤ {STREAM_P99_US} µs, ≤ {STREAM_P99_RATIO}× bare (p99)"),
             met: Some(p50 <= STREAM_P50_US && p99 <= STREAM_P99_US && ratio <= STREAM_P99_RATIO),
@@ -335,7 +336,7 @@ fn stream_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
 }
 
 /// A stalled reader may raise the LowCmd stream's p99 lateness to 1.5× the healthy run's, and no
-/// send may be later than 1 ms (issue: a reader that stops reading, reliable QoS).
+/// send may be later than 1 ms (a reader that stops reading, reliable QoS).
 const STALLED_P99_RATIO: f64 = 1.5;
 const STALLED_MAX_US: u64 = 1000;
 

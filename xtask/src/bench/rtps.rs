@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::Context;
 use serde_json::Value;
 
-use crate::bench::{Row, mean_ns};
+use super::{Row, mean_ns};
 
 /// The criterion group of `crates/rtps-proto/benches/rtps.rs`.
 const GROUP: &str = "rtps";

@@ -29,38 +29,7 @@ use robowire_core::BufferTooSmall;
 use robowire_core::cdr::{CdrEncoding, CdrError, CdrReader, CdrWriter};
 
 /// Service names and API ids of `motion_switcher` (API version "1.0.0.1").
-pub mod motion_switcher {
-    /// Service name: topics `rt/api/motion_switcher/request` and `/response`.
-    pub const SERVICE: &str = "motion_switcher";
-    /// API version.
-    pub const API_VERSION: &str = "1.0.0.1";
-    /// CheckMode: parameter `{}`; data `{"form":"0","name":"<mode>"}`, name empty when no sport
-    /// mode owns the motors.
-    pub const CHECK_MODE: i64 = 1001;
-    /// SelectMode: parameter `{"name":"<mode>"}`.
-    pub const SELECT_MODE: i64 = 1002;
-    /// ReleaseMode: parameter `{}`.
-    pub const RELEASE_MODE: i64 = 1003;
-    /// SetSilent.
-    pub const SET_SILENT: i64 = 1004;
-    /// GetSilent.
-    pub const GET_SILENT: i64 = 1005;
-
-    pub use super::mode_name;
-
-    /// The CheckMode answer's data for `name` (empty: no sport mode owns the motors).
-    pub fn check_mode_data(name: &str) -> impl core::fmt::Display + '_ {
-        CheckModeData(name)
-    }
-
-    struct CheckModeData<'a>(&'a str);
-
-    impl core::fmt::Display for CheckModeData<'_> {
-        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-            write!(f, r#"{{"form":"0","name":"{}"}}"#, self.0)
-        }
-    }
-}
+pub mod motion_switcher;
 
 /// The mode name in a CheckMode answer (`{"form":"0","name":"normal"}`) or a SelectMode
 /// parameter (`{"name":"ai"}`): the string value of `"name"` in a flat JSON object (no
@@ -79,120 +48,16 @@ pub fn mode_name(json: &str) -> Option<&str> {
 }
 
 /// Service name and the API ids of `sport` that robowire uses (API version "1.0.0.1").
-pub mod sport {
-    /// Service name.
-    pub const SERVICE: &str = "sport";
-    /// API version.
-    pub const API_VERSION: &str = "1.0.0.1";
-    /// Damp.
-    pub const DAMP: i64 = 1001;
-    /// BalanceStand.
-    pub const BALANCE_STAND: i64 = 1002;
-    /// StopMove.
-    pub const STOP_MOVE: i64 = 1003;
-    /// StandUp.
-    pub const STAND_UP: i64 = 1004;
-    /// StandDown (lie down before the sport mode is released).
-    pub const STAND_DOWN: i64 = 1005;
-}
+pub mod sport;
 
 /// The G1's locomotion service (Unitree's `LocoClient`): service `sport` like the Go2's, but
 /// its own API (version "1.0.0.0") and ids. Parameters and data are JSON, `{"data": …}` unless
 /// said otherwise.
-pub mod g1_loco {
-    /// Service name (the same topics as the Go2's `sport`).
-    pub const SERVICE: &str = "sport";
-    /// API version.
-    pub const API_VERSION: &str = "1.0.0.0";
-    /// GetFsmId: data `{"data": id}`.
-    pub const GET_FSM_ID: i64 = 7001;
-    /// GetFsmMode: data `{"data": mode}`.
-    pub const GET_FSM_MODE: i64 = 7002;
-    /// GetBalanceMode: data `{"data": mode}`.
-    pub const GET_BALANCE_MODE: i64 = 7003;
-    /// GetSwingHeight: data `{"data": m}`.
-    pub const GET_SWING_HEIGHT: i64 = 7004;
-    /// GetStandHeight: data `{"data": m}`.
-    pub const GET_STAND_HEIGHT: i64 = 7005;
-    /// GetPhase (deprecated by Unitree).
-    pub const GET_PHASE: i64 = 7006;
-    /// SetFsmId: parameter `{"data": id}` (see [`fsm`]).
-    pub const SET_FSM_ID: i64 = 7101;
-    /// SetBalanceMode: `{"data": 0}` balance stand, `1` continuous gait.
-    pub const SET_BALANCE_MODE: i64 = 7102;
-    /// SetSwingHeight: `{"data": m}`.
-    pub const SET_SWING_HEIGHT: i64 = 7103;
-    /// SetStandHeight: `{"data": m}`.
-    pub const SET_STAND_HEIGHT: i64 = 7104;
-    /// SetVelocity: `{"velocity": [vx m/s, vy m/s, yaw rad/s], "duration": s}`.
-    pub const SET_VELOCITY: i64 = 7105;
-    /// SetArmTask: `{"data": task}` (wave hand 0, turning wave 1, shake hand 2 and 3).
-    pub const SET_ARM_TASK: i64 = 7106;
-    /// SetSpeedMode: `{"data": mode}`.
-    pub const SET_SPEED_MODE: i64 = 7107;
-    /// SwitchToUserCtrl: `{"data": bool}`.
-    pub const SWITCH_TO_USER_CTRL: i64 = 7110;
-    /// SwitchToInternalCtrl: `{"data": 0}` last, `1` passive, `2` walk/run.
-    pub const SWITCH_TO_INTERNAL_CTRL: i64 = 7111;
-
-    /// Error codes of the service.
-    pub mod error {
-        /// The locomotion state is not available (no mode selected: after ReleaseMode).
-        pub const LOCO_STATE_UNAVAILABLE: i32 = 7301;
-        /// An FSM id the controller does not have.
-        pub const INVALID_FSM_ID: i32 = 7302;
-        /// A task id the controller does not have.
-        pub const INVALID_TASK_ID: i32 = 7303;
-    }
-
-    /// FSM ids of `SetFsmId` (Unitree's C++ `LocoClient`).
-    pub mod fsm {
-        /// Zero torque.
-        pub const ZERO_TORQUE: i64 = 0;
-        /// Damping.
-        pub const DAMP: i64 = 1;
-        /// Squat.
-        pub const SQUAT: i64 = 2;
-        /// Sit.
-        pub const SIT: i64 = 3;
-        /// Stand up (locked standing).
-        pub const STAND_UP: i64 = 4;
-        /// The walking controller ("Start"); `rt/arm_sdk` is blended in 500, 501 and 801.
-        pub const START: i64 = 500;
-    }
-}
+pub mod g1_loco;
 
 /// The G1's arm action service (Unitree's `G1ArmActionClient`): service `arm`, API version
 /// "1.0.0.14".
-pub mod g1_arm {
-    /// Service name.
-    pub const SERVICE: &str = "arm";
-    /// API version.
-    pub const API_VERSION: &str = "1.0.0.14";
-    /// ExecuteAction: `{"data": action}` (Unitree's Python SDK; its C++ SDK names the key
-    /// `action_id`: the robot is sent both).
-    pub const EXECUTE_ACTION: i64 = 7106;
-    /// GetActionList: data the action list.
-    pub const GET_ACTION_LIST: i64 = 7107;
-    /// ExecuteCustomAction: `{"action_name": name}`.
-    pub const EXECUTE_CUSTOM_ACTION: i64 = 7108;
-    /// StopCustomAction.
-    pub const STOP_CUSTOM_ACTION: i64 = 7113;
-    /// The action that releases the arms (ends a holding action).
-    pub const RELEASE_ARM: i64 = 99;
-
-    /// Error codes of the service.
-    pub mod error {
-        /// `rt/arm_sdk` is in use: no action runs meanwhile.
-        pub const ARM_SDK_OCCUPIED: i32 = 7400;
-        /// The arms hold an action: release them (action 99) first.
-        pub const HOLDING: i32 = 7401;
-        /// No such action.
-        pub const INVALID_ACTION_ID: i32 = 7402;
-        /// Actions run only in FSM 500, 501 and 801 (the walking controllers).
-        pub const INVALID_FSM_ID: i32 = 7404;
-    }
-}
+pub mod g1_arm;
 
 /// The internal API every service answers: its API version.
 pub const API_VERSION_ID: i64 = 1;
@@ -462,49 +327,4 @@ mod owned {
 pub use owned::{ApiRequest, ApiResponse};
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn request_layout_by_the_cdr_rules() {
-        let request = Request {
-            header: RequestHeader { id: 0x0102, api_id: 1001, lease_id: 0, priority: 3, noreply: true },
-            parameter: "{}",
-            binary: &[9, 8],
-        };
-        let mut body = [0xAAu8; 64];
-        let n = request.encode_body(&mut body).unwrap();
-        let expected: &[u8] = &[
-            0x02, 0x01, 0, 0, 0, 0, 0, 0, // id
-            0xE9, 0x03, 0, 0, 0, 0, 0, 0, // api_id 1001
-            0, 0, 0, 0, 0, 0, 0, 0, // lease
-            3, 0, 0, 0, // priority
-            1, 0, 0, 0, // noreply, then alignment for the string length
-            3, 0, 0, 0, b'{', b'}', 0, // "{}" with its NUL
-            0, // alignment
-            2, 0, 0, 0, 9, 8, // binary
-        ];
-        assert_eq!(&body[..n], expected);
-        assert_eq!(Request::decode_body(expected), Ok(request));
-        assert_eq!(request.body_len(), expected.len());
-    }
-
-    #[test]
-    fn response_round_trip_and_errors() {
-        let header = RequestHeader::call(42, motion_switcher::CHECK_MODE);
-        let response = Response::to(&header, status::OK, r#"{"form":"0","name":"normal"}"#);
-        let mut body = [0u8; 128];
-        let n = response.encode_body(&mut body).unwrap();
-        assert_eq!(Response::decode_body(&body[..n]), Ok(response));
-        // Padding after the last field is fine; more is not.
-        assert!(Response::decode_body(&body[..n + 3]).is_ok());
-        assert_eq!(Response::decode_body(&body[..n + 8]), Err(ApiError::Trailing { extra: 8 }));
-        assert!(matches!(Response::decode_body(&body[..n - 1]), Err(ApiError::Truncated { field: "binary", .. })));
-        let mut short = [0u8; 8];
-        assert_eq!(response.encode_body(&mut short), Err(BufferTooSmall { needed: n, available: 8 }));
-        // A string without its NUL.
-        let mut bad = body;
-        bad[20 + 4 + response.data.len()] = b'x';
-        assert_eq!(Response::decode_body(&bad[..n]), Err(ApiError::NoNul { field: "data" }));
-    }
-}
+mod tests;

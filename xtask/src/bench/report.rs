@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use crate::bench::{BENCHES, Row};
+use super::{BENCHES, Row};
 
 /// The page the run writes, relative to the workspace root.
 pub const PAGE: &str = "docs/performance.md";

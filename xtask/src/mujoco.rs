@@ -107,3 +107,17 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// `cargo xtask mujoco`: fetches the library and prints the exports that build and run with it.
+pub fn run() -> anyhow::Result<()> {
+    let root = crate::workspace_root();
+    let dir = fetch(Path::new("python3"), &crate::test::target_dir(&root))?;
+    let dir = dir.canonicalize()?;
+    eprintln!("MuJoCo {} in {}; for physics (`--features mujoco`):", MUJOCO_VERSION, dir.display());
+    // The exports alone on stdout, for `eval "$(cargo xtask mujoco)"`.
+    println!(
+        "export MUJOCO_DYNAMIC_LINK_DIR={0} LD_LIBRARY_PATH={0}${{LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}}",
+        dir.display()
+    );
+    Ok(())
+}

@@ -4,7 +4,7 @@
 use anyhow::Context;
 use serde_json::Value;
 
-use crate::bench::Row;
+use super::Row;
 
 /// The bridge's `cmd_vel` → datagram against the sum of its legs (p50).
 const CMD_VEL_LEGS_RATIO: f64 = 1.2;
@@ -219,6 +219,6 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             met: Some(ratio <= DDS_ROUND_TRIP_RATIO),
         });
     }
-    rows.extend(crate::bench::stalled_reader_rows(&meta["stalled_reader"])?);
+    rows.extend(super::stalled_reader_rows(&meta["stalled_reader"])?);
     Ok(rows)
 }

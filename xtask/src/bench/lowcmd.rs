@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::bench::{Row, mean_ns};
+use super::{Row, mean_ns};
 
 /// Rows of the Unitree LowCmd/LowState benchmarks (Go2, then HG).
 pub(crate) fn rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
