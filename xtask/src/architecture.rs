@@ -76,6 +76,22 @@ mod tests {
     }
 
     #[test]
+    fn a_kmc_only_build_of_robowire_devices_links_no_dds_and_no_capture_library() {
+        let out = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+            .args(["tree", "-p", "robowire-devices", "--no-default-features", "--features", "kmc"])
+            .args(["-e", "normal", "--prefix", "none", "--offline"])
+            .current_dir(crate::workspace_root())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let tree = String::from_utf8_lossy(&out.stdout);
+        assert!(tree.contains("kmc v"), "{tree}");
+        for heavy in ["rustdds", "robowire-dds", "rtps-proto", "mcap", "zstd", "lz4"] {
+            assert!(!tree.lines().any(|l| l.starts_with(&format!("{heavy} v"))), "{heavy} in:\n{tree}");
+        }
+    }
+
+    #[test]
     fn the_table_parser_reads_the_crates_column() {
         let text = "# x\n\n## The layers\n\n| layer | crates | owns |\n|---|---|---|\n| codec | `a`, `b` | bytes |\n| app | `c` | `not-a-crate` |\n\nafter";
         assert_eq!(documented_crates(text).unwrap(), ["a", "b", "c"]);

@@ -19,7 +19,7 @@ pub use loco::{
     BalanceMode, HEIGHT_MAX_M, Loco, VELOCITY_DURATION_MAX_S, VX_MAX_MPS, VY_MAX_MPS, Velocity, YAW_RATE_MAX_RADPS,
 };
 pub use lowcmd_proto::bms::HgBmsState;
-pub use lowcmd_proto::g1::{ARM_SDK_JOINTS, DEFAULT_GAINS, G1Variant, JOINT_LIMITS, JOINT_NAMES, JOINTS, ModePr};
+pub use lowcmd_proto::g1::{ARM_SDK_JOINTS, DEFAULT_GAINS, G1Variant, JOINT_LIMITS, JOINT_NAMES, JOINTS, ModePr, slot};
 pub use lowcmd_proto::robot::CommandError;
 pub use lowcmd_proto::{HgLowCmd, HgLowState};
 pub use options::G1Options;

@@ -1,33 +1,41 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
+// A build without any device kind opens nothing: what serves the kinds is unused there.
+#![cfg_attr(
+    not(any(feature = "kmc", feature = "zsl1", feature = "unitree")),
+    allow(dead_code, unused_variables, unreachable_code)
+)]
 
 mod address;
-mod g1;
-mod kmc;
+mod kinds;
 mod link;
 mod observation;
 #[cfg(feature = "sim")]
 mod sim;
-mod spline;
-mod unitree;
-mod zsl;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::time::Duration;
 
 pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
+#[cfg(feature = "kmc")]
+pub use kinds::kmc::kmc_taps;
+#[cfg(feature = "zsl1")]
+pub use kinds::spline::{SPLINE_IMU_LINK, SPLINE_LINK};
+#[cfg(feature = "zsl1")]
+pub use kinds::zsl1::state_line as zsl_state_line;
 pub use link::{Describe, Observations, StateChanges};
 pub use observation::{BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough};
 pub use robowire_rt::device::Connection;
 #[cfg(feature = "sim")]
 pub use sim::Simulator;
-pub use zsl::state_line as zsl_state_line;
 
 use link::Link;
-use robowire_core::json::LinkProtocol;
-use robowire_record::RecordLinks;
+use robowire_tap::RecordLinks;
 use serde_json::Value;
 use tokio::sync::watch;
+
+/// The ZSL-1's default `target_port`: where the robot sends its state (`sdk_config.yaml`).
+const ZSL_LOCAL_PORT: u16 = 43988;
 
 /// How [`open`] reaches a device, beyond its address.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -58,7 +66,7 @@ impl Default for OpenOptions {
         Self {
             domain: 0,
             sim_interface: None,
-            zsl_local: SocketAddr::new(IpAddr::V4(Ipv4Addr::UNSPECIFIED), zsl_proto::udp::DEFAULT_LOCAL_PORT),
+            zsl_local: SocketAddr::new(IpAddr::V4(Ipv4Addr::UNSPECIFIED), ZSL_LOCAL_PORT),
             kmc_polls: true,
             state_timeout: None,
             record: None,
@@ -75,21 +83,27 @@ pub enum DeviceError {
     #[error(transparent)]
     Address(#[from] AddressError),
     /// The KMC chassis.
+    #[cfg(feature = "kmc")]
     #[error("KMC chassis")]
     Kmc(#[from] ::kmc::KmcError),
     /// A ZSL-1 could not be reached.
+    #[cfg(feature = "zsl1")]
     #[error("ZSL-1 client")]
     ZslConnect(#[from] ::zsl::udp::ConnectError),
     /// A ZSL-1 call did not go out.
+    #[cfg(feature = "zsl1")]
     #[error("ZSL-1 call")]
     ZslCall(#[from] ::zsl::udp::CallError),
     /// A Unitree robot's client.
+    #[cfg(feature = "unitree")]
     #[error("Unitree low-level client")]
     Unitree(#[from] go2::Go2Error),
     /// A Unitree G1's client.
+    #[cfg(feature = "unitree")]
     #[error("Unitree G1 client")]
     G1(#[from] ::g1::G1Error),
     /// The spline daemon's shared memory.
+    #[cfg(feature = "zsl1")]
     #[error("spline shared memory")]
     Spline(#[from] ::zsl::SplineError),
     /// A simulator could not start.
@@ -100,6 +114,16 @@ pub enum DeviceError {
         /// Why.
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// A device kind this build leaves out (its feature of robowire-devices is off).
+    #[error("{address}: this build has no {kind} devices (the `{feature}` feature of robowire-devices is off)")]
+    NotBuilt {
+        /// The address.
+        address: DeviceAddress,
+        /// The kind.
+        kind: &'static str,
+        /// The feature that builds it.
+        feature: &'static str,
     },
     /// A `sim:` address in a build without the `sim` feature.
     #[error("{address}: this build has no simulators (the `sim` feature of robowire-devices is off)")]
@@ -166,26 +190,9 @@ impl std::fmt::Debug for AnyDevice {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
-    let link: Box<dyn Link> = match address {
-        DeviceAddress::Kmc(path) => Box::new(::kmc::Driver::open(path, kmc_options(options))?),
-        DeviceAddress::Zsl1(ip) | DeviceAddress::Zsl1w(ip) => {
-            let model = if matches!(address, DeviceAddress::Zsl1w(_)) {
-                ::zsl::udp::Model::Zsl1W
-            } else {
-                ::zsl::udp::Model::Zsl1
-            };
-            let client = ::zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), *ip);
-            Box::new(::zsl::udp::HighLevel::open(zsl_options(client, model, options))?)
-        }
-        DeviceAddress::Go2(interface) => {
-            Box::new(go2::LowLevel::<go2::Go2>::open(go2_options::<go2::Go2>(Some(interface), options))?)
-        }
-        DeviceAddress::Hg(interface) => {
-            Box::new(go2::LowLevel::<go2::Hg>::open(go2_options::<go2::Hg>(Some(interface), options))?)
-        }
-        DeviceAddress::G1(interface) => Box::new(::g1::G1::open(g1_options(Some(interface), options))?),
-        DeviceAddress::Spline(name) => Box::new(::zsl::spline::SplineMonitor::open(spline_options(name, options))?),
+    let link = match address {
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
+        _ => kinds::open(address, options)?,
     };
     Ok(AnyDevice {
         address: address.clone(),
@@ -193,86 +200,6 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
         #[cfg(feature = "sim")]
         simulator: None,
     })
-}
-
-fn kmc_options(options: &OpenOptions) -> ::kmc::DriverOptions {
-    let defaults = ::kmc::DriverOptions::default();
-    let record = options.record.as_ref();
-    ::kmc::DriverOptions {
-        poll_battery: options.kmc_polls,
-        poll_allstate: options.kmc_polls,
-        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
-        taps: record.map(|r| kmc_taps(r, &kmc_proto::description::HOST)).unwrap_or_default(),
-        ..defaults
-    }
-}
-
-/// The taps of a KMC serial line recorded with `record`: its frames as `kmc/serial`, described by
-/// `side` (`kmc_proto::description::HOST` at the host, `CHASSIS` at a chassis), and the bytes the
-/// decoder skipped as `kmc/serial_skipped` (`robowire_core::json::SKIPPED_BYTES`).
-pub fn kmc_taps(record: &RecordLinks, side: &'static LinkProtocol) -> robowire_serial::SerialTaps {
-    robowire_serial::SerialTaps {
-        frames: Some(record.link("kmc/serial", side)),
-        skipped: Some(record.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES)),
-    }
-}
-
-/// The link `/spline_shm` is recorded as, seen by the controller or a monitor
-/// (`zsl_proto::description::SPLINE_CLIENT`).
-pub const SPLINE_LINK: &str = "spline/spline";
-/// The link `/imu_shm` is recorded as, seen by a reader (`zsl_proto::description::IMU`).
-pub const SPLINE_IMU_LINK: &str = "spline/imu";
-
-fn spline_options(name: &str, options: &OpenOptions) -> ::zsl::spline::SplineMonitorOptions {
-    let monitor = ::zsl::spline::SplineMonitorOptions::new(name);
-    match &options.record {
-        Some(record) => monitor.with_tap(record.link(SPLINE_LINK, &zsl_proto::description::SPLINE_CLIENT)),
-        None => monitor,
-    }
-}
-
-fn zsl_options(
-    client: ::zsl::udp::ClientOptions,
-    model: ::zsl::udp::Model,
-    options: &OpenOptions,
-) -> ::zsl::udp::ClientOptions {
-    let watchdog = options.state_timeout.unwrap_or(client.watchdog);
-    let client = client.with_model(model).with_watchdog(watchdog);
-    match &options.record {
-        Some(record) => client.with_tap(record.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
-        None => client,
-    }
-}
-
-fn go2_options<R: unitree::Family>(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
-    unitree_options(interface, options, R::RECORDED_AS, R::LOW_LEVEL)
-}
-
-/// A G1 client's options: the HG low level, recorded as `g1/low_level`, `g1/api` and
-/// `g1/arm_sdk`.
-fn g1_options(interface: Option<&str>, options: &OpenOptions) -> ::g1::G1Options {
-    let hg = &lowcmd_proto::description::HG_LOW_LEVEL;
-    let low_level = unitree_options(interface, options, "g1", hg);
-    let arm_sdk_tap = options.record.as_ref().map(|r| r.link("g1/arm_sdk", hg));
-    ::g1::G1Options { low_level, arm_sdk_tap, ..::g1::G1Options::default() }
-}
-
-/// A Unitree low-level client's options: the domain, the state timeout, and with a recorder its
-/// links `{recorded_as}/low_level` (described by `low_level`) and `{recorded_as}/api`.
-fn unitree_options(
-    interface: Option<&str>,
-    options: &OpenOptions,
-    recorded_as: &str,
-    low_level: &'static dyn robowire_core::json::LinkDescription,
-) -> go2::LowLevelOptions {
-    let defaults = go2::LowLevelOptions::on(interface, options.domain);
-    let record = options.record.as_ref();
-    go2::LowLevelOptions {
-        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
-        low_level_tap: record.map(|r| r.link(&format!("{recorded_as}/low_level"), low_level)),
-        services_tap: record.map(|r| r.link(&format!("{recorded_as}/api"), &lowcmd_proto::description::API_CLIENT)),
-        ..defaults
-    }
 }
 
 #[cfg(feature = "sim")]
@@ -403,31 +330,37 @@ impl AnyDevice {
         self.link().call(service)
     }
 
+    #[cfg(feature = "kmc")]
     /// The KMC driver, if this is a chassis.
     pub fn kmc(&self) -> Option<&::kmc::Driver> {
         self.link().as_any().downcast_ref()
     }
 
+    #[cfg(feature = "zsl1")]
     /// The ZSL-1 HighLevel client, if this is a ZSL-1 or ZSL-1W.
     pub fn zsl(&self) -> Option<&::zsl::udp::HighLevel> {
         self.link().as_any().downcast_ref()
     }
 
+    #[cfg(feature = "unitree")]
     /// The Go2 low-level client, if this is a Go2.
     pub fn go2(&self) -> Option<&go2::LowLevel<go2::Go2>> {
         self.link().as_any().downcast_ref()
     }
 
+    #[cfg(feature = "unitree")]
     /// The HG low-level client, if this is an HG robot opened as `hg:`.
     pub fn hg(&self) -> Option<&go2::LowLevel<go2::Hg>> {
         self.link().as_any().downcast_ref()
     }
 
+    #[cfg(feature = "unitree")]
     /// The G1 client, if this is a G1 (`g1:`, `sim:g1`).
     pub fn g1(&self) -> Option<&::g1::G1> {
         self.link().as_any().downcast_ref()
     }
 
+    #[cfg(feature = "zsl1")]
     /// The spline monitor, if this is a spline daemon.
     pub fn spline(&self) -> Option<&::zsl::spline::SplineMonitor> {
         self.link().as_any().downcast_ref()
@@ -454,28 +387,5 @@ impl AnyDevice {
         #[cfg(feature = "sim")]
         drop(self.simulator);
         closed
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_state_timeout_reaches_every_facade_and_none_keeps_their_defaults() {
-        let quick = OpenOptions { state_timeout: Some(Duration::from_millis(250)), ..OpenOptions::default() };
-        let zsl_client = || ::zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
-
-        assert_eq!(kmc_options(&quick).state_timeout, Duration::from_millis(250));
-        assert_eq!(zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &quick).watchdog, Duration::from_millis(250));
-        assert_eq!(go2_options::<go2::Go2>(Some("lo"), &quick).state_timeout, Duration::from_millis(250));
-        assert_eq!(g1_options(Some("lo"), &quick).low_level.state_timeout, Duration::from_millis(250));
-
-        let default = OpenOptions::default();
-        assert_eq!(kmc_options(&default).state_timeout, ::kmc::DriverOptions::default().state_timeout);
-        let zsl = zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &default);
-        assert_eq!((zsl.watchdog, zsl.model), (zsl_client().watchdog, ::zsl::udp::Model::Zsl1W));
-        assert_eq!(go2_options::<go2::Go2>(None, &default).state_timeout, go2::STATE_TIMEOUT);
-        assert_eq!(g1_options(None, &default).low_level.state_timeout, go2::STATE_TIMEOUT);
     }
 }

@@ -185,6 +185,7 @@ impl Observations {
 }
 
 /// `[a, b, c]` as `+0.123 +0.456 +0.789`.
+#[cfg(any(feature = "zsl1", feature = "unitree"))]
 pub(crate) fn floats(values: &[f32]) -> String {
     values.iter().map(|x| format!("{x:+.3}")).collect::<Vec<_>>().join(" ")
 }

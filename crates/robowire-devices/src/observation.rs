@@ -98,17 +98,20 @@ pub struct Passthrough {
 }
 
 /// The quaternion (x, y, z, w) of a heading about z, rad.
+#[cfg(feature = "kmc")]
 pub(crate) fn yaw_quaternion(heading_rad: f64) -> [f64; 4] {
     let half = heading_rad / 2.0;
     [0.0, 0.0, half.sin(), half.cos()]
 }
 
 /// A quaternion w, x, y, z (the vendors' order) as x, y, z, w.
+#[cfg(any(feature = "zsl1", feature = "unitree"))]
 pub(crate) fn xyzw(wxyz: [f32; 4]) -> [f64; 4] {
     [wxyz[1].into(), wxyz[2].into(), wxyz[3].into(), wxyz[0].into()]
 }
 
 /// Three floats widened.
+#[cfg(any(feature = "zsl1", feature = "unitree"))]
 pub(crate) fn wide(v: [f32; 3]) -> [f64; 3] {
     v.map(f64::from)
 }

@@ -1,9 +1,14 @@
 //! `sim:` addresses: the simulator first, then the same client a real device gets.
 
+#[cfg(feature = "zsl1")]
 use robowire_sim::dog::{DogSim, DogSimConfig};
+#[cfg(feature = "unitree")]
 use robowire_sim::g1::{G1Sim, G1SimConfig};
+#[cfg(feature = "unitree")]
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+#[cfg(feature = "kmc")]
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
+#[cfg(feature = "zsl1")]
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
 
 use crate::link::Link;
@@ -13,14 +18,19 @@ use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
 #[derive(Debug)]
 #[non_exhaustive]
 pub enum Simulator {
+    #[cfg(feature = "kmc")]
     /// A KMC chassis on a pseudo-terminal.
     Kmc(ChassisSim),
+    #[cfg(feature = "zsl1")]
     /// A ZSL-1 / ZSL-1W on loopback UDP.
     Dog(DogSim),
+    #[cfg(feature = "unitree")]
     /// A Go2 on DDS.
     Go2(Go2Sim),
+    #[cfg(feature = "unitree")]
     /// A G1 on DDS.
     G1(G1Sim),
+    #[cfg(feature = "zsl1")]
     /// The spline daemon on private shared memory.
     Spline(SplineSim),
 }
@@ -33,11 +43,13 @@ pub(crate) fn open(
     let failed =
         |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator { address: address.clone(), source };
     Ok(match kind {
+        #[cfg(feature = "kmc")]
         SimKind::Kmc => {
             let sim = ChassisSim::spawn(ChassisSimConfig::default()).map_err(|e| failed(e.into()))?;
-            let driver = kmc::Driver::open(sim.path(), crate::kmc_options(options))?;
+            let driver = kmc::Driver::open(sim.path(), crate::kinds::kmc::driver_options(options))?;
             (Simulator::Kmc(sim), Box::new(driver))
         }
+        #[cfg(feature = "zsl1")]
         SimKind::Zsl1 | SimKind::Zsl1w => {
             let model = if kind == SimKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
             let sim =
@@ -47,34 +59,42 @@ pub(crate) fn open(
                 dog,
                 ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip())
             };
-            let link = zsl::udp::HighLevel::open(crate::zsl_options(client, model, options))?;
+            let link = zsl::udp::HighLevel::open(crate::kinds::zsl1::client_options(client, model, options))?;
             (Simulator::Dog(sim), Box::new(link))
         }
+        #[cfg(feature = "zsl1")]
         SimKind::Spline => {
             static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
             let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let tag = format!("devices-{}-{n}", std::process::id());
             let sim = SplineSim::spawn(SplineSimConfig::private(&tag)).map_err(|e| failed(e.into()))?;
-            let monitor = zsl::spline::SplineMonitor::open(crate::spline_options(&sim.config().spline_name, options))?;
+            let monitor = zsl::spline::SplineMonitor::open(crate::kinds::spline::monitor_options(
+                &sim.config().spline_name,
+                options,
+            ))?;
             (Simulator::Spline(sim), Box::new(monitor))
         }
+        #[cfg(feature = "unitree")]
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
-            let client = crate::go2_options::<go2::Go2>(Some(interface), options);
+            let client = crate::kinds::unitree::low_level_options::<go2::Go2>(Some(interface), options);
             let sim =
                 Go2Sim::spawn(Go2SimConfig { participant: client.participant.clone(), ..Go2SimConfig::default() })
                     .map_err(|e| failed(e.into()))?;
             let client = go2::LowLevel::<go2::Go2>::open(client)?;
             (Simulator::Go2(sim), Box::new(client))
         }
+        #[cfg(feature = "unitree")]
         SimKind::G1 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
-            let client = crate::g1_options(Some(interface), options);
+            let client = crate::kinds::g1::client_options(Some(interface), options);
             let participant = client.low_level.participant.clone();
             let sim =
                 G1Sim::spawn(G1SimConfig { participant, ..G1SimConfig::default() }).map_err(|e| failed(e.into()))?;
             let client = g1::G1::open(client)?;
             (Simulator::G1(sim), Box::new(client))
         }
+        #[allow(unreachable_patterns)] // every kind built
+        _ => return Err(crate::kinds::not_built(address)),
     })
 }

@@ -9,8 +9,9 @@ mod write;
 
 pub use read::{CaptureSummary, ChannelSummary, ReadError, RecordedFrame, read_frames, summarize};
 pub use robowire_core::json::{FrameError, JsonFrame, LinkDescription, WireSchema};
+pub use robowire_tap::RecordLinks;
 pub use robowire_tap::{Direction, SampleOrigin, Tap};
-pub use write::{Compression, RecordError, RecordLinks, Recorder, RecorderOptions, RecordingSummary};
+pub use write::{Compression, RecordError, Recorder, RecorderOptions, RecordingSummary};
 
 /// The message encoding of the raw channels: the frame's bytes, as on the wire.
 pub const RAW_ENCODING: &str = "robowire.raw";

@@ -4,14 +4,14 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use mcap::records::{MessageHeader, Metadata};
 use robowire_core::json::LinkDescription;
-use robowire_tap::{Tap, TapRing, TappedFrame};
+use robowire_tap::{LinkRegistry, RecordLinks, Tap, TapRing, TappedFrame};
 
 use crate::channels::{Channels, Placed};
 use crate::json_thread::{JsonMessage, JsonThread};
@@ -115,9 +115,6 @@ pub struct RecordingSummary {
     pub not_wire: u64,
 }
 
-/// Every link's name and description, by link number.
-type Links = Arc<Mutex<Vec<(String, &'static dyn LinkDescription)>>>;
-
 /// Records taps into one MCAP file.
 ///
 /// The taps stamp frames with the monotonic clock; the writer logs them at Unix time, through
@@ -128,7 +125,7 @@ type Links = Arc<Mutex<Vec<(String, &'static dyn LinkDescription)>>>;
 #[derive(Debug)]
 pub struct Recorder {
     ring: TapRing,
-    links: Links,
+    links: LinkRegistry,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<Result<RecordingSummary, RecordError>>>,
 }
@@ -156,7 +153,7 @@ impl Recorder {
             .then(|| JsonThread::spawn(ring.slots() / 2))
             .transpose()
             .map_err(|source| RecordError::Create { path: path.clone(), source })?;
-        let links = Links::default();
+        let links = LinkRegistry::default();
         let stop = Arc::new(AtomicBool::new(false));
         let mut state = WriterState {
             writer,
@@ -191,7 +188,7 @@ impl Recorder {
     /// A handle that registers links with this recorder, for code that opens devices on its
     /// behalf (`robowire_devices::OpenOptions::record`).
     pub fn links(&self) -> RecordLinks {
-        RecordLinks { ring: self.ring.clone(), links: self.links.clone(), prefix: String::new() }
+        RecordLinks::new(self.ring.clone(), self.links.clone())
     }
 
     /// Frames dropped so far because the ring was full.
@@ -231,41 +228,6 @@ impl Drop for Recorder {
     }
 }
 
-/// Registers links with a [`Recorder`] ([`Recorder::links`]); clones register with the same
-/// one. Taps handed out after the recorder finished drop their frames and count them.
-#[derive(Debug, Clone)]
-pub struct RecordLinks {
-    ring: TapRing,
-    links: Links,
-    /// Put before each link's name (`kmc0/`), or empty.
-    prefix: String,
-}
-
-impl RecordLinks {
-    /// As [`Recorder::link`].
-    pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
-        let mut links = robowire_rt::lock(&self.links);
-        links.push((format!("{}{}", self.prefix, name.trim_matches('/')), description));
-        self.ring.tap(u16::try_from(links.len() - 1).unwrap_or(u16::MAX))
-    }
-
-    /// A handle that registers links under `prefix` (`kmc0`: `kmc0/kmc/serial`), for two
-    /// devices whose links have the same names.
-    pub fn under(&self, prefix: &str) -> RecordLinks {
-        let prefix = format!("{}{}/", self.prefix, prefix.trim_matches('/'));
-        RecordLinks { prefix, ..self.clone() }
-    }
-}
-
-/// Two handles are equal when they register with the same recorder.
-impl PartialEq for RecordLinks {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.links, &other.links)
-    }
-}
-
-impl Eq for RecordLinks {}
-
 /// Unix time minus monotonic time, ns: what turns a tap's stamp into a log time.
 fn unix_minus_monotonic_ns() -> i64 {
     let unix_ns = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_nanos());
@@ -278,7 +240,7 @@ struct WriterState {
     writer: mcap::Writer<BufWriter<File>>,
     path: PathBuf,
     command: String,
-    links: Links,
+    links: LinkRegistry,
     /// Added to a tap's monotonic stamp: Unix time, ns.
     unix_offset_ns: i64,
     channels: Channels,

@@ -1,10 +1,13 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
+mod links;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use crossbeam_queue::ArrayQueue;
+pub use links::{LinkRegistry, RecordLinks};
 pub use robowire_core::Direction;
 
 /// Bytes one slot holds: the largest frame robowire records, a Unitree HG `LowState_` DDS

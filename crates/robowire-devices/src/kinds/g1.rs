@@ -5,10 +5,10 @@
 use ::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS};
 use serde_json::Value;
 
+use super::unitree::{imu, low_level_stats, lowstate_passthrough};
 use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, JointReadings};
-use crate::unitree::{imu, low_level_stats, lowstate_passthrough};
-use crate::{DeviceError, Observation};
+use crate::{DeviceError, Observation, OpenOptions};
 
 /// The slots `variant` drives, in slot order.
 fn driven(variant: G1Variant) -> impl Iterator<Item = usize> {
@@ -147,6 +147,20 @@ impl Link for G1 {
         G1::close(*self);
         Ok(())
     }
+}
+
+/// A G1 on `interface`, through the `g1` facade.
+pub(crate) fn open(interface: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+    Ok(Box::new(G1::open(client_options(Some(interface), options))?))
+}
+
+/// A G1 client's options: the HG low level, recorded as `g1/low_level`, `g1/api` and
+/// `g1/arm_sdk`.
+pub(crate) fn client_options(interface: Option<&str>, options: &OpenOptions) -> G1Options {
+    let hg = &lowcmd_proto::description::HG_LOW_LEVEL;
+    let low_level = super::unitree::recorded_options(interface, options, "g1", hg);
+    let arm_sdk_tap = options.record.as_ref().map(|r| r.link("g1/arm_sdk", hg));
+    G1Options { low_level, arm_sdk_tap, ..G1Options::default() }
 }
 
 #[cfg(test)]

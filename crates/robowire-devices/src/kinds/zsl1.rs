@@ -6,7 +6,7 @@ use zsl::udp::{Device, HighLevel, Model, RobotState};
 
 use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Odometry, wide, xyzw};
-use crate::{DeviceError, Observation};
+use crate::{DeviceError, Observation, OpenOptions};
 
 /// Joint names, `[leg][joint]` order of the state: FR, FL, RR, RL × abad, hip, knee (+ foot).
 pub(crate) fn joint_names(model: Model) -> Vec<String> {
@@ -183,6 +183,26 @@ impl Link for HighLevel {
     fn close(self: Box<Self>) -> Result<(), DeviceError> {
         HighLevel::close(*self);
         Ok(())
+    }
+}
+
+/// A ZSL-1 (or ZSL-1W, by `model`) at `ip`, its state expected at `options.zsl_local`.
+pub(crate) fn open(ip: std::net::IpAddr, model: Model, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+    let client = zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), ip);
+    Ok(Box::new(HighLevel::open(client_options(client, model, options))?))
+}
+
+/// The client's options: the model, the watchdog, with a recorder its link `dog/high_level`.
+pub(crate) fn client_options(
+    client: zsl::udp::ClientOptions,
+    model: Model,
+    options: &OpenOptions,
+) -> zsl::udp::ClientOptions {
+    let watchdog = options.state_timeout.unwrap_or(client.watchdog);
+    let client = client.with_model(model).with_watchdog(watchdog);
+    match &options.record {
+        Some(record) => client.with_tap(record.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
+        None => client,
     }
 }
 

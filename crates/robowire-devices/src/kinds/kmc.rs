@@ -8,7 +8,7 @@ use serde_json::{Value, json};
 
 use crate::link::{Describe, Link, Observations};
 use crate::observation::{BatteryReading, MotorReport, Odometry, yaw_quaternion};
-use crate::{DeviceError, Observation};
+use crate::{DeviceError, Observation, OpenOptions};
 
 fn odometry_json(state: &ChassisState) -> Value {
     let o = &state.odometry;
@@ -169,5 +169,36 @@ impl Link for Driver {
 
     fn close(self: Box<Self>) -> Result<(), DeviceError> {
         Ok(Driver::close(*self)?)
+    }
+}
+
+/// The KMC chassis's driver on the serial port `path`.
+pub(crate) fn open(path: &std::path::Path, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+    Ok(Box::new(Driver::open(path, driver_options(options))?))
+}
+
+/// The driver's options: the polls, the state timeout, with a recorder its serial link's taps.
+pub(crate) fn driver_options(options: &OpenOptions) -> kmc::DriverOptions {
+    let defaults = kmc::DriverOptions::default();
+    let record = options.record.as_ref();
+    kmc::DriverOptions {
+        poll_battery: options.kmc_polls,
+        poll_allstate: options.kmc_polls,
+        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
+        taps: record.map(|r| kmc_taps(r, &kmc_proto::description::HOST)).unwrap_or_default(),
+        ..defaults
+    }
+}
+
+/// The taps of a KMC serial line recorded with `record`: its frames as `kmc/serial`, described by
+/// `side` (`kmc_proto::description::HOST` at the host, `CHASSIS` at a chassis), and the bytes the
+/// decoder skipped as `kmc/serial_skipped` (`robowire_core::json::SKIPPED_BYTES`).
+pub fn kmc_taps(
+    record: &robowire_tap::RecordLinks,
+    side: &'static robowire_core::json::LinkProtocol,
+) -> robowire_serial::SerialTaps {
+    robowire_serial::SerialTaps {
+        frames: Some(record.link("kmc/serial", side)),
+        skipped: Some(record.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES)),
     }
 }

@@ -9,7 +9,7 @@ use serde_json::Value;
 
 use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
-use crate::{DeviceError, Observation};
+use crate::{DeviceError, Observation, OpenOptions};
 
 /// What differs between the Unitree families for a device view.
 pub(crate) trait Family: Robot<State: serde::Serialize> {
@@ -199,5 +199,33 @@ impl<R: Family> Link for LowLevel<R> {
     fn close(self: Box<Self>) -> Result<(), DeviceError> {
         LowLevel::close(*self);
         Ok(())
+    }
+}
+
+/// A Unitree robot of family `R` on `interface`, through its low-level client.
+pub(crate) fn open<R: Family>(interface: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+    Ok(Box::new(LowLevel::<R>::open(low_level_options::<R>(Some(interface), options))?))
+}
+
+/// A low-level client's options for family `R`, recorded under its name (`go2/low_level`).
+pub(crate) fn low_level_options<R: Family>(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
+    recorded_options(interface, options, R::RECORDED_AS, R::LOW_LEVEL)
+}
+
+/// A Unitree low-level client's options: the domain, the state timeout, and with a recorder its
+/// links `{recorded_as}/low_level` (described by `low_level`) and `{recorded_as}/api`.
+pub(crate) fn recorded_options(
+    interface: Option<&str>,
+    options: &OpenOptions,
+    recorded_as: &str,
+    low_level: &'static dyn robowire_core::json::LinkDescription,
+) -> go2::LowLevelOptions {
+    let defaults = go2::LowLevelOptions::on(interface, options.domain);
+    let record = options.record.as_ref();
+    go2::LowLevelOptions {
+        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
+        low_level_tap: record.map(|r| r.link(&format!("{recorded_as}/low_level"), low_level)),
+        services_tap: record.map(|r| r.link(&format!("{recorded_as}/api"), &lowcmd_proto::description::API_CLIENT)),
+        ..defaults
     }
 }

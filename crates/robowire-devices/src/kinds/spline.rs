@@ -9,7 +9,7 @@ use zsl::{JointFlags, JointIndex, Leg, SplineStateBlock};
 
 use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::JointReadings;
-use crate::{DeviceError, Observation};
+use crate::{DeviceError, Observation, OpenOptions};
 
 const LEGS: [(Leg, &str); 4] =
     [(Leg::FrontRight, "FR"), (Leg::FrontLeft, "FL"), (Leg::RearRight, "RR"), (Leg::RearLeft, "RL")];
@@ -98,5 +98,25 @@ impl Link for SplineMonitor {
     fn close(self: Box<Self>) -> Result<(), DeviceError> {
         SplineMonitor::close(*self);
         Ok(())
+    }
+}
+
+/// The link `/spline_shm` is recorded as, seen by the controller or a monitor
+/// (`zsl_proto::description::SPLINE_CLIENT`).
+pub const SPLINE_LINK: &str = "spline/spline";
+/// The link `/imu_shm` is recorded as, seen by a reader (`zsl_proto::description::IMU`).
+pub const SPLINE_IMU_LINK: &str = "spline/imu";
+
+/// A monitor of the spline daemon's shared memory `name`.
+pub(crate) fn open(name: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+    Ok(Box::new(SplineMonitor::open(monitor_options(name, options))?))
+}
+
+/// The monitor's options: with a recorder, the states it takes recorded as [`SPLINE_LINK`].
+pub(crate) fn monitor_options(name: &str, options: &OpenOptions) -> zsl::spline::SplineMonitorOptions {
+    let monitor = zsl::spline::SplineMonitorOptions::new(name);
+    match &options.record {
+        Some(record) => monitor.with_tap(record.link(SPLINE_LINK, &zsl_proto::description::SPLINE_CLIENT)),
+        None => monitor,
     }
 }
