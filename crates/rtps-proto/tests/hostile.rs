@@ -15,7 +15,8 @@ use rtps_proto::discovery::Qos;
 use rtps_proto::participant::{Destination, Event, Participant};
 use rtps_proto::wire::WireErrorKind;
 
-/// Counts live heap bytes and their peak.
+/// Counts live heap bytes and their peak, of the whole process: each test measures with the
+/// others waiting ([`one_at_a_time`]), or it would count their heap too.
 struct Counting;
 static LIVE: AtomicUsize = AtomicUsize::new(0);
 static PEAK: AtomicUsize = AtomicUsize::new(0);
@@ -39,9 +40,11 @@ unsafe impl GlobalAlloc for Counting {
 static ALLOCATOR: Counting = Counting;
 
 use robowire_fixtures::rtps::hostile_datagrams as one_datagram_each;
+use robowire_fixtures::wait::one_at_a_time;
 
 #[test]
 fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on() {
+    let _turn = one_at_a_time();
     let now = Time::from_nanos(1_000_000_000);
     let mut ours = Participant::new(pair::config(1), now);
     let mut attacker = Participant::new(pair::config(2), now);
@@ -93,6 +96,7 @@ fn the_six_rustdds_datagrams_are_refused_or_bounded_and_the_participant_goes_on(
 
 #[test]
 fn a_fragmented_sample_larger_than_the_limit_is_refused_before_any_allocation() {
+    let _turn = one_at_a_time();
     let now = Time::from_nanos(1_000_000_000);
     let mut ours = Participant::new(pair::config(1), now);
     let mut peer = Participant::new(pair::config(2), now);
@@ -144,6 +148,7 @@ fn small_frag(prefix: [u8; 12], reader: [u8; 4], writer: [u8; 4], sn: u32, size:
 
 #[test]
 fn small_fragments_of_many_writers_hold_no_more_than_the_reassembly_budget() {
+    let _turn = one_at_a_time();
     let now = Time::from_nanos(1_000_000_000);
     let mut ours = Participant::new(pair::config(1), now);
     let mut peer = Participant::new(pair::config(2), now);
