@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use go2::{Go2Error, LowLevelOptions};
 use lowcmd_proto::g1::G1Variant;
-use robowire_tap::Tap;
+use robowire_tap::{RecordLinks, Tap};
 
 use crate::G1Error;
 use crate::arm_stream::{ARM_SDK_WEIGHT_RATE_MAX_PER_S, ArmSdkConfig};
@@ -27,6 +27,18 @@ pub struct G1Options {
 }
 
 impl G1Options {
+    /// Recorded with `links` when given: the HG low level as `g1/low_level`, the services as
+    /// `g1/api`, `rt/arm_sdk` as `g1/arm_sdk` (all described by `lowcmd_proto::description`).
+    pub fn recorded(self, links: Option<&RecordLinks>) -> Self {
+        let Some(links) = links else { return self };
+        let hg = &lowcmd_proto::description::HG_LOW_LEVEL;
+        Self {
+            low_level: self.low_level.recorded(Some(links), "g1", hg),
+            arm_sdk_tap: Some(links.link("g1/arm_sdk", hg)),
+            ..self
+        }
+    }
+
     /// Domain `domain` on interface `interface` (`None`: the library chooses); everything else
     /// the defaults.
     pub fn on(interface: Option<&str>, domain: u16) -> Self {

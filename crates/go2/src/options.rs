@@ -3,9 +3,10 @@
 use std::time::Duration;
 
 use lowcmd_proto::stream::StreamConfig;
+use robowire_core::json::LinkDescription;
 use robowire_dds::ParticipantOptions;
 use robowire_rt::Placement;
-use robowire_tap::Tap;
+use robowire_tap::{RecordLinks, Tap};
 
 use crate::Go2Error;
 
@@ -54,6 +55,18 @@ impl Default for LowLevelOptions {
 }
 
 impl LowLevelOptions {
+    /// Recorded with `links` when given: `rt/lowcmd` written and `rt/lowstate` taken as
+    /// `{name}/low_level` (described by `low_level`: `lowcmd_proto::description::GO2_LOW_LEVEL` or
+    /// `HG_LOW_LEVEL`), the service requests and answers as `{name}/api`.
+    pub fn recorded(self, links: Option<&RecordLinks>, name: &str, low_level: &'static dyn LinkDescription) -> Self {
+        let Some(links) = links else { return self };
+        Self {
+            low_level_tap: Some(links.link(&format!("{name}/low_level"), low_level)),
+            services_tap: Some(links.link(&format!("{name}/api"), &lowcmd_proto::description::API_CLIENT)),
+            ..self
+        }
+    }
+
     /// Domain `domain` on interface `interface` (`None`: the library chooses).
     pub fn on(interface: Option<&str>, domain: u16) -> Self {
         Self { participant: ParticipantOptions::new(domain, interface), ..Self::default() }

@@ -107,14 +107,11 @@ impl Go2LowLevel {
         };
         let service_timeout = seconds("service_timeout_s", service_timeout_s)?;
         let (links, capture) = record_arg(record, "robowire.go2.LowLevel")?;
-        let options = LowLevelOptions {
-            service_timeout,
-            low_level_tap: links.as_ref().map(|r| r.link(&format!("{robot}/low_level"), low_level)),
-            services_tap: links
-                .as_ref()
-                .map(|r| r.link(&format!("{robot}/api"), &lowcmd_proto::description::API_CLIENT)),
-            ..LowLevelOptions::on(interface, domain)
-        };
+        let options = LowLevelOptions { service_timeout, ..LowLevelOptions::on(interface, domain) }.recorded(
+            links.as_ref(),
+            robot,
+            low_level,
+        );
         let (client, robot) = match robot {
             "go2" => (Client::Go2(Arc::new(py.detach(|| LowLevel::<Go2>::open(options)).map_err(raise)?)), "go2"),
             _ => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(raise)?)), "hg"),

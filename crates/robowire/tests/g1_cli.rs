@@ -98,8 +98,16 @@ fn status_damp_and_zero_of_a_simulated_g1() {
 fn zero_on_a_23_joint_g1_commands_its_23_joints() {
     with_loopback_multicast(|| {
         let sim = start_sim(&["--dof", "23"]);
-        let zero = stdout(&g1(&["zero", "--duration", "0.3", "--hold", "0.3"]));
+        let capture = std::env::temp_dir().join(format!("robowire-g1-zero-{}.mcap", std::process::id()));
+        let capture_arg = capture.to_str().unwrap();
+        let zero = stdout(&g1(&["--record", capture_arg, "zero", "--duration", "0.3", "--hold", "0.3"]));
         assert!(zero.contains("moving the 23 joints of a Dof23 G1"), "{zero}");
+        // Every link the G1 client has is recorded: its low level, its services, rt/arm_sdk.
+        let summary = stdout(&robowire().args(["decode", "--mcap", capture_arg]).output().unwrap());
+        for link in ["g1/low_level: unitree_hg.low_level", "g1/api: unitree_api.client", "g1/arm_sdk: unitree_hg"] {
+            assert!(summary.contains(&format!("link:{link}")), "{link} in {summary}");
+        }
+        std::fs::remove_file(&capture).unwrap();
         let report = SimReport::of(sim);
         assert!(report.count("lowcmd accepted") > 100, "{}", report.last);
         assert_eq!(report.count("bad mode_machine"), 0, "mode_machine 4, the robot's: {}", report.last);

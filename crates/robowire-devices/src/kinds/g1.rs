@@ -157,10 +157,10 @@ pub(crate) fn open(interface: &str, options: &OpenOptions) -> Result<Box<dyn Lin
 /// A G1 client's options: the HG low level, recorded as `g1/low_level`, `g1/api` and
 /// `g1/arm_sdk`.
 pub(crate) fn client_options(interface: Option<&str>, options: &OpenOptions) -> G1Options {
-    let hg = &lowcmd_proto::description::HG_LOW_LEVEL;
-    let low_level = super::unitree::recorded_options(interface, options, "g1", hg);
-    let arm_sdk_tap = options.record.as_ref().map(|r| r.link("g1/arm_sdk", hg));
-    G1Options { low_level, arm_sdk_tap, ..G1Options::default() }
+    let defaults = G1Options::on(interface, options.domain);
+    let state_timeout = options.state_timeout.unwrap_or(defaults.low_level.state_timeout);
+    let low_level = go2::LowLevelOptions { state_timeout, ..defaults.low_level };
+    G1Options { low_level, ..defaults }.recorded(options.record.as_ref())
 }
 
 #[cfg(test)]

@@ -221,11 +221,6 @@ pub(crate) fn recorded_options(
     low_level: &'static dyn robowire_core::json::LinkDescription,
 ) -> go2::LowLevelOptions {
     let defaults = go2::LowLevelOptions::on(interface, options.domain);
-    let record = options.record.as_ref();
-    go2::LowLevelOptions {
-        state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout),
-        low_level_tap: record.map(|r| r.link(&format!("{recorded_as}/low_level"), low_level)),
-        services_tap: record.map(|r| r.link(&format!("{recorded_as}/api"), &lowcmd_proto::description::API_CLIENT)),
-        ..defaults
-    }
+    go2::LowLevelOptions { state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout), ..defaults }
+        .recorded(options.record.as_ref(), recorded_as, low_level)
 }

@@ -143,17 +143,8 @@ impl PyG1 {
         let variant = variant.map(variant_named).transpose()?;
         let service_timeout = seconds("service_timeout_s", service_timeout_s)?;
         let (links, capture) = record_arg(record, "robowire.g1.G1")?;
-        let options = G1Options {
-            low_level: LowLevelOptions {
-                service_timeout,
-                low_level_tap: links.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
-                services_tap: links.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_CLIENT)),
-                ..LowLevelOptions::on(interface, domain)
-            },
-            variant,
-            arm_sdk_tap: links.as_ref().map(|r| r.link("g1/arm_sdk", &lowcmd_proto::description::HG_LOW_LEVEL)),
-            ..G1Options::default()
-        };
+        let low_level = LowLevelOptions { service_timeout, ..LowLevelOptions::on(interface, domain) };
+        let options = G1Options { low_level, variant, ..G1Options::default() }.recorded(links.as_ref());
         let robot = py.detach(|| G1::open(options)).map_err(raise)?;
         Ok(Self { client: Arc::new(Owned::new("G1 client", Arc::new(robot))), capture })
     }

@@ -50,8 +50,9 @@ enum G1Command {
 
 pub(crate) fn run(args: G1Args) -> anyhow::Result<ExitCode> {
     let robot_args = &args.robot;
-    robot_args.run("g1", &lowcmd_proto::description::HG_LOW_LEVEL, |low_level, connect| async move {
-        let robot = G1::open(G1Options { low_level, ..G1Options::default() }).context("joining DDS")?;
+    robot_args.run("g1", |low_level, links, connect| async move {
+        let options = G1Options { low_level, ..G1Options::default() }.recorded(links.as_ref());
+        let robot = G1::open(options).context("joining DDS")?;
         let state = robot.wait_state(connect, |_| true).await.with_context(|| robot_args.silent(connect))?;
         let code = match args.command {
             G1Command::Status { json } => {

@@ -65,7 +65,8 @@ enum Go2Command {
 
 pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
     let robot_args = &args.robot;
-    robot_args.run("go2", &lowcmd_proto::description::GO2_LOW_LEVEL, |options, connect| async move {
+    robot_args.run("go2", |options, links, connect| async move {
+        let options = options.recorded(links.as_ref(), "go2", &lowcmd_proto::description::GO2_LOW_LEVEL);
         let robot = LowLevel::<Go2>::open(options).context("joining DDS")?;
         let state = robot.wait_state(connect, |_| true).await.with_context(|| robot_args.silent(connect))?;
         let code = match args.command {

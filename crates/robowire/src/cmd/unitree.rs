@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use go2::{Connection, Device, LowLevelOptions};
-use robowire_core::json::LinkDescription;
+use robowire_record::RecordLinks;
 
 use crate::cmd::go2::DdsArgs;
 use crate::cmd::seconds;
@@ -31,14 +31,13 @@ pub(crate) struct RobotArgs {
 }
 
 impl RobotArgs {
-    /// Runs `body` on a two-thread runtime with the low-level options (domain, interface; with
-    /// `--record`, the links `{name}/low_level` described by `low_level` and `{name}/api`) and the
-    /// connect timeout; then closes the capture, whatever `body` returned.
+    /// Runs `body` on a two-thread runtime with the low-level options (domain, interface), the
+    /// recorder's links with `--record` (the facade's options name their links), and the connect
+    /// timeout; then closes the capture, whatever `body` returned.
     pub(crate) fn run<F>(
         &self,
         name: &str,
-        low_level: &'static dyn LinkDescription,
-        body: impl FnOnce(LowLevelOptions, Duration) -> F,
+        body: impl FnOnce(LowLevelOptions, Option<RecordLinks>, Duration) -> F,
     ) -> anyhow::Result<ExitCode>
     where
         F: Future<Output = anyhow::Result<ExitCode>>,
@@ -46,15 +45,9 @@ impl RobotArgs {
         let connect = seconds("--connect-timeout-s", self.connect_timeout_s)?;
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
         let recorder = self.record.start(&format!("robowire {name}"))?;
-        let options = LowLevelOptions {
-            participant: self.dds.participant(),
-            low_level_tap: recorder.as_ref().map(|r| r.link(&format!("{name}/low_level"), low_level)),
-            services_tap: recorder
-                .as_ref()
-                .map(|r| r.link(&format!("{name}/api"), &lowcmd_proto::description::API_CLIENT)),
-            ..LowLevelOptions::default()
-        };
-        let code = runtime.block_on(body(options, connect));
+        let links = recorder.as_ref().map(robowire_record::Recorder::links);
+        let options = LowLevelOptions { participant: self.dds.participant(), ..LowLevelOptions::default() };
+        let code = runtime.block_on(body(options, links, connect));
         crate::cmd::record::finish(recorder)?;
         code
     }
