@@ -80,14 +80,17 @@ fn build_peer() -> Result<PathBuf, String> {
     for (tool, flag) in [("fastddsgen", "-version"), ("cmake", "--version"), ("g++", "--version")] {
         run(tool, &[flag], &dir).map_err(|e| format!("no {tool} ({e}): {INSTALL}"))?;
     }
-    let (generated, build) = (dir.join("gen"), dir.join("build"));
-    for d in [&generated, &build] {
+    // fastddsgen's preprocessor writes `<idl>.cc` into its temporary directory: `/tmp` unless
+    // told, where another user's run leaves files this user may not overwrite.
+    let (generated, build, temporary) = (dir.join("gen"), dir.join("build"), dir.join("tmp"));
+    for d in [&generated, &build, &temporary] {
         std::fs::create_dir_all(d).map_err(|e| e.to_string())?;
     }
     for idl in ["unitree_go.idl", "unitree_hg.idl"] {
         std::fs::copy(sources.join(idl), generated.join(idl)).map_err(|e| e.to_string())?;
     }
-    run("fastddsgen", &["-replace", "unitree_go.idl", "unitree_hg.idl"], &generated)
+    let temporary = temporary.to_str().ok_or("a non-UTF-8 path")?;
+    run("fastddsgen", &["-replace", "-t", temporary, "unitree_go.idl", "unitree_hg.idl"], &generated)
         .unwrap_or_else(|e| panic!("fastddsgen refuses the peer's IDL: {e}"));
     let source_dir = sources.to_str().ok_or("a non-UTF-8 path")?;
     let gen_dir = format!("-DGEN_DIR={}", generated.display());
