@@ -32,6 +32,11 @@ use rustdds::{
 
 /// How long anything may take before the test fails (a watchdog, not a measurement).
 const WAIT: Duration = Duration::from_secs(30);
+/// How long a dropped rustdds participant may take to be forgotten: at once when its dispose goes
+/// out, its announced lease (5 × its 10 s announcement period) when its drop dies before that
+/// (rustdds 0.15.1's discovery thread can end up joining itself: "failed to join thread:
+/// Resource deadlock avoided"), and a margin.
+const RUSTDDS_GONE: Duration = Duration::from_secs(50 + 20);
 
 /// A payload as rustdds carries it: the representation identifier of its encapsulation header and
 /// the bytes after the header (rustdds writes the header's two option bytes as zero and does not
@@ -674,7 +679,7 @@ fn the_rustdds_participant_leaves_and_comes_back() {
                 let began = Instant::now();
                 drop((cmd_writer, state_reader));
                 drop(dp);
-                some_async(WAIT, "robowire forgets the rustdds participant", || {
+                some_async(RUSTDDS_GONE, "robowire forgets the rustdds participant", || {
                     let gone = !robowire.discovered_participants().iter().any(|p| p.guid_prefix == rustdds)
                         && !robowire.discovered_endpoints().iter().any(|e| prefix(e.guid) == rustdds);
                     (gone && state_writer.matched_readers() == 0 && cmd_reader.matched_writers() == 0).then_some(())
