@@ -279,14 +279,20 @@ def test_init_robot_again_replaces_the_connection(dog, ip):
 
 
 def test_ctrl_c_interrupts_a_blocking_wait(ip):
-    with connect_plain(ip) as robot:  # nobody answers
-        timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT))
-        timer.start()
-        started = time.monotonic()
-        with pytest.raises(KeyboardInterrupt):
-            robot.wait_connected(30.0)
-        assert time.monotonic() - started < 30.0  # interrupted, not ended by its timeout
-        timer.join()
+    # Ctrl-C as in a terminal: a process started in the background inherits SIGINT ignored, and
+    # Python then raises no KeyboardInterrupt at all.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with connect_plain(ip) as robot:  # nobody answers
+            timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT))
+            timer.start()
+            started = time.monotonic()
+            with pytest.raises(KeyboardInterrupt):
+                robot.wait_connected(30.0)
+            assert time.monotonic() - started < 30.0  # interrupted, not ended by its timeout
+            timer.join()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def test_a_blocking_wait_releases_the_gil(ip):
