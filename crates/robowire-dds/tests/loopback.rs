@@ -254,10 +254,8 @@ fn participant_user_data_is_announced_and_a_leaving_participant_is_forgotten_at_
         assert!(!seen.unicast.is_empty());
         // Its dispose arrives when it is dropped: gone long before its 20 s lease.
         drop(ros);
-        let began = std::time::Instant::now();
-        while observer.discovered_participants().iter().any(|p| p.guid_prefix == ros_prefix) {
-            assert!(began.elapsed() < Duration::from_secs(10), "still there after its dispose");
-            std::thread::sleep(Duration::from_millis(5));
-        }
+        robowire_fixtures::wait::until(Duration::from_secs(10), "forgotten after its dispose", || {
+            !observer.discovered_participants().iter().any(|p| p.guid_prefix == ros_prefix)
+        });
     });
 }
