@@ -13,9 +13,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, ensure};
 use clap::Parser;
-use g1::slot::{LEFT_ANKLE_PITCH, LEFT_ANKLE_ROLL, RIGHT_ANKLE_PITCH, RIGHT_ANKLE_ROLL};
-use g1::{G1, G1Options, JOINTS, ParticipantOptions};
 use robowire_sim::g1::{G1Sim, G1SimConfig};
+use unitree::g1::slot::{LEFT_ANKLE_PITCH, LEFT_ANKLE_ROLL, RIGHT_ANKLE_PITCH, RIGHT_ANKLE_ROLL};
+use unitree::g1::{G1, G1Options, JOINTS, ParticipantOptions};
 
 /// The ankle swing's amplitudes, rad, at 1 Hz (Unitree's example: 30° pitch, 10° roll).
 const PITCH_RAD: f32 = 30.0 * std::f32::consts::PI / 180.0;

@@ -12,9 +12,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, ensure};
 use clap::Parser;
-use go2::trajectory::JointTrajectory;
-use go2::{Go2, LowLevel, LowLevelOptions, ParticipantOptions};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
+use unitree::trajectory::JointTrajectory;
+use unitree::{Go2, LowLevel, LowLevelOptions, ParticipantOptions};
 
 /// Unitree Go2 low-level stand.
 #[derive(Debug, Parser)]

@@ -5,4 +5,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| go2::fuzz_receive(data));
+fuzz_target!(|data: &[u8]| unitree::fuzz_receive(data));

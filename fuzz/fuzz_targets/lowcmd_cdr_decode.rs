@@ -4,4 +4,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|data: &[u8]| lowcmd_proto::decode_roundtrip::cdr_decode(data));
+fuzz_target!(|data: &[u8]| unitree_proto::decode_roundtrip::cdr_decode(data));

@@ -214,7 +214,7 @@ mod tests {
 
     #[test]
     fn an_xcdr2_sample_is_read() {
-        use lowcmd_proto::{LowCmd, Message, MotorCmd};
+        use unitree_proto::{LowCmd, Message, MotorCmd};
         let mut command = LowCmd::default();
         command.motor_cmd[0] = MotorCmd::servo(0.5, 0.0, 20.0, 0.5, 0.0);
         let mut payload = vec![0u8; LowCmd::cdr_len(CdrEncoding::Xcdr2)];

@@ -20,13 +20,13 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::{HgLowState, LowCmd, LowState, Message};
 use robowire_core::cdr::CdrType;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
 use robowire_fixtures::wait::{runtime, until};
 use serde_json::{Value, json};
+use unitree_proto::{HgLowState, LowCmd, LowState, Message};
 
 /// Any one step's bound (discovery, a burst, an exit).
 const WAIT: Duration = Duration::from_secs(30);

@@ -18,8 +18,6 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::hg::HG_MOTOR_COUNT;
-use lowcmd_proto::{F32, HgLowState, I16, LowCmd, LowState, Message, MotorCmd, U16, U32};
 use robowire_core::cdr::CdrType;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
@@ -27,6 +25,8 @@ use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
 use robowire_fixtures::interop;
 use robowire_fixtures::wait::{runtime, until};
 use serde_json::Value;
+use unitree_proto::hg::HG_MOTOR_COUNT;
+use unitree_proto::{F32, HgLowState, I16, LowCmd, LowState, Message, MotorCmd, U16, U32};
 
 /// How long anything may take to happen.
 const WAIT: Duration = Duration::from_secs(20);

@@ -3,13 +3,13 @@
 
 use std::time::Duration;
 
-use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, Response, motion_switcher, status};
-use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::rpc::{RpcClient, RpcServer, Service};
 use robowire_dds::{Participant, ParticipantOptions, Reader};
 use robowire_fixtures::wait::runtime;
+use unitree_proto::api::{self, ApiRequest, ApiResponse, RequestHeader, Response, motion_switcher, status};
+use unitree_proto::{LowCmd, LowState, Message};
 
 const WAIT: Duration = Duration::from_secs(20);
 

@@ -13,7 +13,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use futures::FutureExt;
-use lowcmd_proto::{CdrEncoding, HgLowState, LowCmd, LowState, Message};
 use robowire_core::cdr::CdrType;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
@@ -26,6 +25,7 @@ use rustdds::{
     DataReaderStatus, DataWriterStatus, DomainParticipant, DomainParticipantBuilder, QosPolicies, QosPolicyBuilder,
     RTPSEntity, RepresentationIdentifier, StatusEvented, TopicKind,
 };
+use unitree_proto::{CdrEncoding, HgLowState, LowCmd, LowState, Message};
 
 // Each test uses a domain of its own: where `lo` already carries multicast, the tests share this
 // namespace and would otherwise meet.

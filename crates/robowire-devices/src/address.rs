@@ -16,7 +16,8 @@ pub enum DeviceAddress {
     Zsl1w(IpAddr),
     /// `go2:eth0`: a Unitree Go2's low-level interface on the DDS domain of that interface.
     Go2(String),
-    /// `hg:eth0`: a Unitree HG robot's (G1, H1-2) low-level interface on that interface.
+    /// `hg:eth0` (or `h1:eth0`): a Unitree HG robot's (H1-2; a G1 without its own rules) low-level
+    /// interface on that interface. A G1 is `g1:`.
     Hg(String),
     /// `g1:eth0`: a Unitree G1 humanoid on that interface, through the `g1` facade.
     G1(String),
@@ -112,7 +113,7 @@ impl FromStr for DeviceAddress {
             "zsl1" => Ok(Self::Zsl1(ip()?)),
             "zsl1w" => Ok(Self::Zsl1w(ip()?)),
             "go2" => Ok(Self::Go2(interface()?)),
-            "hg" => Ok(Self::Hg(interface()?)),
+            "hg" | "h1" => Ok(Self::Hg(interface()?)),
             "g1" => Ok(Self::G1(interface()?)),
             "spline" if rest.starts_with('/') && rest.len() > 1 && !rest[1..].contains('/') => {
                 Ok(Self::Spline(rest.into()))
@@ -215,6 +216,11 @@ mod tests {
         let sim: DeviceAddress = "sim:g1".parse().unwrap();
         assert_eq!((sim.kind(), sim.is_simulated(), sim.uses_dds()), (DeviceKind::G1, true, true));
         assert_eq!("hg:eth0".parse::<DeviceAddress>().unwrap().kind(), DeviceKind::Hg, "hg: stays the generic client");
+        assert_eq!(
+            "h1:eth0".parse::<DeviceAddress>().unwrap(),
+            DeviceAddress::Hg("eth0".into()),
+            "h1: names the HG client"
+        );
         for (bad, reason) in [
             ("kmc", "no kind: write KIND:WHERE"),
             ("kmc:", "nothing after the kind"),

@@ -56,7 +56,7 @@ pub struct OpenOptions {
     /// Record the device's links with this recorder (`None`: not recorded), named after the
     /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `dog/high_level`,
     /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `g1/low_level` and `g1/api`
-    /// (described by `lowcmd_proto::description::HG_LOW_LEVEL` and `API_CLIENT`), `spline/spline` (the states a
+    /// (described by `unitree_proto::description::HG_LOW_LEVEL` and `API_CLIENT`), `spline/spline` (the states a
     /// monitor takes from `/spline_shm`).
     pub record: Option<RecordLinks>,
 }
@@ -97,11 +97,11 @@ pub enum DeviceError {
     /// A Unitree robot's client.
     #[cfg(feature = "unitree")]
     #[error("Unitree low-level client")]
-    Unitree(#[from] go2::Go2Error),
+    Unitree(#[from] unitree::UnitreeError),
     /// A Unitree G1's client.
     #[cfg(feature = "unitree")]
     #[error("Unitree G1 client")]
-    G1(#[from] ::g1::G1Error),
+    G1(#[from] unitree::g1::G1Error),
     /// The spline daemon's shared memory.
     #[cfg(feature = "zsl1")]
     #[error("spline shared memory")]
@@ -344,19 +344,19 @@ impl AnyDevice {
 
     #[cfg(feature = "unitree")]
     /// The Go2 low-level client, if this is a Go2.
-    pub fn go2(&self) -> Option<&go2::LowLevel<go2::Go2>> {
+    pub fn go2(&self) -> Option<&unitree::LowLevel<unitree::Go2>> {
         self.link().as_any().downcast_ref()
     }
 
     #[cfg(feature = "unitree")]
     /// The HG low-level client, if this is an HG robot opened as `hg:`.
-    pub fn hg(&self) -> Option<&go2::LowLevel<go2::Hg>> {
+    pub fn hg(&self) -> Option<&unitree::LowLevel<unitree::Hg>> {
         self.link().as_any().downcast_ref()
     }
 
     #[cfg(feature = "unitree")]
     /// The G1 client, if this is a G1 (`g1:`, `sim:g1`).
-    pub fn g1(&self) -> Option<&::g1::G1> {
+    pub fn g1(&self) -> Option<&unitree::g1::G1> {
         self.link().as_any().downcast_ref()
     }
 

@@ -13,7 +13,7 @@ use tokio::sync::{broadcast, watch};
 use crate::{DeviceError, Observation};
 
 /// How a device's state reads, for people and for JSON: implemented by every facade
-/// (`kmc::Driver`, `zsl::udp::HighLevel`, `go2::LowLevel<Go2>`, `go2::LowLevel<Hg>`, `g1::G1`), so that a
+/// (`kmc::Driver`, `zsl::udp::HighLevel`, `unitree::LowLevel<Go2>`, `unitree::LowLevel<Hg>`, `unitree::g1::G1`), so that a
 /// command working on a facade prints what `robowire status` prints.
 pub trait Describe {
     /// The latest state as JSON (the fields of the device's own status command).

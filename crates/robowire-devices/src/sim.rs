@@ -77,11 +77,11 @@ pub(crate) fn open(
         #[cfg(feature = "unitree")]
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
-            let client = crate::kinds::unitree::low_level_options::<go2::Go2>(Some(interface), options);
+            let client = crate::kinds::unitree::low_level_options::<unitree::Go2>(Some(interface), options);
             let sim =
                 Go2Sim::spawn(Go2SimConfig { participant: client.participant.clone(), ..Go2SimConfig::default() })
                     .map_err(|e| failed(e.into()))?;
-            let client = go2::LowLevel::<go2::Go2>::open(client)?;
+            let client = unitree::LowLevel::<unitree::Go2>::open(client)?;
             (Simulator::Go2(sim), Box::new(client))
         }
         #[cfg(feature = "unitree")]
@@ -91,7 +91,7 @@ pub(crate) fn open(
             let participant = client.low_level.participant.clone();
             let sim =
                 G1Sim::spawn(G1SimConfig { participant, ..G1SimConfig::default() }).map_err(|e| failed(e.into()))?;
-            let client = g1::G1::open(client)?;
+            let client = unitree::g1::G1::open(client)?;
             (Simulator::G1(sim), Box::new(client))
         }
         #[allow(unreachable_patterns)] // every kind built

@@ -36,7 +36,7 @@ fn a_simulated_g1_by_address() {
             .await
             .expect("an observation with the battery");
             let joints = seen.joints.unwrap();
-            assert_eq!(joints.names, g1::JOINT_NAMES, "29 joints by their URDF names");
+            assert_eq!(joints.names, unitree::g1::JOINT_NAMES, "29 joints by their URDF names");
             assert!(joints.position_rad[3] > 0.1, "standing: a bent knee, {:?}", joints.position_rad);
             let battery = seen.battery.unwrap();
             let charge = battery.charge_fraction.unwrap();

@@ -3,9 +3,9 @@
 
 use std::sync::Arc;
 
-use go2::{Connection, Device, Go2, Go2Error, Go2Stats, Hg, LowLevel, LowLevelOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use unitree::{Connection, Device, Go2, Hg, LowLevel, LowLevelOptions, LowLevelStats, UnitreeError};
 
 use crate::errors::{Kind, chain, error, service_error};
 use crate::joints::JointArgs;
@@ -32,16 +32,16 @@ macro_rules! with_client {
     };
 }
 
-/// A `Go2Error` as the exception a Python user expects.
-pub(crate) fn raise(e: Go2Error) -> PyErr {
+/// A `UnitreeError` as the exception a Python user expects.
+pub(crate) fn raise(e: UnitreeError) -> PyErr {
     match &e {
-        Go2Error::Command(_) | Go2Error::Option { .. } => error(Kind::Argument, chain(&e)),
-        Go2Error::Refused { service, api_id, code } => service_error(chain(&e), service, *api_id, *code),
-        Go2Error::Service { service, api_id, .. } => service_error(chain(&e), service, *api_id, -1),
-        Go2Error::NotReleased { .. } | Go2Error::Unexpected { .. } => {
+        UnitreeError::Command(_) | UnitreeError::Option { .. } => error(Kind::Argument, chain(&e)),
+        UnitreeError::Refused { service, api_id, code } => service_error(chain(&e), service, *api_id, *code),
+        UnitreeError::Service { service, api_id, .. } => service_error(chain(&e), service, *api_id, -1),
+        UnitreeError::NotReleased { .. } | UnitreeError::Unexpected { .. } => {
             service_error(chain(&e), "motion_switcher", 0, -1)
         }
-        Go2Error::Closed => error(Kind::Closed, chain(&e)),
+        UnitreeError::Closed => error(Kind::Closed, chain(&e)),
         _ => error(Kind::Error, chain(&e)),
     }
 }
@@ -101,8 +101,8 @@ impl Go2LowLevel {
         record: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let low_level = match robot {
-            "go2" => &lowcmd_proto::description::GO2_LOW_LEVEL,
-            "hg" => &lowcmd_proto::description::HG_LOW_LEVEL,
+            "go2" => &unitree_proto::description::GO2_LOW_LEVEL,
+            "hg" => &unitree_proto::description::HG_LOW_LEVEL,
             other => return Err(error(Kind::Argument, format!("robot = {other:?}: \"go2\" or \"hg\""))),
         };
         let service_timeout = seconds("service_timeout_s", service_timeout_s)?;
@@ -270,7 +270,7 @@ closeable!(
 
 /// A low-level client's stats as a dict: topics, commands sent, damping, timeouts, lost states,
 /// timing (µs).
-pub(crate) fn low_level_stats<'py>(py: Python<'py>, s: &Go2Stats) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn low_level_stats<'py>(py: Python<'py>, s: &LowLevelStats) -> PyResult<Bound<'py, PyDict>> {
     Ok(dict!(py, {
         "lowcmd" => topic(py, &s.lowcmd)?,
         "lowstate" => topic(py, &s.lowstate)?,

@@ -1,8 +1,8 @@
 //! Per-joint arguments of the Unitree clients (`robowire.go2`, `robowire.g1`): each one number
 //! for every joint, or one value per joint.
 
-use go2::JointCommand;
 use pyo3::prelude::*;
+use unitree::JointCommand;
 
 use crate::errors::{Kind, error};
 

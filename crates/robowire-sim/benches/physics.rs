@@ -9,14 +9,14 @@
 
 use std::time::Instant;
 
-use lowcmd_proto::g1::{self, G1Variant};
-use lowcmd_proto::go2::MotorCmd;
-use lowcmd_proto::{HgLowCmd, LowCmd};
 use robowire_core::cdr::CdrType;
 use robowire_sim::g1::{G1Body, JOINTS as G1_JOINTS};
 use robowire_sim::go2::{Go2Body, JOINTS, STAND_POSE_RAD};
 use robowire_sim::physics::PhysicsOptions;
 use serde_json::json;
+use unitree_proto::g1::{self, G1Variant};
+use unitree_proto::go2::MotorCmd;
+use unitree_proto::{HgLowCmd, LowCmd};
 
 const DT_S: f32 = 0.002;
 

@@ -151,9 +151,9 @@ impl<const N: usize> Plant for SlotJoints<N> {
 /// in the world, the yaw rate, and the contact force of its first `feet` feet (N, the rest 0).
 /// `mode` 0 (idle) and everything the sport service plans (gait, path, obstacles) zero: no
 /// sport service drives the simulated robot.
-pub(crate) fn sport_mode_state(plant: &dyn Plant, feet: usize) -> Option<lowcmd_proto::sport_state::SportModeState> {
+pub(crate) fn sport_mode_state(plant: &dyn Plant, feet: usize) -> Option<unitree_proto::sport_state::SportModeState> {
     let base = plant.base()?;
-    let mut state = lowcmd_proto::sport_state::SportModeState::default();
+    let mut state = unitree_proto::sport_state::SportModeState::default();
     let t = plant.time_s();
     state.stamp.sec = (t.trunc() as i32).into();
     state.stamp.nanosec = ((t.fract() * 1e9) as u32).into();

@@ -7,13 +7,13 @@ mod unitree_wire;
 
 use std::time::Instant;
 
-use lowcmd_proto::api::{self, g1_arm, g1_loco, motion_switcher, status};
-use lowcmd_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, ModePr, slot};
-use lowcmd_proto::{HgLowCmd, HgLowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
 use robowire_sim::g1::{G1Fault, G1Sim, G1SimConfig, G1Snapshot, JOINTS, STAND_POSE_RAD};
+use unitree_proto::api::{self, g1_arm, g1_loco, motion_switcher, status};
+use unitree_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, ModePr, slot};
+use unitree_proto::{HgLowCmd, HgLowState, Message};
 use unitree_wire::{ServiceClient, Unsealed, WAIT};
 
 /// The other end of the wire: Unitree's side.

@@ -5,11 +5,11 @@ mod hammer;
 
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::{LowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
+use unitree_proto::{LowState, Message};
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 const WAIT: Duration = Duration::from_secs(20);

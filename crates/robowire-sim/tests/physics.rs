@@ -4,12 +4,12 @@
 //! a user's MJCF without a motor's joint is refused by name. Each in simulated time (2 ms
 //! steps, as the state stream gives them), so the same on any machine.
 
-use lowcmd_proto::g1::{self, G1Variant};
-use lowcmd_proto::go2::MotorCmd;
-use lowcmd_proto::{HgLowCmd, LowCmd};
 use robowire_sim::g1::{G1Body, JOINTS as G1_JOINTS};
 use robowire_sim::go2::{Go2Body, JOINTS, LYING_POSE_RAD};
 use robowire_sim::physics::{PhysicsError, PhysicsOptions};
+use unitree_proto::g1::{self, G1Variant};
+use unitree_proto::go2::MotorCmd;
+use unitree_proto::{HgLowCmd, LowCmd};
 
 /// The stand pose of Unitree's Go2 stand example, per motor.
 const STAND: [f32; JOINTS] = [0.0, 0.67, -1.3, 0.0, 0.67, -1.3, 0.0, 0.67, -1.3, 0.0, 0.67, -1.3];

@@ -6,11 +6,11 @@
 
 use std::time::Duration;
 
-use lowcmd_proto::{CdrEncoding, LowCmd, LowState, Message};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::replay::{DdsReplay, DdsTopic, Pace, ReplayError};
+use unitree_proto::{CdrEncoding, LowCmd, LowState, Message};
 
 /// Every wait is bounded, so a broken player fails the test instead of hanging it.
 const WATCHDOG: Duration = Duration::from_secs(20);

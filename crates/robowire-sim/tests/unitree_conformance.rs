@@ -16,13 +16,13 @@ mod unitree_wire;
 use std::time::{Duration, Instant};
 
 use conformance::{Body, Client, Simulator, State};
-use lowcmd_proto::Message;
-use lowcmd_proto::api::{self, motion_switcher, status};
-use lowcmd_proto::robot::Robot;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_fixtures::wait::until;
 use robowire_sim::g1::G1Sim;
 use robowire_sim::go2::{AdvanceError, Go2Fault as Fault, Go2Sim, SimClock};
+use unitree_proto::Message;
+use unitree_proto::api::{self, motion_switcher, status};
+use unitree_proto::robot::Robot;
 use unitree_wire::{Unsealed, WAIT};
 
 /// How far from where it stands a check sends its joint, rad.
@@ -155,8 +155,8 @@ fn faults<S: Simulator>(body: Body) {
 /// `rt/sportmodestate` comes from the physics: the body's height, and the snapshot's base.
 #[cfg(feature = "mujoco")]
 fn sport_state<S: Simulator>(body: Body) {
-    use lowcmd_proto::sport_state::{SPORT_MODE_STATE_TOPIC, SportModeState};
     use robowire_dds::qos::Qos;
+    use unitree_proto::sport_state::{SPORT_MODE_STATE_TOPIC, SportModeState};
     let sim = S::spawn(body, SimClock::default());
     let c = Client::<S>::new(1);
     let mut reader = c.participant.reader::<SportModeState>(SPORT_MODE_STATE_TOPIC, Qos::READER).unwrap();

@@ -1,7 +1,7 @@
 //! A slot holds the largest frame of every protocol robowire records.
 
-use lowcmd_proto::{CdrEncoding, HgLowState, LowState, Message};
 use robowire_tap::SLOT_BYTES;
+use unitree_proto::{CdrEncoding, HgLowState, LowState, Message};
 use zsl_proto::udp::HighLevelState;
 
 #[test]

@@ -10,7 +10,7 @@
 //! - one way: a LowCmd written (encode, CRC, RTPS) → decoded and verified at a reader in
 //!   another participant, beside `ddsperf`'s half round trip.
 //!
-//! - a stalled reader: the send lateness of a `go2::LowLevel` client's 500 Hz LowCmd stream
+//! - a stalled reader: the send lateness of a `unitree::LowLevel` client's 500 Hz LowCmd stream
 //!   (`set_joints` latched once, nothing else) while a RELIABLE reader of `rt/lowcmd`, a process
 //!   of its own (this program run again), is healthy; stops taking samples for 1 s (its
 //!   participant still acknowledges what arrives: acknowledgements come from its background
@@ -36,15 +36,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use go2::{Device, JointCommand, LowLevel, LowLevelOptions};
-use lowcmd_proto::api::motion_switcher;
-use lowcmd_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 use robowire_core::cdr::CdrType;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::g1::{G1Sim, G1SimConfig};
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use serde_json::{Value, json};
+use unitree::{Device, JointCommand, LowLevel, LowLevelOptions};
+use unitree_proto::api::motion_switcher;
+use unitree_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 
 /// Both sides get a CPU of their own, ddsperf's and ours alike: the client side on CPU 0, the
 /// peer (pong, the simulator, the second participant) on CPU 1.
@@ -155,7 +155,7 @@ async fn g1_round_trips(seconds: u32) -> Vec<f64> {
     let _sim = on_cpu(PEER_CPU, || G1Sim::spawn(config).expect("simulator"));
     let tagged = |tag: u32| {
         let mut cmd = HgLowCmd::default();
-        cmd.mode_machine = lowcmd_proto::g1::G1Variant::Dof29.mode_machine();
+        cmd.mode_machine = unitree_proto::g1::G1Variant::Dof29.mode_machine();
         cmd.reserve[0] = tag.into();
         cmd
     };
@@ -175,7 +175,7 @@ where
     S: Message + CdrType + Send + Sync + 'static,
 {
     let us = Participant::new(ParticipantOptions::new(0, Some("lo"))).expect("participant");
-    let switcher = go2::services::ServiceClient::new(&us, motion_switcher::SERVICE).unwrap();
+    let switcher = unitree::services::ServiceClient::new(&us, motion_switcher::SERVICE).unwrap();
     let released = switcher.call(motion_switcher::RELEASE_MODE, "{}", Duration::from_secs(20)).await.unwrap();
     assert_eq!(released.code, 0);
     let writer = us.writer::<C>(C::TOPIC, Qos::WRITER).unwrap();
@@ -427,10 +427,10 @@ fn lowcmd_stream_recorded(stall: Stall, before: Duration, stall_for: Duration, a
     let recorder = record.then(|| robowire_record::Recorder::create(&capture, "bench").expect("a recorder"));
     let mut reader = ReaderProcess::spawn();
     let options = LowLevelOptions {
-        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL)),
         ..LowLevelOptions::on(Some("lo"), 0)
     };
-    let client = LowLevel::<go2::Go2>::open(options).expect("Go2 client");
+    let client = LowLevel::<unitree::Go2>::open(options).expect("Go2 client");
     client.set_joints(&[JointCommand::hold(0.0, 0.0, 1.0); 12]).expect("a command");
     reader.line("receiving", Duration::from_secs(30));
     std::thread::sleep(before);

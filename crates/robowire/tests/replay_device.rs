@@ -42,7 +42,7 @@ fn record_demo(device: &str, capture: &Path) -> Vec<RecordedFrame> {
     }
     let descriptions = [
         &kmc_proto::description::DESCRIPTIONS[..],
-        &lowcmd_proto::description::DESCRIPTIONS,
+        &unitree_proto::description::DESCRIPTIONS,
         &zsl_proto::description::DESCRIPTIONS,
         &[&robowire_core::json::SKIPPED_BYTES],
     ]
@@ -168,9 +168,9 @@ fn a_live_go2_client_receives_the_recorded_lowstates() {
 }
 
 fn check_go2_replay() {
-    use go2::{Device, Go2, LowLevel, LowLevelOptions, LowState};
-    use lowcmd_proto::Message;
     use robowire_dds::qos::Qos;
+    use unitree::{Device, Go2, LowLevel, LowLevelOptions, LowState};
+    use unitree_proto::Message;
     let capture = temp("go2.mcap");
     let frames = record_demo("go2", &capture);
     // Recorded at the client: the LowStates it received, the demo's bit flips among them.
@@ -228,7 +228,7 @@ fn check_go2_replay() {
     // in order, byte for byte (the encapsulation header, the body, the CRC: the broken ones
     // still broken).
     let raw = runtime().block_on(async {
-        let participant = robowire_dds::Participant::new(go2::ParticipantOptions::new(0, Some("lo"))).unwrap();
+        let participant = robowire_dds::Participant::new(unitree::ParticipantOptions::new(0, Some("lo"))).unwrap();
         let reliable = Qos { reliable: true, depth: 1024, ..Qos::READER };
         let mut reader = participant.raw_reader(LowState::TOPIC, LowState::DDS_TYPE_NAME, reliable).unwrap();
         let replay = Running::spawn(
@@ -277,7 +277,7 @@ fn what_cannot_be_played_is_a_clear_error() {
     serial.record(Direction::Sent, &[0xb3]);
     serial.record(Direction::Sent, &[0xa5, 0, 0, 0, 0, 0, 0, 0, 0]);
     recorder.link("kmc/serial_skipped", &robowire_core::json::SKIPPED_BYTES).record(Direction::Received, &[0x42]);
-    recorder.link("go2/api", &lowcmd_proto::description::API_CLIENT).record(Direction::Sent, &[0, 1, 0, 0]);
+    recorder.link("go2/api", &unitree_proto::description::API_CLIENT).record(Direction::Sent, &[0, 1, 0, 0]);
     recorder.finish().unwrap();
 
     let found = ["kmc/serial (kmc.host, 2 frames)", "kmc/serial_skipped (stream.skipped, 1 frames)", "go2/api"];

@@ -213,10 +213,10 @@ fn a_go2_publishes_joint_states_and_passes_lowstate_through() {
 
 #[test]
 fn a_g1_publishes_its_joints_by_name_its_battery_and_passes_its_hg_lowstate_through() {
-    use lowcmd_proto::HgLowState;
     use robowire_dds::qos::Qos;
     use robowire_dds::{Participant, ParticipantOptions};
     use ros2_proto::sensor::{BatteryState, Imu, JointState};
+    use unitree_proto::HgLowState;
 
     /// Generous: a topic silent this long is a failure, not slowness.
     const WAIT: std::time::Duration = std::time::Duration::from_secs(20);
@@ -233,7 +233,7 @@ fn a_g1_publishes_its_joints_by_name_its_battery_and_passes_its_hg_lowstate_thro
             let low = tokio::time::timeout(WAIT, lowstate.recv()).await.expect("rt/g1/lowstate").unwrap().value;
             assert_eq!(low.mode_machine, 5);
             let joints = tokio::time::timeout(WAIT, joints.recv()).await.expect("joint_states").unwrap().value;
-            assert_eq!(joints.name, g1::JOINT_NAMES);
+            assert_eq!(joints.name, unitree::g1::JOINT_NAMES);
             assert_eq!(joints.header.frame_id, "g1/base_link");
             let q = |slot: usize| low.motor_state[slot].q.get();
             assert!(joints.position.iter().enumerate().all(|(i, p)| (*p as f32 - q(i)).abs() < 0.05), "{joints:?}");
@@ -268,7 +268,7 @@ fn a_cyclonedds_peer_reads_a_g1_with_unitrees_hg_classes() {
         let bridge = Bridge::start(&["--device", "sim:g1", "--interface", "lo", "--namespace", "g1"]);
         let seen = peer(&python, "sense_g1", "/g1");
         let names: Vec<&str> = seen["names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
-        assert_eq!(names, g1::JOINT_NAMES);
+        assert_eq!(names, unitree::g1::JOINT_NAMES);
         assert_eq!(seen["crc_ok"], true, "Unitree's CRC accepts the passed-through HG LowState: {seen}");
         assert_eq!(seen["mode_machine"], 5);
         let q =

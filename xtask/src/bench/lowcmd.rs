@@ -1,4 +1,4 @@
-//! Rows of the Unitree low-level codec benchmarks (`lowcmd-proto`'s criterion bench): the CRC
+//! Rows of the Unitree low-level codec benchmarks (`unitree-proto`'s criterion bench): the CRC
 //! beside Unitree's bitwise routine, the Go2 and HG messages' encode/decode beside a memcpy, their
 //! XCDR1 copy plans beside the struct-image paths.
 

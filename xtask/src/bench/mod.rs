@@ -23,7 +23,7 @@ use crate::workspace_root;
 pub(crate) const BENCHES: &[(&str, &str)] = &[
     ("kmc-proto", "codec"),
     ("kmc", "serial"),
-    ("lowcmd-proto", "lowcmd"),
+    ("unitree-proto", "lowcmd"),
     ("rtps-proto", "rtps"),
     ("zsl", "spline"),
     ("zsl", "udp"),

@@ -2,9 +2,6 @@
 //! low-level messages, the services' requests and answers), made with the codecs from values
 //! like those robowire's bridges and simulators send.
 
-use lowcmd_proto::api::{self, Request, RequestHeader, Response};
-use lowcmd_proto::robot::GO2_JOINT_NAMES;
-use lowcmd_proto::{BufferTooSmall, CdrEncoding, Message};
 use ros2_proto::builtin::{Header, Time};
 use ros2_proto::decode_roundtrip::input;
 use ros2_proto::diagnostic::{DiagnosticArray, DiagnosticStatus, KeyValue};
@@ -16,6 +13,9 @@ use ros2_proto::rmw_dds_common::{Gid, NodeEntitiesInfo, ParticipantEntitiesInfo}
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
 use ros2_proto::srv::{RequestId, TriggerRequest, TriggerRequestBody, TriggerResponse, TriggerResponseBody};
 use ros2_proto::tf::TfMessage;
+use unitree_proto::api::{self, Request, RequestHeader, Response};
+use unitree_proto::robot::GO2_JOINT_NAMES;
+use unitree_proto::{BufferTooSmall, CdrEncoding, Message};
 
 /// A named seed input.
 type Seed = (String, Vec<u8>);
@@ -172,7 +172,7 @@ fn api_bodies() -> Vec<(&'static str, bool, Vec<u8>)> {
     requests.chain(responses).collect()
 }
 
-/// `lowcmd_proto::decode_roundtrip::api_decode` inputs: selector 0 (request) or 1 (answer),
+/// `unitree_proto::decode_roundtrip::api_decode` inputs: selector 0 (request) or 1 (answer),
 /// the body.
 pub(super) fn api_seeds() -> Vec<Seed> {
     api_bodies()
@@ -181,7 +181,7 @@ pub(super) fn api_seeds() -> Vec<Seed> {
         .collect()
 }
 
-/// `go2::fuzz_receive` inputs that no golden vector gives: HG `LowCmd_` and
+/// `unitree::fuzz_receive` inputs that no golden vector gives: HG `LowCmd_` and
 /// `LowState_` (selectors 2, 3), default and filled with a byte pattern, and the service bodies
 /// (selectors 4, 5), each in XCDR1 and XCDR2.
 pub(super) fn dds_seeds() -> Vec<Seed> {
@@ -189,10 +189,10 @@ pub(super) fn dds_seeds() -> Vec<Seed> {
     for encoding in [CdrEncoding::Xcdr1, CdrEncoding::Xcdr2] {
         let tag = if encoding == CdrEncoding::Xcdr1 { "xcdr1" } else { "xcdr2" };
         for (name, payload) in [
-            ("hg-lowcmd", payload_of(lowcmd_proto::HgLowCmd::default(), encoding)),
-            ("hg-lowcmd-pattern", payload_of(pattern::<lowcmd_proto::HgLowCmd>(), encoding)),
-            ("hg-lowstate", payload_of(lowcmd_proto::HgLowState::default(), encoding)),
-            ("hg-lowstate-pattern", payload_of(pattern::<lowcmd_proto::HgLowState>(), encoding)),
+            ("hg-lowcmd", payload_of(unitree_proto::HgLowCmd::default(), encoding)),
+            ("hg-lowcmd-pattern", payload_of(pattern::<unitree_proto::HgLowCmd>(), encoding)),
+            ("hg-lowstate", payload_of(unitree_proto::HgLowState::default(), encoding)),
+            ("hg-lowstate-pattern", payload_of(pattern::<unitree_proto::HgLowState>(), encoding)),
         ] {
             let selector = if name.starts_with("hg-lowcmd") { 2 } else { 3 };
             seeds.push((format!("seed-{name}-{tag}"), [&[selector][..], &payload].concat()));

@@ -39,12 +39,12 @@ pub const TARGETS: &[Target] = &[
     Target {
         name: "lowcmd_image_decode",
         seeds: || unitree_seeds("packed_hex"),
-        check: lowcmd_proto::decode_roundtrip::image_decode,
+        check: unitree_proto::decode_roundtrip::image_decode,
     },
     Target {
         name: "lowcmd_cdr_decode",
         seeds: || unitree_seeds("cdr_hex"),
-        check: lowcmd_proto::decode_roundtrip::cdr_decode,
+        check: unitree_proto::decode_roundtrip::cdr_decode,
     },
     Target { name: "zsl_datagram_decode", seeds: zsl1_seeds, check: zsl_proto::decode_roundtrip::datagram_decode },
     Target {
@@ -57,11 +57,11 @@ pub const TARGETS: &[Target] = &[
         seeds: || Ok(messages::ros2_seeds()),
         check: ros2_proto::decode_roundtrip::message_decode,
     },
-    Target { name: "dds_sample_receive", seeds: dds_seeds, check: go2::fuzz_receive },
+    Target { name: "dds_sample_receive", seeds: dds_seeds, check: unitree::fuzz_receive },
     Target {
         name: "lowcmd_api_decode",
         seeds: || Ok(messages::api_seeds()),
-        check: lowcmd_proto::decode_roundtrip::api_decode,
+        check: unitree_proto::decode_roundtrip::api_decode,
     },
     Target { name: "rtps_message_parse", seeds: rtps_seeds, check: rtps_proto::fuzzing::parse_all },
     Target { name: "rtps_participant", seeds: rtps_participant_seeds, check: rtps_proto::fuzzing::participant },

@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use lowcmd_proto::{CdrEncoding, LowCmd, LowState, Message};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
+use unitree_proto::{CdrEncoding, LowCmd, LowState, Message};
 
 use super::{Outcome, to_json};
 use crate::{hex_decode, hex_encode, workspace_root};
@@ -139,7 +139,7 @@ pub fn check(path: &Path) -> anyhow::Result<Vec<Outcome>> {
             .collect::<anyhow::Result<Vec<_>>>()?
             .concat();
         let expected = vector["crc"].as_u64().context("crc")?;
-        let got = lowcmd_proto::crc::crc32_words(&words).map(u64::from);
+        let got = unitree_proto::crc::crc32_words(&words).map(u64::from);
         let problems =
             if got == Some(expected) { Vec::new() } else { vec![format!("CRC {got:?}, expected {expected:#010x}")] };
         outcomes.push(Outcome::new(format!("crc {}", str_of(&vector, "name")?), problems));

@@ -2,8 +2,8 @@
 //! pelvis IMU; the battery from `rt/lf/bmsstate`; the HG LowState itself to pass through. It is
 //! commanded joint by joint, not by a velocity: it is not driven, and has no services here.
 
-use ::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS};
 use serde_json::Value;
+use unitree::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS};
 
 use super::unitree::{imu, low_level_stats, lowstate_passthrough};
 use crate::link::{Describe, Link, Observations, floats};
@@ -159,7 +159,7 @@ pub(crate) fn open(interface: &str, options: &OpenOptions) -> Result<Box<dyn Lin
 pub(crate) fn client_options(interface: Option<&str>, options: &OpenOptions) -> G1Options {
     let defaults = G1Options::on(interface, options.domain);
     let state_timeout = options.state_timeout.unwrap_or(defaults.low_level.state_timeout);
-    let low_level = go2::LowLevelOptions { state_timeout, ..defaults.low_level };
+    let low_level = unitree::LowLevelOptions { state_timeout, ..defaults.low_level };
     G1Options { low_level, ..defaults }.recorded(options.record.as_ref())
 }
 

@@ -27,9 +27,9 @@ pub(crate) fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<Box
         #[cfg(feature = "zsl1")]
         DeviceAddress::Spline(name) => spline::open(name, options)?,
         #[cfg(feature = "unitree")]
-        DeviceAddress::Go2(interface) => unitree::open::<::go2::Go2>(interface, options)?,
+        DeviceAddress::Go2(interface) => unitree::open::<::unitree::Go2>(interface, options)?,
         #[cfg(feature = "unitree")]
-        DeviceAddress::Hg(interface) => unitree::open::<::go2::Hg>(interface, options)?,
+        DeviceAddress::Hg(interface) => unitree::open::<::unitree::Hg>(interface, options)?,
         #[cfg(feature = "unitree")]
         DeviceAddress::G1(interface) => g1::open(interface, options)?,
         other => return Err(not_built(other)),
@@ -63,7 +63,8 @@ mod tests {
         let quick = OpenOptions { state_timeout: Some(Duration::from_millis(250)), ..OpenOptions::default() };
         let zsl_client = || ::zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into());
         let zsl_options = super::zsl1::client_options;
-        let (go2_options, g1_options) = (super::unitree::low_level_options::<::go2::Go2>, super::g1::client_options);
+        let (go2_options, g1_options) =
+            (super::unitree::low_level_options::<::unitree::Go2>, super::g1::client_options);
 
         assert_eq!(super::kmc::driver_options(&quick).state_timeout, Duration::from_millis(250));
         assert_eq!(zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &quick).watchdog, Duration::from_millis(250));
@@ -74,7 +75,7 @@ mod tests {
         assert_eq!(super::kmc::driver_options(&default).state_timeout, ::kmc::DriverOptions::default().state_timeout);
         let zsl = zsl_options(zsl_client(), ::zsl::udp::Model::Zsl1W, &default);
         assert_eq!((zsl.watchdog, zsl.model), (zsl_client().watchdog, ::zsl::udp::Model::Zsl1W));
-        assert_eq!(go2_options(None, &default).state_timeout, ::go2::STATE_TIMEOUT);
-        assert_eq!(g1_options(None, &default).low_level.state_timeout, ::go2::STATE_TIMEOUT);
+        assert_eq!(go2_options(None, &default).state_timeout, ::unitree::STATE_TIMEOUT);
+        assert_eq!(g1_options(None, &default).low_level.state_timeout, ::unitree::STATE_TIMEOUT);
     }
 }

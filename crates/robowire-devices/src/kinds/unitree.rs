@@ -2,10 +2,10 @@
 //! LowState itself from `rt/lowstate`. It is commanded joint by joint, not by a velocity: it is
 //! not driven, and has no services here (releasing the sport mode is the `go2` facade's).
 
-use go2::{Device, Go2, Hg, HgLowState, LowLevel, LowState, Robot};
-use lowcmd_proto::F32;
 use robowire_core::cdr::CdrType;
 use serde_json::Value;
+use unitree::{Device, Go2, Hg, HgLowState, LowLevel, LowState, Robot};
+use unitree_proto::F32;
 
 use crate::link::{Describe, Link, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
@@ -40,11 +40,11 @@ pub(crate) fn imu(quaternion: [F32; 4], gyroscope: [F32; 3], accelerometer: [F32
 
 impl Family for Go2 {
     const RECORDED_AS: &'static str = "go2";
-    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &lowcmd_proto::description::GO2_LOW_LEVEL;
+    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &unitree_proto::description::GO2_LOW_LEVEL;
 
     fn text(state: &LowState) -> String {
         let mut lines = vec![Self::line(state)];
-        for (i, name) in go2::GO2_JOINT_NAMES.iter().enumerate() {
+        for (i, name) in unitree::GO2_JOINT_NAMES.iter().enumerate() {
             let m = &state.motor_state[i];
             lines.push(format!(
                 "  {name:<9} q {:+.3} rad  dq {:+.3} rad/s  tau {:+.2} N·m  mode {}  {} °C",
@@ -79,7 +79,7 @@ impl Family for Go2 {
         let bms = &state.bms_state;
         Observation {
             joints: Some(JointReadings {
-                names: go2::GO2_JOINT_NAMES.iter().map(|n| format!("{n}_joint")).collect(),
+                names: unitree::GO2_JOINT_NAMES.iter().map(|n| format!("{n}_joint")).collect(),
                 position_rad: motors.iter().map(|m| f64::from(m.q.get())).collect(),
                 velocity_radps: motors.iter().map(|m| f64::from(m.dq.get())).collect(),
                 effort_nm: motors.iter().map(|m| f64::from(m.tau_est.get())).collect(),
@@ -98,7 +98,7 @@ impl Family for Go2 {
 
 impl Family for Hg {
     const RECORDED_AS: &'static str = "hg";
-    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &lowcmd_proto::description::HG_LOW_LEVEL;
+    const LOW_LEVEL: &'static dyn robowire_core::json::LinkDescription = &unitree_proto::description::HG_LOW_LEVEL;
 
     fn text(state: &HgLowState) -> String {
         let q: Vec<f32> = state.motor_state.iter().map(|m| m.q.get()).collect();
@@ -147,7 +147,7 @@ pub(crate) fn lowstate_passthrough<S: CdrType>(state: &S) -> Option<Passthrough>
 }
 
 /// The low-level client's counters as one line.
-pub(crate) fn low_level_stats(s: &go2::Go2Stats) -> String {
+pub(crate) fn low_level_stats(s: &unitree::LowLevelStats) -> String {
     format!(
         "lowcmd sent {} (damping {}) | lowstate received {} decode errors {} CRC errors {} lost by tick {} | \
          send lateness p50 {} µs p99 {} µs",
@@ -208,7 +208,7 @@ pub(crate) fn open<R: Family>(interface: &str, options: &OpenOptions) -> Result<
 }
 
 /// A low-level client's options for family `R`, recorded under its name (`go2/low_level`).
-pub(crate) fn low_level_options<R: Family>(interface: Option<&str>, options: &OpenOptions) -> go2::LowLevelOptions {
+pub(crate) fn low_level_options<R: Family>(interface: Option<&str>, options: &OpenOptions) -> unitree::LowLevelOptions {
     recorded_options(interface, options, R::RECORDED_AS, R::LOW_LEVEL)
 }
 
@@ -219,8 +219,8 @@ pub(crate) fn recorded_options(
     options: &OpenOptions,
     recorded_as: &str,
     low_level: &'static dyn robowire_core::json::LinkDescription,
-) -> go2::LowLevelOptions {
-    let defaults = go2::LowLevelOptions::on(interface, options.domain);
-    go2::LowLevelOptions { state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout), ..defaults }
+) -> unitree::LowLevelOptions {
+    let defaults = unitree::LowLevelOptions::on(interface, options.domain);
+    unitree::LowLevelOptions { state_timeout: options.state_timeout.unwrap_or(defaults.state_timeout), ..defaults }
         .recorded(options.record.as_ref(), recorded_as, low_level)
 }

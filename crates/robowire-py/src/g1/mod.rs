@@ -6,10 +6,12 @@ mod services;
 use std::future::Future;
 use std::sync::Arc;
 
-use g1::{ARM_JOINTS, ARM_SDK_JOINTS, Connection, Device, G1, G1Error, G1Options, G1Variant, JOINTS, LowLevelOptions};
-use lowcmd_proto::api::{g1_arm, g1_loco};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use unitree::g1::{
+    ARM_JOINTS, ARM_SDK_JOINTS, Connection, Device, G1, G1Error, G1Options, G1Variant, JOINTS, LowLevelOptions,
+};
+use unitree_proto::api::{g1_arm, g1_loco};
 
 use crate::errors::{Kind, chain, error, service_error};
 use crate::go2::{connection, low_level_stats};
@@ -365,12 +367,12 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("G1Loco", py.get_type::<Loco>())?;
     m.add("G1ArmActions", py.get_type::<ArmActions>())?;
     m.add("G1_JOINTS", JOINTS)?;
-    m.add("G1_JOINT_NAMES", g1::JOINT_NAMES.to_vec())?;
-    m.add("G1_DEFAULT_KP", g1::DEFAULT_GAINS.map(|g| g.kp).to_vec())?;
-    m.add("G1_DEFAULT_KD", g1::DEFAULT_GAINS.map(|g| g.kd).to_vec())?;
+    m.add("G1_JOINT_NAMES", unitree::g1::JOINT_NAMES.to_vec())?;
+    m.add("G1_DEFAULT_KP", unitree::g1::DEFAULT_GAINS.map(|g| g.kp).to_vec())?;
+    m.add("G1_DEFAULT_KD", unitree::g1::DEFAULT_GAINS.map(|g| g.kd).to_vec())?;
     m.add("G1_ARM_JOINT_SLOTS", ARM_SDK_JOINTS.to_vec())?;
-    m.add("G1_VX_MAX_MPS", g1::VX_MAX_MPS)?;
-    m.add("G1_VY_MAX_MPS", g1::VY_MAX_MPS)?;
-    m.add("G1_YAW_RATE_MAX_RADPS", g1::YAW_RATE_MAX_RADPS)?;
+    m.add("G1_VX_MAX_MPS", unitree::g1::VX_MAX_MPS)?;
+    m.add("G1_VY_MAX_MPS", unitree::g1::VY_MAX_MPS)?;
+    m.add("G1_YAW_RATE_MAX_RADPS", unitree::g1::YAW_RATE_MAX_RADPS)?;
     Ok(())
 }

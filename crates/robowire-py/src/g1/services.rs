@@ -3,8 +3,8 @@
 
 use std::future::Future;
 
-use g1::{G1, G1Error};
 use pyo3::prelude::*;
+use unitree::g1::{G1, G1Error};
 
 use super::{Shared, blocking, client};
 use crate::errors::{Kind, error};
@@ -51,7 +51,7 @@ service_class!(
     /// before anything is sent (`ArgumentError`); a refusal is a `ServiceError` with its `code`:
     /// 7301 (locomotion unavailable after `G1.release()`, until `G1.select_mode()`), 7302 (no such
     /// FSM id), 7303 (no such arm task). Every call waits at most the client's `service_timeout_s`.
-    Loco, g1::Loco, G1::loco
+    Loco, unitree::g1::Loco, G1::loco
 );
 
 #[pymethods]
@@ -118,8 +118,8 @@ impl Loco {
     /// SetBalanceMode: 0 balance stand, 1 continuous gait. Raises `ArgumentError` for another.
     fn set_balance_mode(&self, py: Python<'_>, mode: u8) -> PyResult<()> {
         let mode = match mode {
-            0 => g1::BalanceMode::BalanceStand,
-            1 => g1::BalanceMode::ContinuousGait,
+            0 => unitree::g1::BalanceMode::BalanceStand,
+            1 => unitree::g1::BalanceMode::ContinuousGait,
             other => {
                 return Err(error(
                     Kind::Argument,
@@ -170,7 +170,7 @@ service_class!(
     /// `ServiceError` with its `code`: 7400 (`rt/arm_sdk` in use: ramp its weight to 0 first), 7401
     /// (the arms hold an action: `release_arm()`), 7402 (no such action), 7404 (actions run only in
     /// FSM 500, 501 and 801). Every call waits at most the client's `service_timeout_s`.
-    ArmActions, g1::ArmActions, G1::arm
+    ArmActions, unitree::g1::ArmActions, G1::arm
 );
 
 #[pymethods]

@@ -1,10 +1,10 @@
 //! `robowire.sim.G1`: a Unitree G1 humanoid on DDS.
 
-use lowcmd_proto::g1::G1Variant;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robowire_dds::ParticipantOptions;
 use robowire_sim::g1::{G1Sim, G1SimConfig};
+use unitree_proto::g1::G1Variant;
 
 use super::go2::topic;
 use super::unitree::faults;
@@ -70,8 +70,8 @@ impl G1 {
             participant: ParticipantOptions::new(domain, interface),
             mode_machine: mode_machine.unwrap_or(defaults.mode_machine),
             state_period,
-            low_level_tap: links.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
-            services_tap: links.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_SERVER)),
+            low_level_tap: links.as_ref().map(|r| r.link("g1/low_level", &unitree_proto::description::HG_LOW_LEVEL)),
+            services_tap: links.as_ref().map(|r| r.link("g1/api", &unitree_proto::description::API_SERVER)),
             #[cfg(feature = "mujoco")]
             physics,
             ..defaults

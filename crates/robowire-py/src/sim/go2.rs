@@ -61,8 +61,8 @@ impl Go2 {
         let config = Go2SimConfig {
             participant: ParticipantOptions::new(domain, interface),
             state_period,
-            low_level_tap: links.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
-            services_tap: links.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
+            low_level_tap: links.as_ref().map(|r| r.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL)),
+            services_tap: links.as_ref().map(|r| r.link("go2/api", &unitree_proto::description::API_SERVER)),
             #[cfg(feature = "mujoco")]
             physics,
             ..Go2SimConfig::default()

@@ -3,9 +3,9 @@
 
 use std::sync::{Arc, Mutex};
 
-use lowcmd_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, IntoBytes, LowCmd, LowState, Message};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
+use unitree_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, IntoBytes, LowCmd, LowState, Message};
 
 use super::view::{Image, StructView, lock};
 use crate::errors::{Kind, crc_error, error};
@@ -119,7 +119,7 @@ macro_rules! message_class {
             /// Every field zero (the IDL's default, Unitree's `unitree_go_msg_dds__LowCmd_()`).
             #[staticmethod]
             fn zeroed() -> Self {
-                Self::from_message(&<$msg as lowcmd_proto::FromZeros>::new_zeroed())
+                Self::from_message(&<$msg as unitree_proto::FromZeros>::new_zeroed())
             }
 
             fn __getattr__<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {

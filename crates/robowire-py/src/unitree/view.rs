@@ -1,17 +1,17 @@
 //! Live views into a message's struct image: a nested struct (`cmd.motor_cmd[3]`) or an array
 //! (`cmd.motor_cmd`, `state.imu_state.rpy`) reads and writes the message's bytes, so
 //! `cmd.motor_cmd[3].q = 0.5` changes `cmd`. Where a field lies, its type and its range come from
-//! `lowcmd_proto::field`; this module turns its places and values into Python objects.
+//! `unitree_proto::field`; this module turns its places and values into Python objects.
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use lowcmd_proto::field::{Element, PlaceKind};
-use lowcmd_proto::layout::{Scalar, StructLayout};
-use lowcmd_proto::{FieldError, FieldPlace, FieldValue, Message};
 use pyo3::IntoPyObjectExt;
 use pyo3::exceptions::{PyAttributeError, PyIndexError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySlice};
+use unitree_proto::field::{Element, PlaceKind};
+use unitree_proto::layout::{Scalar, StructLayout};
+use unitree_proto::{FieldError, FieldPlace, FieldValue, Message};
 
 use crate::errors::{Kind, error};
 

@@ -4,8 +4,8 @@
 
 use std::time::Duration;
 
-use lowcmd_proto::bms::HgBmsState;
 use robowire_dds::Writer;
+use unitree_proto::bms::HgBmsState;
 
 /// How often the battery state goes out.
 pub const PERIOD: Duration = Duration::from_secs(1);

@@ -1,6 +1,6 @@
 //! A Unitree G1 humanoid on DDS (the HG messages) that Unitree's own software can drive.
 //!
-//! What is modelled, as the robot does it (see `lowcmd_proto::g1` for the sources):
+//! What is modelled, as the robot does it (see `unitree_proto::g1` for the sources):
 //!
 //! - It boots standing under its own controller: `motion_switcher` CheckMode names the mode
 //!   [`BOOT_MODE`], the loco FSM is 500 (the walking controller), the joints are held at
@@ -12,7 +12,7 @@
 //!   with `mode` 1 (a `mode` 0 motor exerts no torque: a frame with one that carries a target,
 //!   gain or torque is counted in `disabled_motors`, its `mode` 1 motors still applied). Slots
 //!   the variant does not drive move nothing. `mode_pr` PR and AB both drive the ankles and
-//!   the waist's roll and pitch (AB mapped by `lowcmd_proto::g1::joint_targets`); the state
+//!   the waist's roll and pitch (AB mapped by `unitree_proto::g1::joint_targets`); the state
 //!   echoes the last applied LowCmd's `mode_pr` and reports the parallel pairs in it. A LowCmd
 //!   older than [`COMMAND_HOLD_S`] leaves the motors passive.
 //! - `rt/arm_sdk` (HG `LowCmd_`) while the controller owns the motors: the arm and waist joints
@@ -49,15 +49,15 @@ mod services;
 use std::sync::atomic::{AtomicBool, AtomicI64, Ordering};
 use std::time::Duration;
 
-use lowcmd_proto::api::{g1_arm, g1_loco, motion_switcher};
-use lowcmd_proto::g1::{ARM_SDK_TOPIC, G1Variant};
-use lowcmd_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, Message};
 use robowire_core::cdr::CdrType;
 use robowire_core::schedule::Time;
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::{ParticipantOptions, StatsHandle};
 use robowire_rt::stats::Counter;
 use robowire_tap::Tap;
+use unitree_proto::api::{g1_arm, g1_loco, motion_switcher};
+use unitree_proto::g1::{ARM_SDK_TOPIC, G1Variant};
+use unitree_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, Message};
 
 pub use crate::unitree::{
     AdvanceError, BasePose, COMMAND_HOLD_S, Fault as G1Fault, MAX_SPEED, SimClock, SimError as G1SimError,
@@ -89,10 +89,10 @@ pub struct G1SimConfig {
     pub cpu: Option<usize>,
     /// Where each `rt/lowstate` written (the corrupted ones of a fault too) and `rt/lowcmd` and
     /// `rt/arm_sdk` frame taken goes, as its payload: a link described by
-    /// `lowcmd_proto::description::HG_LOW_LEVEL`.
+    /// `unitree_proto::description::HG_LOW_LEVEL`.
     pub low_level_tap: Option<Tap>,
     /// Where each service request taken and answer written goes
-    /// (`lowcmd_proto::description::API_SERVER`).
+    /// (`unitree_proto::description::API_SERVER`).
     pub services_tap: Option<Tap>,
     /// Answer every applied LowCmd with a LowState at once, its `reserve` the command's, besides
     /// the 500 Hz stream (for round-trip measurements; a real G1 only streams).
@@ -303,11 +303,11 @@ impl G1Sim {
             switcher: server(motion_switcher::SERVICE)?,
             loco: server(g1_loco::SERVICE)?,
             arm: server(g1_arm::SERVICE)?,
-            battery: participant.writer(lowcmd_proto::bms::BMS_TOPIC, robowire_dds::qos::Qos::STREAM_WRITER)?,
+            battery: participant.writer(unitree_proto::bms::BMS_TOPIC, robowire_dds::qos::Qos::STREAM_WRITER)?,
         };
         let inbox = G1Inbox {
             lowcmd: CommandInbox::new(config.state_period),
-            arm_sdk: CommandInbox::new(lowcmd_proto::g1::ARM_SDK_PERIOD),
+            arm_sdk: CommandInbox::new(unitree_proto::g1::ARM_SDK_PERIOD),
             controller: AtomicBool::new(true),
             fsm_id: AtomicI64::new(BOOT_FSM_ID),
             bad_mode_machine: Counter::default(),

@@ -1,13 +1,13 @@
 //! The G1's body without I/O: 29 joint slots on a [`Plant`] (the shared PD joint model, each
-//! joint with its torque and range from [`lowcmd_proto::g1::JOINT_LIMITS`], or physics with the
+//! joint with its torque and range from [`unitree_proto::g1::JOINT_LIMITS`], or physics with the
 //! `mujoco` feature), the robot's own controller
 //! holding the stand pose with `rt/arm_sdk` blended in, `rt/lowcmd` once released, and the HG
 //! `LowState` it reports.
 
-use lowcmd_proto::g1::{
+use unitree_proto::g1::{
     self, ARM_SDK_JOINTS, ARM_SDK_WEIGHT_RATE_PER_S, G1Variant, Gains, ModePr, PARALLEL_PAIRS, ab_to_pr, pr_to_ab, slot,
 };
-use lowcmd_proto::{HgLowCmd, HgLowState, HgMotorCmd};
+use unitree_proto::{HgLowCmd, HgLowState, HgMotorCmd};
 
 use crate::joints::{JointStops, Joints, PdTarget};
 use crate::plant::{BaseReading, Plant, SlotJoints};
@@ -264,7 +264,7 @@ impl G1Body {
 
     /// What `rt/sportmodestate` says (physics only; Unitree's simulator publishes the Go2's
     /// message for the G1 too): the pelvis's place and the 2 feet's forces (left, right).
-    pub fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+    pub fn sport_state(&self) -> Option<unitree_proto::sport_state::SportModeState> {
         crate::plant::sport_mode_state(&*self.plant, 2)
     }
 

@@ -5,13 +5,13 @@
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 
-use lowcmd_proto::api::{self, ApiRequest, g1_arm, g1_loco, status};
-use lowcmd_proto::g1::{G1Variant, ModePr};
-use lowcmd_proto::{HgLowCmd, HgLowState};
 use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
 use robowire_rt::lock;
 use serde_json::{Value, json};
+use unitree_proto::api::{self, ApiRequest, g1_arm, g1_loco, status};
+use unitree_proto::g1::{G1Variant, ModePr};
+use unitree_proto::{HgLowCmd, HgLowState};
 
 use super::{ArmSdkFrame, G1Robot, has_disabled_motor};
 use crate::unitree::{Handover, Owner, Report, ServiceServer, answer_at_once, serve};
@@ -26,7 +26,7 @@ pub(super) struct Endpoints {
     pub(super) loco: ServiceServer,
     pub(super) arm: ServiceServer,
     /// `rt/lf/bmsstate`.
-    pub(super) battery: Writer<lowcmd_proto::bms::HgBmsState>,
+    pub(super) battery: Writer<unitree_proto::bms::HgBmsState>,
 }
 
 /// What the robot checks a LowCmd against.

@@ -18,14 +18,14 @@ mod services;
 
 use std::time::Duration;
 
-use lowcmd_proto::api::{motion_switcher, sport};
-use lowcmd_proto::{LowCmd, LowState, Message, go2};
 use robowire_core::schedule::Time;
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, ParticipantOptions, StatsHandle, TopicStats};
 use robowire_rt::stats::Counter;
 use robowire_tap::Tap;
+use unitree_proto::api::{motion_switcher, sport};
+use unitree_proto::{LowCmd, LowState, Message, go2};
 
 pub use crate::unitree::{
     AdvanceError, BasePose, COMMAND_HOLD_S, Fault as Go2Fault, MAX_SPEED, SimClock, SimError as Go2SimError,
@@ -50,10 +50,10 @@ pub struct Go2SimConfig {
     /// round-trip measurements; a real Go2 only streams).
     pub answer_lowcmd: bool,
     /// Where each `rt/lowstate` written (the corrupted ones of a fault too) and `rt/lowcmd`
-    /// taken goes, as its payload: a link described by `lowcmd_proto::description::GO2_LOW_LEVEL`.
+    /// taken goes, as its payload: a link described by `unitree_proto::description::GO2_LOW_LEVEL`.
     pub low_level_tap: Option<Tap>,
     /// Where each service request taken and answer written goes
-    /// (`lowcmd_proto::description::API_SERVER`).
+    /// (`unitree_proto::description::API_SERVER`).
     pub services_tap: Option<Tap>,
     /// Real time (default, at speed 1) or lock-step.
     pub clock: SimClock,

@@ -7,7 +7,7 @@
 //! with kp 0 and `VelStopF` with kd 0 contribute nothing (a `VelStopF` with kd > 0 would be a
 //! 16000 rad/s target: clamped to the torque limit, as a real drive would saturate).
 
-use lowcmd_proto::{LowCmd, LowState};
+use unitree_proto::{LowCmd, LowState};
 
 use crate::joints::PdTarget;
 use crate::plant::{BaseReading, LegJoints, Plant};
@@ -90,7 +90,7 @@ impl Go2Body {
     }
 
     /// What `rt/sportmodestate` says (physics only): the base's place and the 4 feet's forces.
-    pub fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+    pub fn sport_state(&self) -> Option<unitree_proto::sport_state::SportModeState> {
         crate::plant::sport_mode_state(&*self.plant, 4)
     }
 
@@ -142,7 +142,7 @@ impl Go2Body {
     /// The state the robot reports now (the CRC is written by the encoder).
     pub fn low_state(&self) -> LowState {
         let mut state = LowState::default();
-        state.head = lowcmd_proto::go2::HEAD;
+        state.head = unitree_proto::go2::HEAD;
         let base = self.plant.base().unwrap_or(BaseReading::at_rest(0.0));
         state.imu_state.quaternion = base.quaternion.map(Into::into);
         state.imu_state.gyroscope = base.gyro_radps.map(Into::into);
@@ -181,11 +181,11 @@ impl Go2Body {
 }
 
 /// The Go2 as the physics drives it: its motors' joints by Unitree's names (`FR_hip`, matched as
-/// `FR_hip_joint` too), torques from [`lowcmd_proto::robot::GO2_JOINT_LIMITS`], lying at the
+/// `FR_hip_joint` too), torques from [`unitree_proto::robot::GO2_JOINT_LIMITS`], lying at the
 /// start, the calves' bodies its feet.
 #[cfg(feature = "mujoco")]
 fn physics_rig() -> crate::physics::Rig {
-    use lowcmd_proto::robot::{GO2_JOINT_LIMITS, GO2_JOINT_NAMES};
+    use unitree_proto::robot::{GO2_JOINT_LIMITS, GO2_JOINT_NAMES};
     crate::physics::Rig {
         robot: "Go2",
         mjcf: include_str!("../../models/go2.xml"),
@@ -200,7 +200,7 @@ fn physics_rig() -> crate::physics::Rig {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lowcmd_proto::go2::MotorCmd;
+    use unitree_proto::go2::MotorCmd;
 
     fn stand() -> LowCmd {
         let mut cmd = LowCmd::default();

@@ -5,11 +5,11 @@
 
 use std::sync::{Arc, Mutex};
 
-use lowcmd_proto::api::{self, ApiRequest, sport, status};
-use lowcmd_proto::{LowCmd, LowState};
 use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
 use robowire_rt::lock;
+use unitree_proto::api::{self, ApiRequest, sport, status};
+use unitree_proto::{LowCmd, LowState};
 
 use super::{Go2Robot, head_ok};
 use crate::unitree::{Handover, Owner, Report, ServiceServer, answer_at_once, serve};

@@ -334,8 +334,8 @@ impl<B: StreamBody> Sim<B> {
         let report = Arc::new(Mutex::new(report));
         // The stream's writers never wait: a full send window is a dropped sample, counted.
         let qos = stream_qos(options.clock);
-        let mut writer = participant.writer::<B::State>(<B::State as lowcmd_proto::Message>::TOPIC, qos)?;
-        let mut corrupt = participant.writer::<BitFlipped<B>>(<B::State as lowcmd_proto::Message>::TOPIC, qos)?;
+        let mut writer = participant.writer::<B::State>(<B::State as unitree_proto::Message>::TOPIC, qos)?;
+        let mut corrupt = participant.writer::<BitFlipped<B>>(<B::State as unitree_proto::Message>::TOPIC, qos)?;
         writer.set_tap(options.tap.clone());
         corrupt.set_tap(options.tap);
         let lowstate = writer.stats_handle();
@@ -345,7 +345,7 @@ impl<B: StreamBody> Sim<B> {
         };
         let grid = Periodic::new(robowire_rt::now(), wall_period);
         let sport = match body.base_pose() {
-            Some(_) => Some(participant.writer(lowcmd_proto::sport_state::SPORT_MODE_STATE_TOPIC, qos)?),
+            Some(_) => Some(participant.writer(unitree_proto::sport_state::SPORT_MODE_STATE_TOPIC, qos)?),
             None => None,
         };
         let writers = Writers { state: writer, corrupt, sport };

@@ -8,7 +8,6 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use lowcmd_proto::api::{self, ApiRequest, ApiResponse, Response, motion_switcher, status};
 use robowire_core::schedule::Time;
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::Writer;
@@ -16,6 +15,7 @@ use robowire_dds::rpc::RpcServer;
 use robowire_rt::stats::{Counter, SharedLateness, micros};
 use robowire_rt::{Latest, lock};
 use tokio::sync::watch;
+use unitree_proto::api::{self, ApiRequest, ApiResponse, Response, motion_switcher, status};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use super::Report;
@@ -209,7 +209,7 @@ impl<C: FromBytes + IntoBytes + KnownLayout + Immutable> CommandInbox<C> {
 /// failed write is counted by the writer.
 pub(crate) fn answer_at_once<S>(state: &Latest<S>, answers: Option<&Writer<S>>, echo: impl FnOnce(&mut S))
 where
-    S: lowcmd_proto::Message + robowire_core::cdr::CdrType + Send + Sync,
+    S: unitree_proto::Message + robowire_core::cdr::CdrType + Send + Sync,
 {
     if let Some(answers) = answers
         && let Some((_, mut answer)) = state.read()

@@ -4,12 +4,12 @@
 
 use std::sync::Arc;
 
-use lowcmd_proto::Message;
-use lowcmd_proto::sport_state::SportModeState;
 use robowire_core::cdr::{CdrEncoding, CdrType};
 use robowire_core::schedule::{Periodic, Tick, Time};
 use robowire_dds::Writer;
 use robowire_rt::runner::Job;
+use unitree_proto::Message;
+use unitree_proto::sport_state::SportModeState;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use super::{BasePose, Fault, Handover, Request, SimClock};
@@ -79,7 +79,7 @@ macro_rules! forward_to_body {
         fn time_s(&self) -> f64 {
             self.body.time_s()
         }
-        fn sport_state(&self) -> Option<lowcmd_proto::sport_state::SportModeState> {
+        fn sport_state(&self) -> Option<unitree_proto::sport_state::SportModeState> {
             self.body.sport_state()
         }
         fn base_pose(&self) -> Option<crate::unitree::BasePose> {

@@ -1,19 +1,19 @@
 //! The two sides of the Unitree conformance checks: each simulated robot as the checks see it
 //! ([`Simulator`]: its counters in common terms, the command that holds it), and the client, the
 //! robot's low-level link and `motion_switcher` as Unitree's software uses them, generic over
-//! the message family (`lowcmd_proto::robot::Robot`).
+//! the message family (`unitree_proto::robot::Robot`).
 
 use std::time::{Duration, Instant};
 
-use lowcmd_proto::api::{self, motion_switcher, status};
-use lowcmd_proto::g1::{self, G1Variant};
-use lowcmd_proto::robot::{Go2, Hg, Robot};
-use lowcmd_proto::{HgLowState, LowCmd, LowState, Message, MotorCmd};
 use robowire_core::cdr::CdrType;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, TopicStats, Writer};
 use robowire_sim::g1::{G1Sim, G1SimConfig};
 use robowire_sim::go2::{AdvanceError, BasePose, Go2Fault as Fault, Go2Sim, Go2SimConfig, SimClock};
+use unitree_proto::api::{self, motion_switcher, status};
+use unitree_proto::g1::{self, G1Variant};
+use unitree_proto::robot::{Go2, Hg, Robot};
+use unitree_proto::{HgLowState, LowCmd, LowState, Message, MotorCmd};
 
 use crate::unitree_wire::{ServiceClient, Unsealed, WAIT};
 use robowire_fixtures::wait::until;
@@ -197,7 +197,7 @@ impl Simulator for G1Sim {
     forward!();
 
     /// Unitree's example gains, the robot's `mode_machine` from `state`.
-    fn hold(state: &HgLowState, joint: usize, target_rad: f32) -> lowcmd_proto::HgLowCmd {
+    fn hold(state: &HgLowState, joint: usize, target_rad: f32) -> unitree_proto::HgLowCmd {
         let pose = core::array::from_fn(|s| if s == joint { target_rad } else { state.motor_state[s].q.get() });
         g1::hold(&pose, state.mode_machine, G1Variant::Dof29)
     }

@@ -3,10 +3,10 @@
 
 use std::time::Duration;
 
-use lowcmd_proto::api::{self, ApiRequest, ApiResponse, RequestHeader};
 use robowire_core::cdr::{CdrEncoding, CdrType};
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, Reader, Writer};
+use unitree_proto::api::{self, ApiRequest, ApiResponse, RequestHeader};
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 pub(crate) const WAIT: Duration = Duration::from_secs(20);

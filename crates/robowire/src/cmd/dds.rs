@@ -5,11 +5,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use lowcmd_proto::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
-use lowcmd_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, RawSample, Reader};
 use serde::Serialize;
+use unitree_proto::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
+use unitree_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 
 use super::go2::DdsArgs;
 use crate::hex;

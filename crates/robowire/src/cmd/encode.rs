@@ -7,8 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
-use lowcmd_proto::{CdrEncoding, Message};
 use serde::de::DeserializeOwned;
+use unitree_proto::{CdrEncoding, Message};
 
 use crate::cmd::decode::unitree::{UnitreeMessage, WithMessage};
 use crate::hex;

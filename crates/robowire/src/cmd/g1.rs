@@ -5,8 +5,8 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use g1::{Device, G1, G1Options, G1Variant, JOINT_NAMES, JOINTS};
 use robowire_devices::Describe;
+use unitree::g1::{Device, G1, G1Options, G1Variant, JOINT_NAMES, JOINTS};
 
 use crate::cmd::seconds;
 use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};

@@ -5,9 +5,9 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use go2::trajectory::JointTrajectory;
-use go2::{Device, Go2, LowLevel};
 use robowire_devices::Describe;
+use unitree::trajectory::JointTrajectory;
+use unitree::{Device, Go2, LowLevel};
 
 use crate::cmd::seconds;
 use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};
@@ -24,8 +24,8 @@ pub(crate) struct DdsArgs {
 }
 
 impl DdsArgs {
-    pub(crate) fn participant(&self) -> go2::ParticipantOptions {
-        go2::ParticipantOptions::new(self.domain, self.interface.as_deref())
+    pub(crate) fn participant(&self) -> unitree::ParticipantOptions {
+        unitree::ParticipantOptions::new(self.domain, self.interface.as_deref())
     }
 }
 
@@ -66,7 +66,7 @@ enum Go2Command {
 pub(crate) fn run(args: Go2Args) -> anyhow::Result<ExitCode> {
     let robot_args = &args.robot;
     robot_args.run("go2", |options, links, connect| async move {
-        let options = options.recorded(links.as_ref(), "go2", &lowcmd_proto::description::GO2_LOW_LEVEL);
+        let options = options.recorded(links.as_ref(), "go2", &unitree_proto::description::GO2_LOW_LEVEL);
         let robot = LowLevel::<Go2>::open(options).context("joining DDS")?;
         let state = robot.wait_state(connect, |_| true).await.with_context(|| robot_args.silent(connect))?;
         let code = match args.command {

@@ -35,7 +35,7 @@ pub(crate) struct PlotArgs {
 /// What each codec plots of its links.
 fn link_plots() -> Vec<&'static LinkPlots> {
     let lists: [&'static [LinkPlots]; 3] =
-        [&kmc_proto::description::PLOTS, &zsl_proto::description::PLOTS, &lowcmd_proto::description::PLOTS];
+        [&kmc_proto::description::PLOTS, &zsl_proto::description::PLOTS, &unitree_proto::description::PLOTS];
     lists.into_iter().flatten().collect()
 }
 

@@ -15,7 +15,7 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
     [
         &zsl_proto::description::DESCRIPTIONS[..],
         &kmc_proto::description::DESCRIPTIONS,
-        &lowcmd_proto::description::DESCRIPTIONS,
+        &unitree_proto::description::DESCRIPTIONS,
         &ros2_proto::description::DESCRIPTIONS,
         &[&robowire_core::json::SKIPPED_BYTES],
     ]

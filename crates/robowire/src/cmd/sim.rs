@@ -38,10 +38,10 @@ enum Dof {
 }
 
 impl Dof {
-    fn variant(self) -> lowcmd_proto::g1::G1Variant {
+    fn variant(self) -> unitree_proto::g1::G1Variant {
         match self {
-            Self::Dof29 => lowcmd_proto::g1::G1Variant::Dof29,
-            Self::Dof23 => lowcmd_proto::g1::G1Variant::Dof23,
+            Self::Dof29 => unitree_proto::g1::G1Variant::Dof29,
+            Self::Dof23 => unitree_proto::g1::G1Variant::Dof23,
         }
     }
 }
@@ -385,8 +385,8 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     let recorder = args.record.start("robowire sim go2")?;
     let config = Go2SimConfig {
         participant: args.dds.participant(),
-        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &lowcmd_proto::description::GO2_LOW_LEVEL)),
-        services_tap: recorder.as_ref().map(|r| r.link("go2/api", &lowcmd_proto::description::API_SERVER)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL)),
+        services_tap: recorder.as_ref().map(|r| r.link("go2/api", &unitree_proto::description::API_SERVER)),
         clock: args.body.clock(),
         #[cfg(feature = "mujoco")]
         physics,
@@ -423,8 +423,8 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
-    use lowcmd_proto::g1::G1Variant;
     use robowire_sim::g1::{G1Sim, G1SimConfig};
+    use unitree_proto::g1::G1Variant;
     let variant = args.dof.variant();
     let dof = variant.joint_count();
     let mode_machine = args.mode_machine.unwrap_or(variant.mode_machine());
@@ -444,8 +444,8 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     let config = G1SimConfig {
         participant: args.dds.participant(),
         mode_machine,
-        low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &lowcmd_proto::description::HG_LOW_LEVEL)),
-        services_tap: recorder.as_ref().map(|r| r.link("g1/api", &lowcmd_proto::description::API_SERVER)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &unitree_proto::description::HG_LOW_LEVEL)),
+        services_tap: recorder.as_ref().map(|r| r.link("g1/api", &unitree_proto::description::API_SERVER)),
         clock: args.body.clock(),
         #[cfg(feature = "mujoco")]
         physics,

@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use clap::Args;
-use go2::{Connection, Device, LowLevelOptions};
 use robowire_record::RecordLinks;
+use unitree::{Connection, Device, LowLevelOptions};
 
 use crate::cmd::go2::DdsArgs;
 use crate::cmd::seconds;

@@ -48,14 +48,14 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::time::{Duration, Instant};
 
-use go2::trajectory::JointTrajectory;
-use go2::{Device, Go2, LowLevel, LowLevelOptions, LowState};
-use lowcmd_proto::Message;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use ros2_proto::geometry::{Twist, Vector3};
 use ros2_proto::nav::Odometry;
+use unitree::trajectory::JointTrajectory;
+use unitree::{Device, Go2, LowLevel, LowLevelOptions, LowState};
+use unitree_proto::Message;
 
 /// The flood's PRNG seed: a failure replays the same datagrams.
 const SEED: u64 = 0x0F10_0D5E_ED00_2026;

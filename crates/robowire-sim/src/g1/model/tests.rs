@@ -1,5 +1,5 @@
 use super::*;
-use lowcmd_proto::HgMotorCmd;
+use unitree_proto::HgMotorCmd;
 
 fn hold(q: &[f32; JOINTS], variant: G1Variant) -> HgLowCmd {
     g1::hold(q, variant.mode_machine(), variant)

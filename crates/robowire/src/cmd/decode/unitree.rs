@@ -5,9 +5,9 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::Args;
-use lowcmd_proto::{CdrEncoding, Message, Unverified};
 use serde::Serialize;
 use serde_json::Value;
+use unitree_proto::{CdrEncoding, Message, Unverified};
 
 use super::{cell, json_value};
 use crate::hex;
@@ -37,10 +37,10 @@ impl UnitreeMessage {
     /// Calls `action` with this message's Rust type.
     pub(crate) fn dispatch<A: WithMessage>(self, action: A) -> A::Output {
         match self {
-            Self::LowCmd => action.with::<lowcmd_proto::LowCmd>(),
-            Self::LowState => action.with::<lowcmd_proto::LowState>(),
-            Self::HgLowCmd => action.with::<lowcmd_proto::HgLowCmd>(),
-            Self::HgLowState => action.with::<lowcmd_proto::HgLowState>(),
+            Self::LowCmd => action.with::<unitree_proto::LowCmd>(),
+            Self::LowState => action.with::<unitree_proto::LowState>(),
+            Self::HgLowCmd => action.with::<unitree_proto::HgLowCmd>(),
+            Self::HgLowState => action.with::<unitree_proto::HgLowState>(),
         }
     }
 }

@@ -9,14 +9,14 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use g1::{G1, G1Error, JointCommand};
-use lowcmd_proto::g1::{self as rules, ARM_SDK_JOINTS, JOINTS, ModePr, slot};
-use lowcmd_proto::robot::CommandError;
-use lowcmd_proto::{HgLowCmd, Message};
 use robowire_dds::qos::Qos;
 use robowire_record::RecordLinks;
 use robowire_rt::device::Device as _;
 use robowire_sim::g1::G1Sim;
+use unitree::g1::{G1, G1Error, JointCommand};
+use unitree_proto::g1::{self as rules, ARM_SDK_JOINTS, JOINTS, ModePr, slot};
+use unitree_proto::robot::CommandError;
+use unitree_proto::{HgLowCmd, Message};
 
 use super::{Check, DeviceReport, Progress, Status};
 use crate::output::Output;

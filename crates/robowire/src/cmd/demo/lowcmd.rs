@@ -9,11 +9,11 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use go2::trajectory::{JointTrajectory, STAND_KD, STAND_KP};
-use go2::{Device, LowCmd, MotorCmd};
 use robowire_core::timing::LatenessRing;
 use robowire_devices::{OpenOptions, SimKind, Simulator};
 use robowire_sim::go2::Go2Fault;
+use unitree::trajectory::{JointTrajectory, STAND_KD, STAND_KP};
+use unitree::{Device, LowCmd, MotorCmd};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
 use crate::output::Output;

@@ -5,8 +5,8 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
-use lowcmd_proto::{LowCmd, LowState, Message};
 use robowire_sim::replay::{DdsReplay, DdsTopic, Pace};
+use unitree_proto::{LowCmd, LowState, Message};
 
 use crate::cmd::go2::DdsArgs;
 

@@ -26,10 +26,10 @@ use std::time::Duration;
 
 use anyhow::bail;
 use kmc_proto::description::{CHASSIS, HOST};
-use lowcmd_proto::description::GO2_LOW_LEVEL;
-use lowcmd_proto::{CdrEncoding, LowState, Message};
 use robowire_record::{Direction, RecordedFrame};
 use robowire_sim::replay::Pace;
+use unitree_proto::description::GO2_LOW_LEVEL;
+use unitree_proto::{CdrEncoding, LowState, Message};
 use zsl_proto::description::{HIGH_LEVEL, IMU, LOW_LEVEL, SPLINE_CLIENT, SPLINE_DAEMON};
 use zsl_proto::udp::AnyDatagram;
 
@@ -196,7 +196,7 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lowcmd_proto::LowCmd;
+    use unitree_proto::LowCmd;
 
     fn frame(
         link: &str,
