@@ -75,20 +75,37 @@ mod tests {
         assert!(missing.is_empty() && unknown.is_empty(), "not in the map: {missing:?}; not crates: {unknown:?}");
     }
 
-    #[test]
-    fn a_kmc_only_build_of_robowire_devices_links_no_dds_and_no_capture_library() {
+    /// `cargo tree -e normal` of `args`, one package per line.
+    fn normal_tree(args: &[&str]) -> String {
         let out = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
-            .args(["tree", "-p", "robowire-devices", "--no-default-features", "--features", "kmc"])
+            .arg("tree")
+            .args(args)
             .args(["-e", "normal", "--prefix", "none", "--offline"])
             .current_dir(crate::workspace_root())
             .output()
             .unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let tree = String::from_utf8_lossy(&out.stdout);
-        assert!(tree.contains("kmc v"), "{tree}");
-        for heavy in ["rustdds", "robowire-dds", "rtps-proto", "mcap", "zstd", "lz4"] {
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    fn assert_none_of(heavy: &[&str], tree: &str) {
+        for heavy in heavy {
             assert!(!tree.lines().any(|l| l.starts_with(&format!("{heavy} v"))), "{heavy} in:\n{tree}");
         }
+    }
+
+    #[test]
+    fn a_kmc_only_build_of_robowire_devices_links_no_dds_and_no_capture_library() {
+        let tree = normal_tree(&["-p", "robowire-devices", "--no-default-features", "--features", "kmc"]);
+        assert!(tree.contains("kmc v"), "{tree}");
+        assert_none_of(&["rustdds", "robowire-dds", "rtps-proto", "mcap", "zstd", "lz4"], &tree);
+    }
+
+    #[test]
+    fn cargo_xtask_golden_and_mujoco_build_no_dds_and_no_capture_library() {
+        let tree = normal_tree(&["-p", "xtask"]);
+        assert!(tree.contains("unitree-proto v"), "{tree}");
+        assert_none_of(&["rustdds", "robowire-dds", "unitree", "mcap", "zstd", "lz4"], &tree);
     }
 
     #[test]

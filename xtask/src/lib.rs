@@ -4,14 +4,33 @@
 
 pub mod architecture;
 pub mod bench;
+#[cfg(feature = "full")]
 pub mod fuzz;
 pub mod golden;
 pub mod mujoco;
+pub mod python;
+#[cfg(feature = "full")]
 pub mod test;
 
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
+
+/// Runs this command again in xtask built with the feature `full` (the tasks that link DDS and
+/// MCAP), so that `cargo xtask golden` and `mujoco` build neither; its exit status is ours.
+#[cfg(not(feature = "full"))]
+pub fn with_full() -> anyhow::Result<()> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut command = std::process::Command::new(cargo);
+    command.args(["run", "--quiet", "--package", "xtask", "--features", "full", "--"]);
+    command.args(std::env::args_os().skip(1)).current_dir(workspace_root());
+    let status = command.status().context("cannot run cargo for the xtask with feature `full`")?;
+    // It printed its own error: leave with its code, adding nothing.
+    if !status.success() {
+        std::process::exit(status.code().unwrap_or(1));
+    }
+    Ok(())
+}
 
 /// The workspace root (the parent of `xtask/`).
 pub fn workspace_root() -> PathBuf {

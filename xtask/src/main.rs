@@ -52,9 +52,14 @@ enum Task {
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Task::Golden { bless } => xtask::golden::run(bless),
+        #[cfg(feature = "full")]
         Task::Fuzz { target, time } => xtask::fuzz::run(target.as_deref(), time),
+        #[cfg(feature = "full")]
         Task::Test { python_only: false } => xtask::test::test_all(),
+        #[cfg(feature = "full")]
         Task::Test { python_only: true } => xtask::test::test_python(),
+        #[cfg(not(feature = "full"))]
+        Task::Fuzz { .. } | Task::Test { .. } => xtask::with_full(),
         Task::Mujoco => xtask::mujoco::run(),
         Task::Bench { quick } => xtask::bench::run(quick).and_then(|rows| {
             anyhow::ensure!(rows.iter().all(|r| r.met != Some(false)), "a benchmark missed its target");

@@ -111,7 +111,7 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
 /// `cargo xtask mujoco`: fetches the library and prints the exports that build and run with it.
 pub fn run() -> anyhow::Result<()> {
     let root = crate::workspace_root();
-    let dir = fetch(Path::new("python3"), &crate::test::target_dir(&root))?;
+    let dir = fetch(Path::new("python3"), &crate::python::target_dir(&root))?;
     let dir = dir.canonicalize()?;
     eprintln!("MuJoCo {} in {}; for physics (`--features mujoco`):", MUJOCO_VERSION, dir.display());
     // The exports alone on stdout, for `eval "$(cargo xtask mujoco)"`.

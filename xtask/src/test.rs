@@ -17,36 +17,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use anyhow::{Context, anyhow, bail};
+use anyhow::bail;
 use robowire_dds::netns::userns;
 use robowire_fixtures::interop;
 use robowire_fixtures::peers::{cpython, unitree_python};
 
+use crate::python::{build_wheel, build_wheel_with, install, pip, run, target_dir};
 use crate::workspace_root;
-
-/// The target directory (`$CARGO_TARGET_DIR` or `target/`).
-pub fn target_dir(root: &Path) -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
-}
-
-pub(crate) fn run(what: &str, command: &mut Command) -> anyhow::Result<()> {
-    let status = command.status().with_context(|| format!("{what}: cannot start {command:?}"))?;
-    if !status.success() {
-        bail!("{what} failed ({status})");
-    }
-    Ok(())
-}
-
-fn cargo(root: &Path, args: &[&str]) -> anyhow::Result<()> {
-    run(&format!("cargo {}", args.join(" ")), Command::new("cargo").args(args).current_dir(root))
-}
-
-fn pip(python: &Path, args: &[&str]) -> anyhow::Result<()> {
-    run(
-        &format!("pip {}", args.join(" ")),
-        Command::new(python).args(["-m", "pip", "--disable-pip-version-check", "-q"]).args(args),
-    )
-}
 
 /// Whether this process runs as root (pytest then makes its private network itself).
 fn is_root() -> bool {
@@ -62,37 +39,6 @@ pub fn test_all() -> anyhow::Result<()> {
     cargo(&root, &["test", "--workspace"])?;
     crate::mujoco::test(&root, &target_dir(&root))?;
     test_python()
-}
-
-/// The CPython 3.10 interop environment with the freshly built wheel installed.
-pub(crate) fn py310_with_wheel(root: &Path, target: &Path) -> anyhow::Result<(PathBuf, PathBuf)> {
-    let py310 = unitree_python().map_err(|e| anyhow!("the CPython 3.10 interop environment: {e}"))?;
-    let wheel = build_wheel(root, target, &py310)?;
-    install(&py310, &wheel)?;
-    Ok((py310, wheel))
-}
-
-/// `major.minor` of `python`, if it runs.
-fn python_version(python: &Path) -> Option<(u32, u32)> {
-    let out = Command::new(python).args(["-c", "import sys; print(*sys.version_info[:2])"]).output().ok()?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    let mut parts = text.split_whitespace().map(|n| n.parse().ok());
-    Some((parts.next()??, parts.next()??))
-}
-
-/// The Python of the suite's second run: CPython 3.12 or 3.13, else any `python3` ≥ 3.9 on the
-/// `PATH`; its `major.minor`.
-fn second_python() -> anyhow::Result<(String, PathBuf)> {
-    let found = ["3.12", "3.13"].into_iter().find_map(|v| cpython(v).map(|p| (v.to_owned(), p)));
-    if let Some(found) = found {
-        return Ok(found);
-    }
-    let python3 = PathBuf::from("python3");
-    match python_version(&python3) {
-        Some((major, minor)) if (major, minor) >= (3, 9) => Ok((format!("{major}.{minor}"), python3)),
-        Some((major, minor)) => bail!("python3 is {major}.{minor}; the Python suite needs 3.9 or newer"),
-        None => bail!("no python3 on the PATH for the Python suite (3.9 or newer; 3.12 preferred)"),
-    }
 }
 
 /// Builds the wheel and runs the Python suite: on the CPython 3.10 interop environment (gated
@@ -194,40 +140,31 @@ struct PytestRun {
     mujoco: Option<PathBuf>,
 }
 
-/// Installs `wheel` (not editable), replacing any earlier build of the same version.
-fn install(python: &Path, wheel: &Path) -> anyhow::Result<()> {
-    pip(python, &["install", "--force-reinstall", "--no-deps", "--no-warn-script-location", &wheel.to_string_lossy()])
+fn cargo(root: &Path, args: &[&str]) -> anyhow::Result<()> {
+    run(&format!("cargo {}", args.join(" ")), Command::new("cargo").args(args).current_dir(root))
 }
 
-/// `pip wheel crates/robowire-py`, as the README tells users to install it.
-fn build_wheel(root: &Path, target: &Path, python: &Path) -> anyhow::Result<PathBuf> {
-    build_wheel_with(root, target, python, None)
+/// `major.minor` of `python`, if it runs.
+fn python_version(python: &Path) -> Option<(u32, u32)> {
+    let out = Command::new(python).args(["-c", "import sys; print(*sys.version_info[:2])"]).output().ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut parts = text.split_whitespace().map(|n| n.parse().ok());
+    Some((parts.next()??, parts.next()??))
 }
 
-/// [`build_wheel`], with physics (the cargo feature `mujoco`, against the MuJoCo in `mujoco`)
-/// when given, as the README tells users to build it.
-fn build_wheel_with(root: &Path, target: &Path, python: &Path, mujoco: Option<&Path>) -> anyhow::Result<PathBuf> {
-    let out = target.join(if mujoco.is_some() { "wheels-mujoco" } else { "wheels" });
-    let _ = std::fs::remove_dir_all(&out);
-    let with = if mujoco.is_some() { " --features mujoco" } else { "" };
-    println!("== building the wheel (pip wheel crates/robowire-py, maturin, release{with})");
-    let crate_dir = root.join("crates/robowire-py");
-    run(
-        "pip wheel",
-        Command::new(python)
-            .args(["-m", "pip", "--disable-pip-version-check", "-q", "wheel", "--no-deps", "-w"])
-            .arg(&out)
-            .arg(&crate_dir)
-            .envs(mujoco.map(|dir| ("MUJOCO_DYNAMIC_LINK_DIR", dir.as_os_str())))
-            .envs(mujoco.map(|_| ("MATURIN_PEP517_ARGS", std::ffi::OsStr::new("--features mujoco")))),
-    )?;
-    let wheel = std::fs::read_dir(&out)?
-        .flatten()
-        .map(|e| e.path())
-        .find(|p| p.extension().is_some_and(|e| e == "whl"))
-        .context("pip wheel made no wheel")?;
-    println!("built {}", wheel.display());
-    Ok(wheel)
+/// The Python of the suite's second run: CPython 3.12 or 3.13, else any `python3` ≥ 3.9 on the
+/// `PATH`; its `major.minor`.
+fn second_python() -> anyhow::Result<(String, PathBuf)> {
+    let found = ["3.12", "3.13"].into_iter().find_map(|v| cpython(v).map(|p| (v.to_owned(), p)));
+    if let Some(found) = found {
+        return Ok(found);
+    }
+    let python3 = PathBuf::from("python3");
+    match python_version(&python3) {
+        Some((major, minor)) if (major, minor) >= (3, 9) => Ok((format!("{major}.{minor}"), python3)),
+        Some((major, minor)) => bail!("python3 is {major}.{minor}; the Python suite needs 3.9 or newer"),
+        None => bail!("no python3 on the PATH for the Python suite (3.9 or newer; 3.12 preferred)"),
+    }
 }
 
 /// A venv with nothing but pip (pytest is added by the caller), made once per `target/`.

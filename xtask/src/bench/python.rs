@@ -8,7 +8,7 @@ use anyhow::Context;
 use serde_json::Value;
 
 use crate::bench::Row;
-use crate::test::{py310_with_wheel, run, target_dir};
+use crate::python::{py310_with_wheel, run, target_dir};
 use crate::workspace_root;
 use robowire_fixtures::peers::peers_dir;
 
