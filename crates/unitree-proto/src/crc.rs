@@ -36,23 +36,72 @@ pub fn crc32_words(covered: &[u8]) -> Option<u32> {
     Some(backend(&buf[..len]))
 }
 
-/// CRC of `covered`, reversing its 4-byte groups in place first (they stay reversed): the
-/// fast path for a caller that owns a scratch copy of the image anyway.
-pub fn crc32_words_in_place(covered: &mut [u8]) -> Option<u32> {
-    if !covered.len().is_multiple_of(4) || covered.len() > MAX_COVERED_LEN {
+/// CRC of `covered` with every byte ANDed with the byte of `mask` at its place first (a
+/// message's padding zeroed without a copy of the message): mask and swap in one pass through a
+/// small stack buffer, each buffer fed to the CRC as it fills. `None` as [`crc32_words`], or for a
+/// `mask` shorter than `covered`.
+pub fn crc32_words_masked(covered: &[u8], mask: &[u8]) -> Option<u32> {
+    /// Bytes masked and swapped per CRC update: a few cache lines, in L1.
+    const CHUNK: usize = 512;
+    if !covered.len().is_multiple_of(4) || covered.len() > MAX_COVERED_LEN || mask.len() < covered.len() {
         return None;
     }
-    let (words, _) = covered.as_chunks_mut::<4>();
-    for word in words {
-        *word = u32::from_le_bytes(*word).to_be_bytes();
+    let mut digest = Digest::new();
+    let mut buf = [0u8; CHUNK];
+    for (image, mask) in covered.chunks(CHUNK).zip(mask.chunks(CHUNK)) {
+        let (words, _) = image.as_chunks::<4>();
+        let (masks, _) = mask.as_chunks::<4>();
+        let (out, _) = buf.as_chunks_mut::<4>();
+        for ((o, w), m) in out.iter_mut().zip(words).zip(masks) {
+            *o = (u32::from_le_bytes(*w) & u32::from_le_bytes(*m)).to_be_bytes();
+        }
+        digest.update(&buf[..image.len()]);
     }
-    Some(backend(covered))
+    Some(digest.finalize())
 }
 
 /// CRC of `covered` on the portable table backend (what `no_std` builds use).
 pub fn crc32_words_table(covered: &[u8]) -> Option<u32> {
     let (buf, len) = swapped(covered)?;
     Some(TABLE.checksum(&buf[..len]))
+}
+
+/// The fastest backend built in, fed piece by piece.
+#[cfg(feature = "std")]
+struct Digest(crc_fast::Digest);
+
+#[cfg(feature = "std")]
+impl Digest {
+    fn new() -> Self {
+        Self(crc_fast::Digest::new(crc_fast::CrcAlgorithm::Crc32Mpeg2))
+    }
+
+    fn update(&mut self, bytes: &[u8]) {
+        self.0.update(bytes);
+    }
+
+    fn finalize(self) -> u32 {
+        // A 32-bit algorithm: the u64 result fits in u32.
+        self.0.finalize() as u32
+    }
+}
+
+#[cfg(not(feature = "std"))]
+struct Digest(crc::Digest<'static, u32, crc::Table<16>>);
+
+#[cfg(not(feature = "std"))]
+impl Digest {
+    fn new() -> Self {
+        Self(TABLE.digest())
+    }
+
+    fn update(&mut self, bytes: &[u8]) {
+        self.0.update(bytes);
+    }
+
+    fn finalize(self) -> u32 {
+        self.0.finalize()
+    }
 }
 
 #[cfg(feature = "std")]
@@ -84,9 +133,15 @@ mod tests {
         for (input, crc) in cases {
             assert_eq!(crc32_words(input), Some(crc));
             assert_eq!(crc32_words_table(input), Some(crc));
-            assert_eq!(crc32_words_in_place(&mut input.to_vec()), Some(crc));
+            assert_eq!(crc32_words_masked(input, &[0xFF; MAX_COVERED_LEN]), Some(crc));
         }
         assert_eq!(crc32_words(&[0; 3]), None);
+        assert_eq!(crc32_words_masked(&[0; 8], &[0xFF; 4]), None, "a mask shorter than the bytes");
+        // Masked bytes count as zeros, wherever the chunks fall.
+        let image: Vec<u8> = (0..2000u32).map(|i| i as u8 | 1).collect();
+        let mask: Vec<u8> = (0..2000u32).map(|i| if i % 7 == 3 { 0 } else { 0xFF }).collect();
+        let zeroed: Vec<u8> = image.iter().zip(&mask).map(|(b, m)| b & m).collect();
+        assert_eq!(crc32_words_masked(&image, &mask), crc32_words_table(&zeroed));
         assert_eq!(crc32_words(&[0; MAX_COVERED_LEN + 4]), None);
     }
 }

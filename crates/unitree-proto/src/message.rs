@@ -4,7 +4,7 @@ use robowire_core::BufferTooSmall;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
 use crate::cdr::CdrEncoding;
-use crate::crc::crc32_words_in_place;
+use crate::crc::crc32_words_masked;
 use crate::field::{FieldError, FieldPlace, FieldValue};
 use crate::layout::{PadRange, StructLayout, padding_count, padding_mask, padding_ranges};
 use crate::plan::{CdrPlan, cdr_plan};
@@ -104,11 +104,8 @@ pub trait Message: sealed::Sealed + FromBytes + IntoBytes + KnownLayout + Immuta
 
     /// The CRC of the zero-padded image (what [`seal`](Self::seal) writes).
     fn computed_crc(&self) -> u32 {
-        let mut scratch = *self;
-        scratch.zero_padding();
-        let bytes = scratch.as_mut_bytes();
-        let n = bytes.len();
-        crc32_words_in_place(&mut bytes[..n - 4]).unwrap_or(0)
+        let bytes = self.as_bytes();
+        crc32_words_masked(&bytes[..bytes.len() - 4], Self::PADDING_MASK).unwrap_or(0)
     }
 
     /// Zeroes the padding and writes the CRC: the message as it must be sent.
