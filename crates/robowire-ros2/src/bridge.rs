@@ -5,13 +5,14 @@ use std::pin::Pin;
 use std::sync::Arc;
 use std::time::Duration;
 
-use robowire_dds::{DdsError, Participant, ParticipantOptions};
-use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, OpenOptions};
+use robowire_dds::{Participant, ParticipantOptions};
+use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
 use robowire_record::RecordLinks;
 use tokio::sync::watch;
 
 use ros2_proto::rmw_dds_common::NAME_BOUND;
 
+use crate::error::BridgeError;
 use crate::graph::{RosDistro, RosGraph};
 use crate::node::{Node, NodeOptions};
 use crate::report::{DeviceCounters, DeviceReport};
@@ -60,27 +61,6 @@ impl BridgeOptions {
             ros_distro: RosDistro::default(),
         }
     }
-}
-
-/// Why the bridge could not start or stopped.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum BridgeError {
-    /// A bad option.
-    #[error("{0}")]
-    Option(String),
-    /// DDS.
-    #[error(transparent)]
-    Dds(#[from] DdsError),
-    /// A device could not be opened, or refused what the bridge needs of it.
-    #[error("{address}")]
-    Device {
-        /// The device's address.
-        address: DeviceAddress,
-        /// Why.
-        #[source]
-        source: DeviceError,
-    },
 }
 
 /// One bridged device: its address, namespace and counters.

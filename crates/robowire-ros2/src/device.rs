@@ -21,7 +21,7 @@ use ros2_proto::nav::Odometry as OdometryMsg;
 use ros2_proto::sensor::{BatteryState, Imu, JointState};
 use ros2_proto::tf::TfMessage;
 
-use crate::bridge::BridgeError;
+use crate::error::BridgeError;
 use crate::node::{CmdVel, Node, RateLimiter, stamp_now};
 use crate::report::DeviceReport;
 use crate::service::{Caller, TriggerService};

@@ -17,7 +17,7 @@ use ros2_proto::rmw_dds_common::{
     DISCOVERY_TOPIC, GID_LEN_HUMBLE, GID_LEN_JAZZY, Gid, NodeEntitiesInfo, ParticipantEntitiesInfo,
 };
 
-use crate::bridge::BridgeError;
+use crate::error::BridgeError;
 
 /// The participant USER_DATA of rmw's participants in the root enclave.
 pub(crate) const ENCLAVE_USER_DATA: &[u8] = b"enclave=/;";

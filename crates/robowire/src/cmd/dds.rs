@@ -11,7 +11,7 @@ use serde::Serialize;
 use unitree_proto::api::{REQUEST_TYPE_NAME, RESPONSE_TYPE_NAME, Request, Response};
 use unitree_proto::{HgLowCmd, HgLowState, LowCmd, LowState, Message};
 
-use super::go2::DdsArgs;
+use super::dds_args::DdsArgs;
 use crate::hex;
 
 #[derive(Debug, Args)]

@@ -1,4 +1,4 @@
-//! `robowire go2 …`: a Unitree Go2's low-level interface over DDS through the `go2` facade.
+//! `robowire go2 …`: a Unitree Go2's low-level interface over DDS through the `unitree` facade.
 
 use std::process::ExitCode;
 use std::time::Duration;
@@ -11,23 +11,6 @@ use unitree::{Device, Go2, LowLevel};
 
 use crate::cmd::seconds;
 use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};
-
-/// Where the robot is on DDS, shared by `go2`, `g1`, `dds` and the Unitree simulators.
-#[derive(Debug, Clone, Args)]
-pub(crate) struct DdsArgs {
-    /// The network interface by name (the robot's network is 192.168.123.x: e.g. eth0, enp3s0).
-    #[arg(long)]
-    pub(crate) interface: Option<String>,
-    /// DDS domain.
-    #[arg(long, default_value_t = 0)]
-    pub(crate) domain: u16,
-}
-
-impl DdsArgs {
-    pub(crate) fn participant(&self) -> unitree::ParticipantOptions {
-        unitree::ParticipantOptions::new(self.domain, self.interface.as_deref())
-    }
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct Go2Args {

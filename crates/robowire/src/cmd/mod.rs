@@ -1,6 +1,7 @@
 //! One module per subcommand, as `robowire --help` lists them.
 
 pub(crate) mod dds;
+pub(crate) mod dds_args;
 pub(crate) mod decode;
 pub(crate) mod demo;
 pub(crate) mod device;

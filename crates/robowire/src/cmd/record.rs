@@ -151,7 +151,7 @@ pub(crate) struct ReplayArgs {
     link: Option<String>,
     /// With --as-device on a Go2 link: where to publish.
     #[command(flatten)]
-    dds: crate::cmd::go2::DdsArgs,
+    dds: crate::cmd::dds_args::DdsArgs,
     /// With --as-device on a spline link: the spline object to create (the robot's name).
     #[arg(long, default_value = "/spline_shm", requires = "as_device")]
     spline_name: String,

@@ -49,7 +49,7 @@ impl Dof {
 #[derive(Debug, Args)]
 pub(crate) struct G1SimArgs {
     #[command(flatten)]
-    dds: crate::cmd::go2::DdsArgs,
+    dds: crate::cmd::dds_args::DdsArgs,
     /// Joints: 29 (waist roll and pitch, 3-joint wrists) or 23 (neither; the same 29 slots).
     #[arg(long, value_enum, default_value = "29")]
     dof: Dof,
@@ -73,7 +73,7 @@ pub(crate) struct G1SimArgs {
 #[derive(Debug, Args)]
 pub(crate) struct Go2SimArgs {
     #[command(flatten)]
-    dds: crate::cmd::go2::DdsArgs,
+    dds: crate::cmd::dds_args::DdsArgs,
     #[command(flatten)]
     body: crate::cmd::sim_body::BodyArgs,
     /// Print the simulator's state every this many seconds (0: never).

@@ -9,7 +9,7 @@ use clap::Args;
 use robowire_record::RecordLinks;
 use unitree::{Connection, Device, LowLevelOptions};
 
-use crate::cmd::go2::DdsArgs;
+use crate::cmd::dds_args::DdsArgs;
 use crate::cmd::seconds;
 
 /// Damping sent before exiting, after a move and by `damp`.

@@ -8,7 +8,7 @@ use std::time::Duration;
 use robowire_sim::replay::{DdsReplay, DdsTopic, Pace};
 use unitree_proto::{LowCmd, LowState, Message};
 
-use crate::cmd::go2::DdsArgs;
+use crate::cmd::dds_args::DdsArgs;
 
 /// After the first reader matched, for its side to discover the writer (see
 /// `DdsReplay::first_reader`).

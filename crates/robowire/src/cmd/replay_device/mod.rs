@@ -107,7 +107,7 @@ pub(crate) struct Target<'a> {
     /// The ZSL-1's address.
     pub(crate) bind: IpAddr,
     /// The Go2's domain and interface.
-    pub(crate) dds: &'a crate::cmd::go2::DdsArgs,
+    pub(crate) dds: &'a crate::cmd::dds_args::DdsArgs,
     /// The spline daemon's objects: spline, IMU.
     pub(crate) shm: (&'a str, &'a str),
     /// The recorded pace scaled by this; `None`: as fast as possible.
