@@ -19,6 +19,7 @@ mod high_level;
 mod low_level;
 mod options;
 mod session;
+mod shared;
 mod snapshot;
 mod stream;
 

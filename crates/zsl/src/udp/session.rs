@@ -12,48 +12,20 @@
 //! and how late comes back as a seqlock and atomics.
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
 use robowire_core::timing::LatenessSummary;
+use robowire_rt::Time;
 use robowire_rt::device::{Receive, Received, Receiving, Stamped};
-use robowire_rt::runner::{Runner, RunnerOptions, Waker};
-use robowire_rt::stats::{Counter, SharedLateness};
-use robowire_rt::{Latest, Time};
+use robowire_rt::runner::{Runner, RunnerOptions};
 use robowire_udp::{LinkStats, Peer, StatsHandle, UdpError, UdpLink, UdpReceiver};
-use zsl_proto::codec::{ClientCodec, StateReceived};
-use zsl_proto::stream::{CommandStream, Connection, Interface, Watchdog};
-use zsl_proto::zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
+use zsl_proto::codec::StateReceived;
+use zsl_proto::stream::{CommandStream, Connection, Watchdog};
 
+use super::shared::{Codec, Shared, Wire};
 use super::stream::{Input, StreamJob, in_order};
 use super::{CallError, ClientOptions, ConnectError};
-
-/// An [`Interface`] whose datagrams can cross threads through a seqlock.
-pub(super) trait Wire:
-    Interface<
-        Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send,
-        State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send + Sync,
-        Memory: Send,
-        Observed: Send,
-    > + Send
-    + Sync
-    + 'static
-{
-}
-
-impl<I> Wire for I where
-    I: Interface<
-            Command: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send,
-            State: FromBytes + IntoBytes + KnownLayout + Immutable + std::fmt::Debug + Send + Sync,
-            Memory: Send,
-            Observed: Send,
-        > + Send
-        + Sync
-        + 'static
-{
-}
-
-pub(super) type Codec<I> = ClientCodec<<I as Interface>::Command, <I as Interface>::State>;
 
 /// Statistics of one client.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -83,55 +55,6 @@ pub struct ClientStats {
     /// Time between consecutive accepted state datagrams, µs (the robot sends every 2 ms; the
     /// maximum shows how close the link came to the watchdog).
     pub state_gap: LatenessSummary,
-}
-
-/// What the stream thread, the receive thread and the caller share; every field lock-free.
-pub(super) struct Shared<I: Interface> {
-    /// The latest call's command (calls write, the stream takes).
-    pub(super) calls: Latest<I::Command>,
-    /// The latest state, for the per-datagram rules (the receive thread writes).
-    pub(super) states: Latest<I::State>,
-    /// When the watchdog last expired, ns on the monotonic clock (0: never).
-    pub(super) disconnected_at: AtomicU64,
-    /// The last datagram sent, stamped with when the stream took its inputs.
-    pub(super) streamed: Latest<I::Command>,
-    /// The robot's SDK-mismatch flag stopped the stream for good.
-    pub(super) halted: AtomicBool,
-    /// Wakes the stream thread when a call or a disconnect arrives (set once the thread runs).
-    pub(super) waker: OnceLock<Waker>,
-    pub(super) lateness: SharedLateness<4096>,
-    pub(super) calls_sent: Counter,
-    pub(super) refreshes_sent: Counter,
-    pub(super) missed_ticks: Counter,
-    accepted: Counter,
-    short_states: Counter,
-    header_anomalies: Counter,
-}
-
-impl<I: Wire> Shared<I> {
-    fn new() -> Self {
-        Self {
-            calls: Latest::new(),
-            states: Latest::new(),
-            disconnected_at: AtomicU64::new(0),
-            streamed: Latest::new(),
-            halted: AtomicBool::new(false),
-            waker: OnceLock::new(),
-            lateness: SharedLateness::new(),
-            calls_sent: Counter::default(),
-            refreshes_sent: Counter::default(),
-            missed_ticks: Counter::default(),
-            accepted: Counter::default(),
-            short_states: Counter::default(),
-            header_anomalies: Counter::default(),
-        }
-    }
-
-    fn wake(&self) {
-        if let Some(waker) = self.waker.get() {
-            waker.wake();
-        }
-    }
 }
 
 /// The receive side of the link, as robowire-rt's receive loop drives it (spec decisions 2, 3,

@@ -12,7 +12,7 @@ use robowire_rt::stats::micros;
 use robowire_udp::UdpSender;
 use zsl_proto::stream::{Cause, CommandStream};
 
-use super::session::{Codec, Shared, Wire};
+use super::shared::{Codec, Shared, Wire};
 
 /// Datagrams of the stop burst sent when a client closes.
 pub(super) const STOP_BURST: usize = 3;
