@@ -19,7 +19,7 @@ use rtps_proto::participant::{Destination, Event, Participant as Core};
 use rtps_proto::{EntityId, Time};
 use rustix::event::{EventfdFlags, PollFd, PollFlags};
 
-use crate::reader::ReaderSlot;
+use crate::slot::ReaderSlot;
 use crate::sockets::{MAX_DATAGRAM, Sockets};
 
 /// Incompatible remote endpoints remembered per local endpoint (the first ones).

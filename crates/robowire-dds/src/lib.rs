@@ -10,6 +10,7 @@ pub mod qos;
 mod reader;
 pub mod rpc;
 mod sample;
+mod slot;
 mod sockets;
 mod writer;
 

@@ -14,8 +14,9 @@ use rtps_proto::{EntityId, Guid, GuidPrefix, VendorId};
 use crate::DdsError;
 use crate::driver::{self, Shared};
 use crate::qos::Qos;
-use crate::reader::{Reader, ReaderSlot};
+use crate::reader::Reader;
 use crate::sample::{Counters, RawSample};
+use crate::slot::ReaderSlot;
 use crate::sockets::Sockets;
 use crate::writer::Writer;
 

@@ -1,12 +1,9 @@
 //! [`Reader`]: a topic's samples for one task, from a slot the background thread fills.
 
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::task::{Context, Poll};
 
-use crossbeam_queue::ArrayQueue;
-use futures::task::AtomicWaker;
 use robowire_core::cdr::CdrType;
 use robowire_tap::{Direction, SampleOrigin, Tap};
 use rtps_proto::EntityId;
@@ -15,67 +12,7 @@ use rtps_proto::participant::Sample as Arrived;
 use crate::DdsError;
 use crate::driver::Shared;
 use crate::sample::{Counters, Sample, SampleIdentity, StatsHandle, TopicStats, decode};
-
-/// What a listened reader runs on the background thread: takes its slot's samples.
-type Listen = Box<dyn FnMut() + Send>;
-
-/// Where the background thread puts a reader's samples: the newest `depth` (keep last), and the
-/// waker of the task that waits for them, or the listener that takes them on the background
-/// thread.
-pub(crate) struct ReaderSlot {
-    queue: ArrayQueue<Arrived>,
-    waker: AtomicWaker,
-    counters: Arc<Counters>,
-    /// A listener is installed: the background thread runs it instead of waking a task.
-    listened: AtomicBool,
-    /// Samples arrived that the listener has not been run for (the slot is in the background
-    /// thread's list to run).
-    due: AtomicBool,
-    /// The listener; taken only by the background thread and by the [`Listener`]'s drop.
-    listener: Mutex<Option<Listen>>,
-}
-
-impl std::fmt::Debug for ReaderSlot {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ReaderSlot").field("kept", &self.queue.len()).finish_non_exhaustive()
-    }
-}
-
-impl ReaderSlot {
-    pub(crate) fn new(depth: usize, counters: Arc<Counters>) -> Self {
-        Self {
-            queue: ArrayQueue::new(depth.max(1)),
-            waker: AtomicWaker::new(),
-            counters,
-            listened: AtomicBool::new(false),
-            due: AtomicBool::new(false),
-            listener: Mutex::new(None),
-        }
-    }
-
-    /// Keeps `sample` (replacing the oldest when full: its buffer is returned) and wakes the
-    /// reader's task; with a listener, whether the listener is to be run (the first sample since
-    /// it last ran).
-    pub(crate) fn push(&self, sample: Arrived) -> (Option<Vec<u8>>, bool) {
-        let replaced = self.queue.force_push(sample).map(|old| {
-            Counters::bump(&self.counters.dropped);
-            old.payload
-        });
-        if self.listened.load(Ordering::Acquire) {
-            return (replaced, !self.due.swap(true, Ordering::AcqRel));
-        }
-        self.waker.wake();
-        (replaced, false)
-    }
-
-    /// The background thread, without the core's lock: runs the listener on what arrived.
-    pub(crate) fn run_listener(&self) {
-        self.due.store(false, Ordering::Release);
-        if let Some(listen) = robowire_rt::lock(&self.listener).as_mut() {
-            listen();
-        }
-    }
-}
+use crate::slot::{Listen, ReaderSlot};
 
 /// Reads `T` from one topic, asynchronously (any executor). Samples whose body does not decode
 /// are counted and skipped. As DDS's keep-last history: of the samples that arrived since the last
@@ -139,15 +76,14 @@ impl<T: CdrType + 'static> Reader<T> {
 
     fn poll_recv(&mut self, cx: &mut Context<'_>) -> Poll<Sample<T>> {
         loop {
-            if let Some(arrived) = self.slot.queue.pop() {
+            if let Some(arrived) = self.slot.pop() {
                 if let Some(sample) = self.take(arrived) {
                     return Poll::Ready(sample);
                 }
                 continue;
             }
-            self.slot.waker.register(cx.waker());
-            // A sample that arrived between the look and the registration.
-            if self.slot.queue.is_empty() {
+            // Looked again after the registration: a sample may have arrived in between.
+            if self.slot.register(cx.waker()) {
                 return Poll::Pending;
             }
         }
@@ -164,15 +100,14 @@ impl<T: CdrType + 'static> Reader<T> {
     {
         let slot = self.slot.clone();
         let listen: Listen = Box::new(move || {
-            while let Some(arrived) = self.slot.queue.pop() {
+            while let Some(arrived) = self.slot.pop() {
                 if let Some(sample) = self.take(arrived) {
                     Counters::bump(&self.counters.samples);
                     on_sample(sample);
                 }
             }
         });
-        *robowire_rt::lock(&slot.listener) = Some(listen);
-        slot.listened.store(true, Ordering::Release);
+        slot.install(listen);
         Listener { slot }
     }
 
@@ -257,10 +192,9 @@ impl std::fmt::Debug for Listener {
 
 impl Drop for Listener {
     fn drop(&mut self) {
-        self.slot.listened.store(false, Ordering::Release);
-        // The reader (inside the function) is dropped once the lock is let go: its drop takes
-        // the participant's lock.
-        let listen = robowire_rt::lock(&self.slot.listener).take();
+        // The reader (inside the function) is dropped once the slot's lock is let go: its drop
+        // takes the participant's lock.
+        let listen = self.slot.uninstall();
         drop(listen);
     }
 }

@@ -7,6 +7,7 @@ mod kmc;
 mod pcap;
 mod rtps;
 mod rtps_json;
+mod rtps_names;
 mod rtps_params;
 pub(crate) mod unitree;
 pub(crate) mod zsl;

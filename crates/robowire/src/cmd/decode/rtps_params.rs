@@ -7,7 +7,7 @@ use rtps_proto::types::{EntityId, Locator, VendorId};
 use rtps_proto::wire::{Endianness, Parameter, ParameterList, pid};
 use serde_json::{Value, json};
 
-use super::rtps_json::{entity, locator, vendor};
+use super::rtps_names::{entity, locator, vendor};
 use crate::hex;
 
 /// The list's parameters in order (PID_PAD and the sentinel left out).
