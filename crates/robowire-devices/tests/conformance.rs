@@ -308,7 +308,7 @@ async fn exercise_links(device: &AnyDevice) {
         Simulator::G1(_) => {
             let g1 = device.g1().unwrap();
             g1.mode().await.unwrap();
-            g1.set_arm_joints(&[::g1::JointCommand::default(); ::g1::ARM_JOINTS]).unwrap();
+            g1.set_arm_joints(&[unitree::g1::JointCommand::default(); unitree::g1::ARM_JOINTS]).unwrap();
         }
         _ => {}
     }
@@ -340,7 +340,7 @@ fn commander(device: &AnyDevice) -> Option<Box<dyn FnMut() -> bool + '_>> {
             let go2 = device.go2().unwrap();
             Some(Box::new(move || {
                 let q = go2.joint_positions().expect("a state");
-                go2.set_joints(&q.map(|q| ::go2::JointCommand::hold(q, 20.0, 0.5))).unwrap();
+                go2.set_joints(&q.map(|q| unitree::JointCommand::hold(q, 20.0, 0.5))).unwrap();
                 let seen = sim.snapshot().lowcmd;
                 seen.accepted + seen.ignored_sport_mode > 0
             }))
