@@ -4,8 +4,8 @@
 
 use alloc::vec::Vec;
 
-use super::participant::{LOCAL_PREFIX, MAX_PAYLOAD, PEER_PREFIX};
 use super::step::Step;
+use super::world::{LOCAL_PREFIX, MAX_PAYLOAD, PEER_PREFIX};
 use crate::EntityId;
 use crate::wire::pid;
 

@@ -4,7 +4,7 @@
 //!
 //! Each job in its own module: `parse` (the wire oracle), `participant` (the setup and the run of
 //! a participant), `step` (the steps and their byte format), `datagram` (the datagrams templated
-//! steps stand for).
+//! steps stand for), `world` (the prefixes, topic and caps they share).
 //!
 //! [`participant`]: fn@participant
 //! [`Participant`]: crate::participant::Participant
@@ -13,17 +13,20 @@ mod datagram;
 mod parse;
 mod participant;
 mod step;
+mod world;
 
 pub use parse::parse_all;
-pub use participant::{LOCAL_PREFIX, PEER_PREFIX, ParticipantSetup, TOPIC, TYPE_NAME, participant, participant_steps};
+pub use participant::{ParticipantSetup, participant, participant_steps};
 pub use step::{Step, encode_steps};
+pub use world::{LOCAL_PREFIX, PEER_PREFIX, TOPIC, TYPE_NAME};
 
 #[cfg(test)]
 mod tests {
     use alloc::vec::Vec;
 
     use super::datagram::{Ids, templated_datagram};
-    use super::participant::{T0, address, fuzz_config};
+    use super::participant::{address, fuzz_config};
+    use super::world::T0;
     use super::*;
     use crate::EntityId;
     use crate::discovery::Qos;

@@ -9,22 +9,10 @@ use core::time::Duration;
 
 use super::datagram::{Ids, fill, header, templated_datagram};
 use super::step::Step;
+use super::world::{LOCAL_PREFIX, MAX_PAYLOAD, PEER_PREFIX, T0, TOPIC, TYPE_NAME};
 use crate::discovery::Qos;
 use crate::participant::{Destination, Event, Participant, ParticipantConfig};
-use crate::{EntityId, GuidPrefix, Locator, Time};
-
-/// The fuzzed participant's GUID prefix.
-pub const LOCAL_PREFIX: GuidPrefix = GuidPrefix([0x01; 12]);
-/// The prefix of the fuzzer's peer (every templated datagram comes from it).
-pub const PEER_PREFIX: GuidPrefix = GuidPrefix([0x0f; 12]);
-/// The topic both participants write and read.
-pub const TOPIC: &str = "rt/fuzz";
-/// Its type name.
-pub const TYPE_NAME: &str = "robowire::msg::dds_::Fuzz_";
-/// When both participants start.
-pub(super) const T0: Time = Time::from_nanos(1_000_000_000);
-/// Bytes of a generated payload at most (a DATA's, a DATA_FRAG's, a local write's).
-pub(super) const MAX_PAYLOAD: usize = 16 * 1024;
+use crate::{EntityId, GuidPrefix, Locator};
 
 pub(super) fn address(prefix: GuidPrefix) -> SocketAddr {
     SocketAddr::new(IpAddr::V4(Ipv4Addr::new(127, 0, 0, 1)), 7400 + u16::from(prefix.0[0]))
