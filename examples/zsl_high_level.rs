@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use anyhow::{Context, ensure};
 use clap::Parser;
-use robowire_sim::dog::{DogSim, DogSimConfig};
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use zsl::udp::{ClientOptions, ControlMode, Device, HighLevel};
 
 /// ZsiBot ZSL-1 high-level demo.
@@ -37,7 +37,7 @@ async fn main() -> anyhow::Result<()> {
     let (_sim, options) = match args.dog_ip {
         Some(dog_ip) => (None, ClientOptions::high_level(args.local_ip, args.local_port, dog_ip)),
         None => {
-            let sim = DogSim::spawn(DogSimConfig::loopback()).context("starting the simulated dog")?;
+            let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).context("starting the simulated dog")?;
             let local = Ipv4Addr::LOCALHOST.into();
             let options = ClientOptions { dog: sim.high_level_addr(), ..ClientOptions::high_level(local, 0, local) };
             println!("simulated dog at {}", sim.high_level_addr());

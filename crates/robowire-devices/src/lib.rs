@@ -54,7 +54,7 @@ pub struct OpenOptions {
     /// 3 s watchdog, Go2/HG/G1 100 ms).
     pub state_timeout: Option<Duration>,
     /// Record the device's links with this recorder (`None`: not recorded), named after the
-    /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `dog/high_level`,
+    /// device: `kmc/serial` (and `kmc/serial_skipped`, the line noise), `zsl1/high_level`,
     /// `go2/low_level` and `go2/api`, `hg/low_level` and `hg/api`, `g1/low_level` and `g1/api`
     /// (described by `unitree_proto::description::HG_LOW_LEVEL` and `API_CLIENT`), `spline/spline` (the states a
     /// monitor takes from `/spline_shm`).
@@ -268,7 +268,7 @@ impl AnyDevice {
     }
 
     /// The latest state as JSON: the fields of the device's own status command
-    /// (`robowire dog status --json`, `robowire go2 status --json`).
+    /// (`robowire zsl1 status --json`, `robowire go2 status --json`).
     pub fn status_json(&self) -> Option<Value> {
         self.link().status_json()
     }

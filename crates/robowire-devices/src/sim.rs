@@ -1,7 +1,5 @@
 //! `sim:` addresses: the simulator first, then the same client a real device gets.
 
-#[cfg(feature = "zsl1")]
-use robowire_sim::dog::{DogSim, DogSimConfig};
 #[cfg(feature = "unitree")]
 use robowire_sim::g1::{G1Sim, G1SimConfig};
 #[cfg(feature = "unitree")]
@@ -10,6 +8,8 @@ use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 #[cfg(feature = "zsl1")]
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
+#[cfg(feature = "zsl1")]
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 
 use crate::link::Link;
 use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
@@ -23,7 +23,7 @@ pub enum Simulator {
     Kmc(ChassisSim),
     #[cfg(feature = "zsl1")]
     /// A ZSL-1 / ZSL-1W on loopback UDP.
-    Dog(DogSim),
+    Zsl1(Zsl1Sim),
     #[cfg(feature = "unitree")]
     /// A Go2 on DDS.
     Go2(Go2Sim),
@@ -53,14 +53,14 @@ pub(crate) fn open(
         SimKind::Zsl1 | SimKind::Zsl1w => {
             let model = if kind == SimKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
             let sim =
-                DogSim::spawn(DogSimConfig { model, ..DogSimConfig::loopback() }).map_err(|e| failed(e.into()))?;
+                Zsl1Sim::spawn(Zsl1SimConfig { model, ..Zsl1SimConfig::loopback() }).map_err(|e| failed(e.into()))?;
             let dog = sim.high_level_addr();
             let client = zsl::udp::ClientOptions {
                 dog,
                 ..zsl::udp::ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip())
             };
             let link = zsl::udp::HighLevel::open(crate::kinds::zsl1::client_options(client, model, options))?;
-            (Simulator::Dog(sim), Box::new(link))
+            (Simulator::Zsl1(sim), Box::new(link))
         }
         #[cfg(feature = "zsl1")]
         SimKind::Spline => {

@@ -253,7 +253,7 @@ impl Device {
 /// Opens the device at `address` (`kmc:/dev/ttyUSB0`, `zsl1:192.168.234.1`, `zsl1w:IP`,
 /// `go2:eth0`, `hg:eth0`, `sim:kmc|zsl1|zsl1w|go2`); `domain` is the DDS domain of `go2:`, `hg:`
 /// and `sim:go2`. `record`: a path or a `robowire.Recorder` to record the client's links into
-/// (`kmc/serial`, `dog/high_level`, `go2/low_level` and `go2/api`, …). A bad address raises
+/// (`kmc/serial`, `zsl1/high_level`, `go2/low_level` and `go2/api`, …). A bad address raises
 /// `ArgumentError`.
 #[pyfunction]
 #[pyo3(signature = (address, *, domain = 0, record = None))]

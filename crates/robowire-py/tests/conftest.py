@@ -1,6 +1,6 @@
 """Shared fixtures of robowire's Python suite.
 
-Everything runs on loopback (each dog test on its own 127.0.0.x) or, for DDS, in a private
+Everything runs on loopback (each ZSL-1 test on its own 127.0.0.x) or, for DDS, in a private
 network namespace entered here before any robowire thread starts (as root, or as the root of a
 user namespace: ``cargo xtask test`` runs pytest under ``unshare --user --map-root-user --net``). Tests that need something
 this machine may lack (the vendor's CPython 3.10 module, Unitree's SDK, the mcap package, DDS multicast) skip,
@@ -80,7 +80,7 @@ def ip() -> str:
 @pytest.fixture
 def dog(ip):
     """A ZSL-1 simulator on the vendor's ports at ``ip``."""
-    with robowire.sim.Dog(ip=ip) as dog:
+    with robowire.sim.Zsl1(ip=ip) as dog:
         yield dog
 
 

@@ -20,7 +20,7 @@ from conftest import cli, missing
 from helpers import wait_until
 
 # A loopback address of this module's own (conftest's `ip` hands out 127.0.0.x).
-DOG_IP = "127.0.9.7"
+ZSL1_IP = "127.0.9.7"
 
 SENT, RECEIVED = {"sent"}, {"received"}
 BOTH = SENT | RECEIVED
@@ -69,7 +69,7 @@ def frames_of(channels, link, direction):
 
 @pytest.fixture(scope="module")
 def captures(tmp_path_factory):
-    """A KMC chassis, a ZSL-1 dog (HighLevel and LowLevel) and the spline daemon, each simulator
+    """A KMC chassis, a ZSL-1 (HighLevel and LowLevel) and the spline daemon, each simulator
     recording its side into a file of its own (a str, a pathlib.Path), their clients all into one
     shared zstd Recorder; and `robowire.open("sim:zsl1", record=PATH)`. {name: (path, {link:
     directions})}, and the shared recorder's summary."""
@@ -89,11 +89,11 @@ def captures(tmp_path_factory):
             wait_until(skipped)
         driver.close()
 
-    with robowire.sim.Dog(ip=DOG_IP, record=tmp / "dog.mcap") as dog:
+    with robowire.sim.Zsl1(ip=ZSL1_IP, record=tmp / "zsl1.mcap"):
         high, low = robowire.zsl1.HighLevel(record=rec), robowire.zsl1.LowLevel(record=rec)
         with high, low:
-            high.initRobot(DOG_IP, 0, DOG_IP)
-            low.initRobot(DOG_IP, 0, DOG_IP)
+            high.initRobot(ZSL1_IP, 0, ZSL1_IP)
+            low.initRobot(ZSL1_IP, 0, ZSL1_IP)
             assert high.wait_connected(5.0) and low.wait_connected(5.0)
             high.standUp()
 
@@ -113,16 +113,16 @@ def captures(tmp_path_factory):
     assert rec.closed and rec.close() == shared  # a second close: the same summary
     return {
         "chassis": (tmp / "chassis.mcap", {"kmc/serial": BOTH}),
-        "dog": (tmp / "dog.mcap", {"dog/high_level": BOTH, "dog/low_level": BOTH}),
+        "zsl1": (tmp / "zsl1.mcap", {"zsl1/high_level": BOTH, "zsl1/low_level": BOTH}),
         "spline": (tmp / "spline.mcap", {"spline/spline": BOTH, "spline/imu": SENT}),
-        "open": (tmp / "open.mcap", {"dog/high_level": BOTH}),
+        "open": (tmp / "open.mcap", {"zsl1/high_level": BOTH}),
         "clients": (
             tmp / "clients.mcap",
             {
                 "kmc/serial": BOTH,
                 "kmc/serial_skipped": RECEIVED,
-                "dog/high_level": BOTH,
-                "dog/low_level": BOTH,
+                "zsl1/high_level": BOTH,
+                "zsl1/low_level": BOTH,
                 "spline/spline": BOTH,
                 "spline/imu": RECEIVED,
             },
@@ -130,7 +130,7 @@ def captures(tmp_path_factory):
     }, shared
 
 
-NAMES = ["chassis", "dog", "spline", "open", "clients"]
+NAMES = ["chassis", "zsl1", "spline", "open", "clients"]
 
 
 def test_the_shared_recorder_says_what_it_wrote(captures):
@@ -228,11 +228,11 @@ def test_a_closed_recorder_refuses_new_devices_and_running_ones_go_on(tmp_path):
 
 def test_a_path_capture_is_finished_by_close_and_records_no_second_session(tmp_path):
     path = pathlib.Path(tmp_path / "high.mcap")
-    with robowire.sim.Dog(ip=DOG_IP):
+    with robowire.sim.Zsl1(ip=ZSL1_IP):
         high = robowire.zsl1.HighLevel(record=path)
-        high.initRobot(DOG_IP, 0, DOG_IP)
+        high.initRobot(ZSL1_IP, 0, ZSL1_IP)
         assert high.wait_connected(5.0)
         high.close()
-        assert frames_of(summary(path), "dog/high_level", "received")  # finished: readable now
+        assert frames_of(summary(path), "zsl1/high_level", "received")  # finished: readable now
         with pytest.raises(robowire.ClosedError, match="capture"):
-            high.initRobot(DOG_IP, 0, DOG_IP)
+            high.initRobot(ZSL1_IP, 0, ZSL1_IP)

@@ -8,34 +8,48 @@ import robowire.spline
 from helpers import wait_until
 
 
-def test_dog_addresses_snapshot_and_close(ip):
-    dog = robowire.sim.Dog(ip=ip)
-    with dog:
-        assert dog.ip == ip
-        assert dog.high_level_addr == (ip, 43997) and dog.low_level_addr == (ip, 43900)
-        snapshot = dog.snapshot()
+def test_zsl1_addresses_snapshot_and_close(ip):
+    sim = robowire.sim.Zsl1(ip=ip)
+    with sim:
+        assert sim.ip == ip
+        assert sim.high_level_addr == (ip, 43997) and sim.low_level_addr == (ip, 43900)
+        snapshot = sim.snapshot()
         assert snapshot["mode"] == 51 and snapshot["activity"] == "lying"
-        dog.set_battery_percent(42.0)
-        assert dog.snapshot()["battery_percent"] == 42.0
+        sim.set_battery_percent(42.0)
+        assert sim.snapshot()["battery_percent"] == 42.0
         with pytest.raises(robowire.ArgumentError):
-            dog.set_battery_percent(101.0)
+            sim.set_battery_percent(101.0)
         with pytest.raises(robowire.ArgumentError):
-            dog.inject_error_word(0)
-    with pytest.raises(robowire.ClosedError):
-        dog.snapshot()
-    with robowire.sim.Dog(ip=ip):  # its ports are free again
+            sim.inject_error_word(0)
+    with pytest.raises(robowire.ClosedError, match="ZSL-1 simulator is closed"):
+        sim.snapshot()
+    with robowire.sim.Zsl1(ip=ip):  # its ports are free again
         pass
 
 
-def test_dog_free_ports_and_a_taken_port(ip):
-    with robowire.sim.Dog(ip=ip, high_level_port=0, low_level_port=0) as dog:
-        assert dog.high_level_addr[1] != 0
-        with robowire.sim.Dog(ip=ip) as vendor_ports:
+def test_zsl1_free_ports_and_a_taken_port(ip):
+    with robowire.sim.Zsl1(ip=ip, high_level_port=0, low_level_port=0) as sim:
+        assert sim.high_level_addr[1] != 0
+        with robowire.sim.Zsl1(ip=ip) as vendor_ports:
             with pytest.raises(robowire.BindError):
-                robowire.sim.Dog(ip=ip)
+                robowire.sim.Zsl1(ip=ip)
             assert vendor_ports.high_level_addr == (ip, 43997)
     with pytest.raises(robowire.ArgumentError):
-        robowire.sim.Dog("zsl2")
+        robowire.sim.Zsl1("zsl2")
+
+
+def test_dog_is_the_old_name_of_zsl1_kept_one_release(ip):
+    with pytest.warns(DeprecationWarning, match="robowire.sim.Dog is now robowire.sim.Zsl1"):
+        dog = robowire.sim.Dog
+    assert dog is robowire.sim.Zsl1
+    with pytest.warns(DeprecationWarning):
+        from robowire.sim import Dog
+    assert Dog is robowire.sim.Zsl1 and "Dog" not in robowire.sim.__all__
+    with Dog("zsl1w", ip=ip) as sim:
+        assert isinstance(sim, robowire.sim.Zsl1) and repr(sim).startswith("Zsl1(")
+        assert sim.snapshot()["model"] == "zsl1w"
+    with pytest.raises(AttributeError):
+        robowire.sim.Cat
 
 
 def test_spline_daemon_with_client_pause_and_faults():

@@ -1,4 +1,4 @@
-"""robowire.zsl1 as a drop-in for mc_sdk_zsl_1_py, call by call against robowire.sim.Dog, with
+"""robowire.zsl1 as a drop-in for mc_sdk_zsl_1_py, call by call against robowire.sim.Zsl1, with
 the vendor's return codes (spec zsl1-udp.md §8.3, §9) and robowire's safer differences."""
 
 import inspect

@@ -19,7 +19,7 @@ def test_the_vendors_zsl1w_method_set():
 
 @pytest.fixture
 def wheel_dog(ip):
-    with robowire.sim.Dog("zsl1w", ip=ip) as dog:
+    with robowire.sim.Zsl1("zsl1w", ip=ip) as dog:
         yield dog
 
 

@@ -14,9 +14,9 @@
 use std::time::{Duration, Instant};
 
 use robowire_record::{Compression, Direction, Recorder, RecorderOptions};
-use robowire_sim::dog::{DogSim, DogSimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use serde_json::json;
 use zsl::udp::{ClientOptions, Device, HighLevel};
 use zsl_proto::description::HIGH_LEVEL;
@@ -28,7 +28,7 @@ fn temp(name: &str) -> std::path::PathBuf {
 
 /// The stream's lateness over `seconds`, recorded or not: (p50 µs, p99 µs, frames dropped).
 fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32, u32, u64) {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let recorder = record.then(|| Recorder::create(temp("stream"), "bench").unwrap());
     let (lateness, dropped) = runtime.block_on(async {
         let mut options = ClientOptions {
@@ -36,7 +36,7 @@ fn stream(runtime: &tokio::runtime::Runtime, seconds: f64, record: bool) -> (u32
             ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, [127, 0, 0, 1].into())
         };
         if let Some(recorder) = &recorder {
-            options = options.with_tap(recorder.link("dog/high_level", &HIGH_LEVEL));
+            options = options.with_tap(recorder.link("zsl1/high_level", &HIGH_LEVEL));
         }
         let dog = HighLevel::open(options).unwrap();
         assert!(dog.wait_connected(Duration::from_secs(2)).await);

@@ -47,7 +47,7 @@ pub enum ReadError {
 /// One frame as recorded.
 #[derive(Debug, Clone)]
 pub struct RecordedFrame {
-    /// The link's name (`dog/high_level`).
+    /// The link's name (`zsl1/high_level`).
     pub link: String,
     /// Sent or received, from the recording side.
     pub direction: Direction,

@@ -179,7 +179,7 @@ impl Recorder {
         Ok(Self { ring, links, stop, thread: Some(thread) })
     }
 
-    /// A tap for the link `name` (`dog/high_level`), whose frames `description` describes: the
+    /// A tap for the link `name` (`zsl1/high_level`), whose frames `description` describes: the
     /// capture names its protocol, and its frames are decoded by it for the JSON channels.
     pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
         self.links().link(name, description)

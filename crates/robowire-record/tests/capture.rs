@@ -20,7 +20,7 @@ fn capture(frames: &[(Direction, Vec<u8>)]) -> Vec<u8> {
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = std::env::temp_dir().join(format!("robowire-capture-{}-{n}.mcap", std::process::id()));
     let recorder = Recorder::create(&path, "test").unwrap();
-    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
+    let tap = recorder.link("zsl1/high_level", &HIGH_LEVEL);
     for (direction, bytes) in frames {
         tap.record(*direction, bytes);
     }
@@ -53,7 +53,7 @@ fn frames_come_back_byte_for_byte_in_order_at_unix_time() {
     let got: Vec<_> = read.iter().map(|f| (f.direction, f.bytes.clone())).collect();
     assert_eq!(got, frames);
     assert!(read.windows(2).all(|w| w[0].unix_ns <= w[1].unix_ns));
-    assert!(read.iter().all(|f| f.link == "dog/high_level" && f.protocol.protocol() == "zsl1.high_level"));
+    assert!(read.iter().all(|f| f.link == "zsl1/high_level" && f.protocol.protocol() == "zsl1.high_level"));
     // The taps' monotonic stamps, logged at Unix time (1 ms of slack for the clocks' reads).
     assert!(read.iter().all(|f| (before - 1_000_000..=after + 1_000_000).contains(&f.unix_ns)), "{before} {after}");
     assert_eq!(read[0].decode().unwrap().schema, "zsl1.HighLevelCommand");
@@ -74,7 +74,8 @@ fn a_protocol_nobody_described_is_an_error_naming_it() {
 
 #[test]
 fn a_capture_written_before_link_descriptions_still_reads() {
-    // Written by the recorder whose protocols were a closed enum; never regenerated.
+    // Written by the recorder whose protocols were a closed enum; never regenerated (its links
+    // carry the ZSL-1's names of then, `dog/…`: the reader takes a link's name as recorded).
     let capture = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/before-descriptions.mcap")).unwrap();
     let frames = read_frames(&capture, &DESCRIPTIONS).unwrap();
     let protocols: Vec<_> = frames.iter().map(|f| (f.link.as_str(), f.protocol.protocol(), f.bytes.len())).collect();
@@ -98,7 +99,7 @@ fn a_capture_written_before_link_descriptions_still_reads() {
 fn an_oversize_frame_is_counted_apart_and_the_rest_recorded() {
     let path = std::env::temp_dir().join(format!("robowire-capture-{}-oversize.mcap", std::process::id()));
     let recorder = Recorder::create(&path, "test").unwrap();
-    let tap = recorder.link("dog/high_level", &HIGH_LEVEL);
+    let tap = recorder.link("zsl1/high_level", &HIGH_LEVEL);
     tap.record(Direction::Received, &[0; SLOT_BYTES + 1]);
     tap.record(Direction::Sent, &HighLevelCommand::stand_up().encode(Model::Zsl1));
     assert_eq!(recorder.oversize(), 1);
@@ -115,12 +116,12 @@ fn an_oversize_frame_is_counted_apart_and_the_rest_recorded() {
 fn the_summary_counts_channels_and_decode_errors() {
     let summary = summarize(&capture(&session()), &DESCRIPTIONS).unwrap();
     let topic = |t: &str| summary.channels.iter().find(|c| c.topic == t).unwrap_or_else(|| panic!("{t}: {summary:?}"));
-    assert_eq!(topic("/dog/high_level/sent/raw").count, 2);
-    assert_eq!(topic("/dog/high_level/received/raw").count, 2);
-    assert_eq!(topic("/dog/high_level/received/raw").decode_errors, 1, "the 3-byte junk");
-    assert_eq!(topic("/dog/high_level/received/zsl1.HighLevelState").count, 1, "only the state decoded");
+    assert_eq!(topic("/zsl1/high_level/sent/raw").count, 2);
+    assert_eq!(topic("/zsl1/high_level/received/raw").count, 2);
+    assert_eq!(topic("/zsl1/high_level/received/raw").decode_errors, 1, "the 3-byte junk");
+    assert_eq!(topic("/zsl1/high_level/received/zsl1.HighLevelState").count, 1, "only the state decoded");
     assert_eq!(summary.metadata["command"], "test");
-    assert_eq!(summary.metadata["link:dog/high_level"], "zsl1.high_level (zsl1-udp, vendor SDK v0.2.7)");
+    assert_eq!(summary.metadata["link:zsl1/high_level"], "zsl1.high_level (zsl1-udp, vendor SDK v0.2.7)");
 }
 
 #[test]
@@ -155,11 +156,11 @@ fn a_metadata_index_pointing_outside_the_file_is_skipped() {
 #[test]
 fn a_raw_and_a_json_channel_on_one_topic_are_summarized_apart() {
     let mut writer = mcap::WriteOptions::new().compression(None).create(std::io::Cursor::new(Vec::new())).unwrap();
-    let raw_metadata = [("link", "dog/high_level"), ("direction", "sent"), ("protocol", "zsl1.high_level")]
+    let raw_metadata = [("link", "zsl1/high_level"), ("direction", "sent"), ("protocol", "zsl1.high_level")]
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .into();
-    let json = writer.add_channel(0, "/dog/high_level/sent/raw", "json", &Default::default()).unwrap();
-    let raw = writer.add_channel(0, "/dog/high_level/sent/raw", "robowire.raw", &raw_metadata).unwrap();
+    let json = writer.add_channel(0, "/zsl1/high_level/sent/raw", "json", &Default::default()).unwrap();
+    let raw = writer.add_channel(0, "/zsl1/high_level/sent/raw", "robowire.raw", &raw_metadata).unwrap();
     let header =
         |channel_id, log_time| mcap::records::MessageHeader { channel_id, sequence: 0, log_time, publish_time: 0 };
     writer.write_to_known_channel(&header(json, 1), b"{}").unwrap();

@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 #[cfg(feature = "zsl")]
+#[deprecated(note = "renamed `robowire_sim::zsl1` (`DogSim` is `Zsl1Sim`, `DogSimConfig` is `Zsl1SimConfig`, …)")]
 pub mod dog;
 #[cfg(feature = "g1")]
 pub mod g1;
@@ -23,3 +24,5 @@ pub mod replay;
 pub mod spline;
 #[cfg(any(feature = "go2", feature = "g1"))]
 mod unitree;
+#[cfg(feature = "zsl")]
+pub mod zsl1;

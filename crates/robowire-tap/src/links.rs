@@ -28,7 +28,7 @@ impl RecordLinks {
         Self { ring, links, prefix: String::new() }
     }
 
-    /// A tap for the link `name` (`dog/high_level`), whose frames `description` describes.
+    /// A tap for the link `name` (`zsl1/high_level`), whose frames `description` describes.
     pub fn link(&self, name: &str, description: &'static dyn LinkDescription) -> Tap {
         let mut links = lock(&self.links);
         links.push((format!("{}{}", self.prefix, name.trim_matches('/')), description));

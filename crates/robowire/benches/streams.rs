@@ -14,9 +14,9 @@ use robowire_core::schedule::{Periodic, Time};
 use robowire_core::timing::{LatenessRing, LatenessSummary};
 use robowire_rt::runner::{DEFAULT_SPIN, Job, Runner, RunnerOptions};
 use robowire_rt::stats::micros;
-use robowire_sim::dog::{DogSim, DogSimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use serde_json::{Value, json};
 use zsl::udp::{ClientOptions, HighLevel, LowLevel};
 
@@ -114,7 +114,7 @@ fn runtime() -> tokio::runtime::Runtime {
 /// The ZSL-1 HighLevel client's idle 500 Hz stream against the dog simulator: the client's
 /// send lateness, the simulator's state-stream lateness, the interval at the dog.
 fn zsl_high_level(seconds: f64) -> (LatenessSummary, LatenessSummary, LatenessSummary) {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).expect("dog simulator");
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).expect("dog simulator");
     let dog = sim.high_level_addr();
     runtime().block_on(async {
         let options = ClientOptions { dog, ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) };
@@ -127,7 +127,7 @@ fn zsl_high_level(seconds: f64) -> (LatenessSummary, LatenessSummary, LatenessSu
 
 /// The ZSL-1 LowLevel client's idle 500 Hz stream against the dog simulator.
 fn zsl_low_level(seconds: f64) -> LatenessSummary {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).expect("dog simulator");
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).expect("dog simulator");
     let dog = sim.low_level_addr();
     runtime().block_on(async {
         let options = ClientOptions { dog, ..ClientOptions::low_level([127, 0, 0, 1].into(), 0, dog.ip()) };

@@ -31,7 +31,9 @@ enum Command {
     /// Talk to a KMC wheeled chassis over a serial port.
     Kmc(cmd::kmc::KmcArgs),
     /// Drive a ZsiBot ZSL-1 / ZSL-1W over UDP (HighLevel: stand, walk, tricks, status).
-    Dog(cmd::dog::DogArgs),
+    // `dog`: its old name, kept for one release (issue 34).
+    #[command(alias = "dog")]
+    Zsl1(cmd::zsl1::Zsl1Args),
     /// Drive a Unitree Go2's low-level interface over DDS (status, watch, release, stand, damp).
     Go2(cmd::go2::Go2Args),
     /// Drive a Unitree G1 humanoid's low-level interface over DDS (status, watch, release, damp, zero).
@@ -74,7 +76,7 @@ fn main() -> ExitCode {
         Command::Watch(args) => cmd::device::on_loopback(loopback, || cmd::device::watch(&args)),
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
-        Command::Dog(args) => cmd::dog::run(args),
+        Command::Zsl1(args) => cmd::zsl1::run(args),
         Command::Go2(args) => cmd::go2::run(args),
         Command::G1(args) => cmd::g1::run(args),
         Command::Dds(args) => cmd::dds::run(args),

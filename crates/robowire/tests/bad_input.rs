@@ -58,7 +58,7 @@ fn every_subcommand_fails_with_one_line_that_says_what_to_do() {
         ),
         case(
             &[
-                "dog",
+                "zsl1",
                 "--dog-ip",
                 "127.0.0.34",
                 "--local-ip",
@@ -76,10 +76,10 @@ fn every_subcommand_fails_with_one_line_that_says_what_to_do() {
         case(&["ros2", "--device", "kmc:/dev/robowire-no-such-port", "--duration", "1"], &["cannot open serial port"]),
         // Busy ports.
         case(
-            &["dog", "--dog-ip", "127.0.0.33", "--local-ip", "127.0.0.33", "--local-port", &busy_port, "status"],
+            &["zsl1", "--dog-ip", "127.0.0.33", "--local-ip", "127.0.0.33", "--local-port", &busy_port, "status"],
             &["cannot bind", "127.0.0.33"],
         ),
-        case(&["sim", "dog", "--bind", "127.0.0.33", "--high-level-port", &busy_port], &["cannot bind"]),
+        case(&["sim", "zsl1", "--bind", "127.0.0.33", "--high-level-port", &busy_port], &["cannot bind"]),
         // Unreadable captures.
         case(&["decode", "--mcap", &missing], &["missing.mcap"]),
         case(&["replay", &missing], &["missing.mcap"]),

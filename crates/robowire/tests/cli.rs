@@ -87,6 +87,21 @@ fn demo_refuses_a_nonsense_duration() {
     assert!(!out.status.success());
 }
 
+/// `--only` takes each device's name, and for one release the old names too (`dog` for `zsl1`,
+/// `lowcmd` for `go2`); only the current names are listed.
+#[test]
+fn demo_only_takes_every_device_and_the_old_names() {
+    for only in ["kmc", "zsl1", "dog", "spline", "go2", "lowcmd", "g1"] {
+        // Parsed, then refused for the duration, before any scenario runs.
+        let out = robowire().args(["demo", "--only", only, "--duration", "0"]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("--duration must be between"), "--only {only}: {stderr}");
+    }
+    let out = robowire().args(["demo", "--only", "cat"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("[possible values: kmc, zsl1, spline, go2, g1]"), "{stderr}");
+}
+
 #[test]
 fn sim_and_device_commands_as_two_processes() {
     let sim = Running::start(&["sim", "kmc", "--report-every-s", "0"]);
@@ -126,10 +141,10 @@ fn sim_and_device_commands_as_two_processes() {
 }
 
 #[test]
-fn demo_lowcmd_loop_and_json_output() {
+fn demo_go2_loop_and_json_output() {
     // The demo makes its own DDS network (as a normal user: a user + network namespace).
     let Some(()) = robowire_fixtures::interop::require(robowire_dds::netns::available()) else { return };
-    let out = demo(&["--only", "lowcmd", "--duration", "1", "--json"]);
+    let out = demo(&["--only", "go2", "--duration", "1", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is only the JSON report");
     assert_eq!(report["passed"], true, "{report}");

@@ -1,5 +1,5 @@
 //! `robowire status ADDRESS` and `robowire watch ADDRESS` for every kind of address, against
-//! the simulators: a chassis on a pseudo-terminal, a dog on loopback UDP, and the `sim:`
+//! the simulators: a chassis on a pseudo-terminal, a ZSL-1 on loopback UDP, and the `sim:`
 //! addresses. (The Go2 on DDS is in `tests/go2.rs`, in a private network.)
 
 mod support;
@@ -49,8 +49,8 @@ fn a_chassis_on_a_serial_port() {
 }
 
 #[test]
-fn a_dog_on_loopback_udp() {
-    let _sim = Running::start(&["sim", "dog", "--bind", "127.0.0.31", "--report-every-s", "0"]);
+fn a_zsl1_on_loopback_udp() {
+    let _sim = Running::start(&["sim", "zsl1", "--bind", "127.0.0.31", "--report-every-s", "0"]);
     let status = status_json(&["zsl1:127.0.0.31", "--local", "127.0.0.31:0"]);
     assert_eq!(status["datagram"], "high_level_state", "{status}");
     assert!(status["mode"].is_u64() && status["battery_percent"].is_u64(), "{status}");

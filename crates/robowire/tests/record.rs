@@ -17,16 +17,16 @@ fn temp(name: &str) -> std::path::PathBuf {
 }
 
 #[test]
-fn a_recorded_dog_session_reads_back_everywhere() {
+fn a_recorded_zsl1_session_reads_back_everywhere() {
     let (sim_capture, client_capture) = (temp("sim.mcap"), temp("client.mcap"));
     let sim = Running::spawn(
         robowire()
-            .args(["sim", "dog", "--bind", "127.0.0.23", "--report-every-s", "0", "--record"])
+            .args(["sim", "zsl1", "--bind", "127.0.0.23", "--report-every-s", "0", "--record"])
             .arg(&sim_capture)
             .stderr(Stdio::piped()),
     );
     let walk = robowire()
-        .args(["dog", "--dog-ip", "127.0.0.23", "--local-ip", "127.0.0.23", "--record"])
+        .args(["zsl1", "--dog-ip", "127.0.0.23", "--local-ip", "127.0.0.23", "--record"])
         .arg(&client_capture)
         .args(["stand"])
         .output()
@@ -34,7 +34,7 @@ fn a_recorded_dog_session_reads_back_everywhere() {
     assert!(walk.status.success(), "{}", String::from_utf8_lossy(&walk.stderr));
     let walk = robowire()
         .args([
-            "dog",
+            "zsl1",
             "--dog-ip",
             "127.0.0.23",
             "--local-ip",
@@ -62,9 +62,9 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         let seen: Value = serde_json::from_slice(&read.stdout).unwrap();
         let channels = seen["channels"].as_object().unwrap();
         for direction in ["sent", "received"] {
-            let raw = &channels[&format!("/dog/high_level/{direction}/raw")];
+            let raw = &channels[&format!("/zsl1/high_level/{direction}/raw")];
             // One JSON channel per message type: commands one way, states the other.
-            let prefix = format!("/dog/high_level/{direction}/zsl1.");
+            let prefix = format!("/zsl1/high_level/{direction}/zsl1.");
             let json = channels.iter().find(|(t, _)| t.starts_with(&prefix)).map(|(_, c)| c).unwrap();
             assert_eq!(raw["encoding"], "robowire.raw");
             assert_eq!(raw["metadata"]["protocol"], "zsl1.high_level");
@@ -77,7 +77,7 @@ fn a_recorded_dog_session_reads_back_everywhere() {
         }
         let metadata = &seen["metadata"]["robowire"];
         assert_eq!(metadata["robowire_version"], env!("CARGO_PKG_VERSION"));
-        assert!(metadata["link:dog/high_level"].as_str().unwrap().starts_with("zsl1.high_level"));
+        assert!(metadata["link:zsl1/high_level"].as_str().unwrap().starts_with("zsl1.high_level"));
     }
     // The simulator sent a state for each command it got, at least: states ≥ commands seen.
     let summary = robowire().args(["decode", "--json", "--mcap"]).arg(&sim_capture).output().unwrap();
@@ -85,7 +85,7 @@ fn a_recorded_dog_session_reads_back_everywhere() {
     let summary: Value = serde_json::from_slice(&summary.stdout).unwrap();
     let channel =
         |topic: &str| summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == topic).unwrap().clone();
-    let commands = channel("/dog/high_level/received/raw");
+    let commands = channel("/zsl1/high_level/received/raw");
     assert_eq!(commands["decode_errors"], 0);
     assert_eq!(commands["out_of_order"], 0);
     assert!(commands["rate_hz"].as_f64().unwrap() > 100.0, "the 500 Hz stream: {commands}");
@@ -126,21 +126,21 @@ fn modes(states: impl Iterator<Item = zsl_proto::udp::HighLevelState>) -> Vec<u3
 fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     use zsl_proto::udp::{AnyDatagram, HighLevelState};
     let capture = temp("walk.mcap");
-    let sim = Running::start(&["sim", "dog", "--bind", "127.0.0.26", "--report-every-s", "0"]);
-    let dog = |args: &[&str], record: bool| {
+    let sim = Running::start(&["sim", "zsl1", "--bind", "127.0.0.26", "--report-every-s", "0"]);
+    let zsl1 = |args: &[&str], record: bool| {
         let mut command = robowire();
-        command.args(["dog", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26"]);
+        command.args(["zsl1", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26"]);
         if record {
             command.arg("--record").arg(&capture);
         }
         let out = command.args(args).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     };
-    dog(&["stand"], false);
+    zsl1(&["stand"], false);
     // Wait for the stand-up to finish (mode 1 reported and the body up), not for a fixed time.
     let standing = || {
         let out = robowire()
-            .args(["dog", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26", "status", "--json"])
+            .args(["zsl1", "--dog-ip", "127.0.0.26", "--local-ip", "127.0.0.26", "status", "--json"])
             .output()
             .unwrap();
         let state: Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
@@ -148,9 +148,9 @@ fn replay_as_device_drives_a_live_client_through_the_recorded_states() {
     };
     let began = std::time::Instant::now();
     while !standing() {
-        assert!(began.elapsed().as_secs() < 30, "the simulated dog never stood up");
+        assert!(began.elapsed().as_secs() < 30, "the simulated robot never stood up");
     }
-    dog(&["move", "0.5", "0", "0", "--duration", "0.5"], true);
+    zsl1(&["move", "0.5", "0", "0", "--duration", "0.5"], true);
     drop(sim);
 
     let zsl = zsl_proto::description::DESCRIPTIONS;

@@ -53,7 +53,7 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
             other => panic!("{topic}: encoding {other}"),
         }
     }
-    for link in ["kmc", "dog", "go2", "g1/low_level", "g1/arm_sdk"] {
+    for link in ["kmc", "zsl1", "go2", "g1/low_level", "g1/arm_sdk"] {
         assert!(channels.keys().any(|t| t.starts_with(&format!("/{link}/"))), "{link} recorded: {seen}");
     }
 
@@ -74,8 +74,8 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
         .map(|(_, c)| c["count"].as_u64().unwrap())
         .sum();
     assert!(skipped >= 1, "the injected line noise is recorded as skipped bytes");
-    recorded_since("/dog/high_level/received/raw", counters("dog", "states"));
-    recorded_since("/dog/high_level/sent/raw", counters("dog", "dog commands"));
+    recorded_since("/zsl1/high_level/received/raw", counters("zsl1", "states"));
+    recorded_since("/zsl1/high_level/sent/raw", counters("zsl1", "sim commands"));
     let lowstates = &channels["/go2/low_level/received"];
     let lowcmds = &channels["/go2/low_level/sent"];
     recorded_since("/go2/low_level/sent", counters("lowcmd", "LowCmd sent"));
@@ -90,7 +90,7 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
     assert!(plot.status.success(), "{}", String::from_utf8_lossy(&plot.stderr));
     let text = std::fs::read_to_string(&svg).unwrap();
     for expected in
-        ["kmc (kmc/serial", "dog (dog/high_level", "go2 (go2/api, go2/low_level", "commanded vx", "calf target"]
+        ["kmc (kmc/serial", "zsl1 (zsl1/high_level", "go2 (go2/api, go2/low_level", "commanded vx", "calf target"]
     {
         assert!(text.contains(expected), "{expected} in the plot");
     }

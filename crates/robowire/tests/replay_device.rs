@@ -287,7 +287,7 @@ fn what_cannot_be_played_is_a_clear_error() {
         &["--link", "kmc/serial"],
         &[&["link kmc/serial (kmc.host) has no device frames"][..], &found].concat(),
     );
-    refused(&capture, &["--link", "dog/high_level"], &[&["no link \"dog/high_level\""][..], &found].concat());
+    refused(&capture, &["--link", "zsl1/high_level"], &[&["no link \"zsl1/high_level\""][..], &found].concat());
     refused(&capture, &["--link", "go2/api"], &["link go2/api is unitree_api.client, which has no device side"]);
 
     let bytes = std::fs::read(&capture).unwrap();

@@ -21,7 +21,7 @@ use std::net::UdpSocket;
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use robowire_sim::dog::{DogSim, DogSimConfig};
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use zsl::udp::{ClientOptions, ControlMode, HighLevel};
 use zsl_proto::udp::{
     HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState, MAGIC_ZSL1, Model,
@@ -146,7 +146,7 @@ fn call_to_wire(runtime: &tokio::runtime::Runtime, samples: &mut Vec<u64>, n: us
 /// (on this VM a sleeping vCPU's wake-up alone swings a round trip between ~10 and ~40 µs).
 /// Measured in a task on the runtime, where a user's control loop runs.
 fn round_trips(runtime: &tokio::runtime::Runtime, raw: &mut Vec<u64>, trip: &mut Vec<u64>, n: usize) {
-    let sim = DogSim::spawn(DogSimConfig { cpu: Some(PEER_CPU), ..DogSimConfig::loopback() }).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig { cpu: Some(PEER_CPU), ..Zsl1SimConfig::loopback() }).unwrap();
     let addr = sim.high_level_addr();
     let (raw_samples, trip_samples) = runtime
         .block_on(runtime.spawn(async move {

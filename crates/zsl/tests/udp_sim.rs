@@ -8,7 +8,7 @@ use std::net::{SocketAddr, UdpSocket};
 use std::time::Duration;
 
 use robowire_fixtures::wait::until_async;
-use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig};
+use robowire_sim::zsl1::{Activity, Zsl1Fault, Zsl1Sim, Zsl1SimConfig};
 use zsl::udp::{
     CallError, ClientOptions, Connection, ControlMode, Device, HighLevel, Latched, LowLevel, MotorCommand, Placement,
     Refusal, ReturnCode,
@@ -23,7 +23,7 @@ fn options_to(dog: SocketAddr) -> ClientOptions {
     ClientOptions { dog, ..ClientOptions::high_level([127, 0, 0, 1].into(), 0, dog.ip()) }
 }
 
-async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
+async fn standing_dog(sim: &Zsl1Sim, options: ClientOptions) -> HighLevel {
     let client = HighLevel::open(options).unwrap();
     assert!(client.wait_connected(WAIT).await, "state from the simulator");
     // The dog starts lying (51); the client's idle stream (mode 0) makes it passive at once.
@@ -31,8 +31,8 @@ async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
     assert!(matches!(mode, ControlMode::LieDown | ControlMode::Passive), "the simulated dog lies: {mode:?}");
     client.stand_up().unwrap();
     assert!(client.wait_for_mode(ControlMode::Stand, WAIT).await.is_some());
-    until_async(WAIT, "sim.snapshot().dog.activity() == Activity::Standing", || {
-        sim.snapshot().dog.activity() == Activity::Standing
+    until_async(WAIT, "sim.snapshot().robot.activity() == Activity::Standing", || {
+        sim.snapshot().robot.activity() == Activity::Standing
     })
     .await;
     client
@@ -40,7 +40,7 @@ async fn standing_dog(sim: &DogSim, options: ClientOptions) -> HighLevel {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn stands_walks_and_lies_down_on_the_simulator() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
     let start = client.position().unwrap();
 
@@ -67,8 +67,8 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 
     client.lie_down().unwrap();
     assert!(client.wait_for_mode(ControlMode::LieDown, WAIT).await.is_some());
-    until_async(WAIT, "sim.snapshot().dog.activity() == Activity::Lying", || {
-        sim.snapshot().dog.activity() == Activity::Lying
+    until_async(WAIT, "sim.snapshot().robot.activity() == Activity::Lying", || {
+        sim.snapshot().robot.activity() == Activity::Lying
     })
     .await;
     let body = client.body().unwrap();
@@ -81,7 +81,7 @@ async fn stands_walks_and_lies_down_on_the_simulator() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn arguments_are_checked_before_anything_is_sent() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr())).await;
     let latched = client.wire_command();
     let refused = |r: Result<Latched, CallError>| matches!(r, Err(CallError::Refused(Refusal::Argument(_))));
@@ -116,14 +116,14 @@ async fn arguments_are_checked_before_anything_is_sent() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn watchdog_disconnects_zeroes_motion_and_reconnects() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let watchdog = Duration::from_millis(300);
     let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(watchdog)).await;
     let mut events = client.connection_events();
     assert_eq!(*events.borrow_and_update(), Connection::Connected);
     client.move_velocity(0.5, 0.0, 0.3).unwrap();
 
-    sim.inject(DogFault::Silence);
+    sim.inject(Zsl1Fault::Silence);
     tokio::time::timeout(WAIT, events.changed()).await.unwrap().unwrap();
     assert_eq!(*events.borrow_and_update(), Connection::Disconnected);
     assert!(!client.check_connection());
@@ -217,10 +217,10 @@ async fn lenient_decoding_merges_short_datagrams_and_counts_anomalies() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn faults_error_word_garbage_and_sdk_mismatch() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let client = standing_dog(&sim, options_to(sim.high_level_addr()).with_watchdog(Duration::from_millis(300))).await;
 
-    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+    sim.inject(Zsl1Fault::ErrorWord(ReturnCode::MotorFault));
     assert!(client.wait_for_state(WAIT, move |s| s.body.error == Some(ReturnCode::MotorFault)).await.is_some());
     assert!(matches!(client.jump(), Err(CallError::Refused(Refusal::SelfCheck(ReturnCode::MotorFault)))));
     // The stream forces passive.
@@ -228,13 +228,13 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
         client.wire_command().control_mode() == ControlMode::Passive
     })
     .await;
-    until_async(WAIT, "sim.snapshot().dog.mode() == ControlMode::Passive", || {
-        sim.snapshot().dog.mode() == ControlMode::Passive
+    until_async(WAIT, "sim.snapshot().robot.mode() == ControlMode::Passive", || {
+        sim.snapshot().robot.mode() == ControlMode::Passive
     })
     .await;
     sim.clear_faults();
 
-    sim.inject(DogFault::Garbage);
+    sim.inject(Zsl1Fault::Garbage);
     tokio::time::timeout(WAIT, client.connection_events().wait_for(|c| *c == Connection::Disconnected))
         .await
         .unwrap()
@@ -243,7 +243,7 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
     sim.clear_faults();
     assert!(client.wait_connected(WAIT).await);
 
-    sim.inject(DogFault::SdkMismatch);
+    sim.inject(Zsl1Fault::SdkMismatch);
     assert!(client.wait_for_state(WAIT, move |s| s.sdk_mismatch).await.is_some());
     until_async(WAIT, "client.halted()", || client.halted()).await; // the stream stops for good, like the vendor's
     assert!(matches!(client.stand_up(), Err(CallError::SdkMismatch)));
@@ -257,7 +257,7 @@ async fn faults_error_word_garbage_and_sdk_mismatch() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn high_level_and_low_level_at_once_on_different_local_ports() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let high = HighLevel::open(options_to(sim.high_level_addr())).unwrap();
     let low_options = ClientOptions { dog: sim.low_level_addr(), ..options_to(sim.low_level_addr()) };
     let low = LowLevel::open(low_options).unwrap();
@@ -293,8 +293,8 @@ async fn high_level_and_low_level_at_once_on_different_local_ports() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_zsl1w_crawls_and_its_wheels_turn() {
-    let config = DogSimConfig { model: zsl::udp::Model::Zsl1W, ..DogSimConfig::loopback() };
-    let sim = DogSim::spawn(config).unwrap();
+    let config = Zsl1SimConfig { model: zsl::udp::Model::Zsl1W, ..Zsl1SimConfig::loopback() };
+    let sim = Zsl1Sim::spawn(config).unwrap();
     let options = options_to(sim.high_level_addr()).with_model(zsl::udp::Model::Zsl1W);
     let client = standing_dog(&sim, options).await;
     client.crawl(0.5, 0.0, 0.0).unwrap();
@@ -312,7 +312,7 @@ async fn a_zsl1w_crawls_and_its_wheels_turn() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let options = options_to(sim.low_level_addr()).with_watchdog(Duration::from_millis(300));
     let low = LowLevel::open(options).unwrap();
     assert!(low.wait_for_state(WAIT, move |_| true).await.is_some());
@@ -321,7 +321,7 @@ async fn low_level_watchdog_zeroes_velocity_targets_and_keeps_the_hold() {
     moving.tau_ff_nm[2] = [2.0; 4];
     low.send_motor_command(&moving).unwrap();
 
-    sim.inject(DogFault::Silence);
+    sim.inject(Zsl1Fault::Silence);
     tokio::time::timeout(WAIT, low.connection_events().wait_for(|c| *c == Connection::Disconnected))
         .await
         .unwrap()
@@ -358,7 +358,7 @@ async fn bad_options_and_placement_are_typed_errors() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn close_frees_the_local_port_at_once() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let high = HighLevel::open(options_to(sim.high_level_addr())).unwrap();
     let port = high.local_addr().port();
     assert!(high.wait_connected(WAIT).await);

@@ -257,8 +257,8 @@ fn capture_seeds() -> Seeds {
         .map(|(name, keep)| {
             let path = std::env::temp_dir().join(format!("robowire-fuzz-{name}-{}.mcap", std::process::id()));
             let recorder = robowire_record::Recorder::create(&path, "cargo xtask fuzz (seed)")?;
-            let high = recorder.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL);
-            let low = recorder.link("dog/low_level", &zsl_proto::description::LOW_LEVEL);
+            let high = recorder.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL);
+            let low = recorder.link("zsl1/low_level", &zsl_proto::description::LOW_LEVEL);
             for (i, (_, bytes)) in datagrams.iter().enumerate().filter(|(_, (_, d))| keep(d)) {
                 let tap = if low_level(bytes) { &low } else { &high };
                 let direction =

@@ -192,7 +192,7 @@ pub(crate) fn open(ip: std::net::IpAddr, model: Model, options: &OpenOptions) ->
     Ok(Box::new(HighLevel::open(client_options(client, model, options))?))
 }
 
-/// The client's options: the model, the watchdog, with a recorder its link `dog/high_level`.
+/// The client's options: the model, the watchdog, with a recorder its link `zsl1/high_level`.
 pub(crate) fn client_options(
     client: zsl::udp::ClientOptions,
     model: Model,
@@ -201,7 +201,7 @@ pub(crate) fn client_options(
     let watchdog = options.state_timeout.unwrap_or(client.watchdog);
     let client = client.with_model(model).with_watchdog(watchdog);
     match &options.record {
-        Some(record) => client.with_tap(record.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
+        Some(record) => client.with_tap(record.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL)),
         None => client,
     }
 }

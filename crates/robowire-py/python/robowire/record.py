@@ -4,7 +4,7 @@ Every client and simulator takes ``record=``: a path (the object records into a 
 and finishes it when it is closed) or a :class:`Recorder` (several devices into one file; close
 the recorder after them). Each link is written both ways as it was on the wire (raw, or CDR for
 DDS) and, beside it, as JSON with a JSON schema. Links are named as ``robowire … --record`` names
-them: ``kmc/serial`` (and ``kmc/serial_skipped``), ``dog/high_level``, ``dog/low_level``,
+them: ``kmc/serial`` (and ``kmc/serial_skipped``), ``zsl1/high_level``, ``zsl1/low_level``,
 ``go2/low_level``, ``go2/api``, ``hg/…``, ``spline/spline``, ``spline/imu``.
 
 >>> import os, tempfile

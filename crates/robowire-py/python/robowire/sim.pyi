@@ -7,7 +7,7 @@ from typing_extensions import Self
 
 from .record import Recorder
 
-__all__ = ["Dog", "Chassis", "Spline", "Go2", "G1", "loopback_has_multicast", "enter_loopback_namespace"]
+__all__ = ["Zsl1", "Chassis", "Spline", "Go2", "G1", "loopback_has_multicast", "enter_loopback_namespace"]
 
 class _Simulator:
     def close(self) -> None:
@@ -15,7 +15,7 @@ class _Simulator:
     def __enter__(self) -> Self: ...
     def __exit__(self, *exc: Any) -> None: ...
 
-class Dog(_Simulator):
+class Zsl1(_Simulator):
     """A ZSL-1 / ZSL-1W on UDP (HighLevel 43997, LowLevel 43900 by default)."""
     def __init__(
         self,
@@ -27,7 +27,7 @@ class Dog(_Simulator):
         state_period_s: float = 0.002,
         record: Union[str, PathLike[str], Recorder, None] = None,
     ) -> None:
-        """record: dog/high_level and dog/low_level, the robot's side."""
+        """record: zsl1/high_level and zsl1/low_level, the robot's side."""
     @property
     def ip(self) -> str: ...
     @property
@@ -41,6 +41,9 @@ class Dog(_Simulator):
     def clear_faults(self) -> None: ...
     def set_battery_percent(self, percent: float) -> None: ...
     def snapshot(self) -> Dict[str, Any]: ...
+
+Dog = Zsl1
+"""The old name of Zsl1, kept for one release (deprecated: a DeprecationWarning when used)."""
 
 class Chassis(_Simulator):
     """A KMC chassis behind a pseudo-terminal."""

@@ -15,13 +15,13 @@ Where robowire differs from the vendor's module it is safer:
 - ``MotorCommand`` fields are live views: ``cmd.q_des_knee[i] = x`` changes the command, and a
   whole field can be assigned (``cmd.kp_hip = [20.0] * 4``); numpy is not required.
 
-Against the simulator (:class:`robowire.sim.Dog`), the vendor's calls and return codes:
+Against the simulator (:class:`robowire.sim.Zsl1`), the vendor's calls and return codes:
 
 >>> import time
 >>> import robowire.sim, robowire.zsl1 as mc_sdk_zsl_1_py
->>> with robowire.sim.Dog(ip="127.0.0.5") as dog:
+>>> with robowire.sim.Zsl1(ip="127.0.0.5") as sim:
 ...     robot = mc_sdk_zsl_1_py.HighLevel()
-...     robot.initRobot("127.0.0.5", 43988, dog.ip)
+...     robot.initRobot("127.0.0.5", 43988, sim.ip)
 ...     robot.wait_connected(timeout_s=3.0)  # robowire's; the vendor's way polls checkConnect()
 ...     robot.standUp()
 ...     while robot.getCurrentCtrlmode() != 1:

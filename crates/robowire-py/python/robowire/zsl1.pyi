@@ -177,7 +177,7 @@ class _Session:
 class HighLevel(_Session):
     """The ZSL-1 HighLevel client (mc_sdk_zsl_1_py.HighLevel): the vendor's calls and codes."""
     def __init__(self, *, record: Union[str, PathLike[str], Recorder, None] = None) -> None:
-        """record (robowire's): dog/high_level into a path or a Recorder."""
+        """record (robowire's): zsl1/high_level into a path or a Recorder."""
     def initRobot(self, local_ip: str, local_port: int, dog_ip: str = "192.168.234.1") -> None:
         """Binds local_ip:local_port, streams to dog_ip:43997 every 2 ms; raises BindError."""
     def checkConnect(self) -> bool: ...
@@ -229,7 +229,7 @@ class HighLevel(_Session):
 class LowLevel(_Session):
     """The ZSL-1 LowLevel client (mc_sdk_zsl_1_py.LowLevel)."""
     def __init__(self, *, record: Union[str, PathLike[str], Recorder, None] = None) -> None:
-        """record (robowire's): dog/low_level into a path or a Recorder."""
+        """record (robowire's): zsl1/low_level into a path or a Recorder."""
     def initRobot(self, local_ip: str, local_port: int, dog_ip: str = "192.168.234.1") -> None:
         """Binds local_ip:local_port, streams to dog_ip:43900 every 2 ms; raises BindError."""
     def checkConnect(self) -> bool: ...

@@ -1,10 +1,10 @@
 //! `robowire.sim`: every simulator in-process, as a context manager, with its faults.
 
 mod chassis;
-mod dog;
 mod g1;
 mod go2;
 mod unitree;
+mod zsl1;
 
 pub(crate) use go2::topic;
 pub(crate) use spline::state_dict;
@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 /// Adds the classes to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    m.add("SimDog", py.get_type::<dog::Dog>())?;
+    m.add("SimZsl1", py.get_type::<zsl1::Zsl1>())?;
     m.add("SimChassis", py.get_type::<chassis::Chassis>())?;
     m.add("SimSpline", py.get_type::<spline::Spline>())?;
     m.add("SimGo2", py.get_type::<go2::Go2>())?;

@@ -29,7 +29,7 @@ macro_rules! high_level_class {
         #[pymethods]
         impl $class {
             /// Not connected until `initRobot`. `record` (not the vendor's): a path or a
-            /// `robowire.Recorder` to record every datagram both ways into (`dog/high_level`).
+            /// `robowire.Recorder` to record every datagram both ways into (`zsl1/high_level`).
             #[new]
             #[pyo3(signature = (*, record = None))]
             fn new(record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {

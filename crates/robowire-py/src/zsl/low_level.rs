@@ -25,7 +25,7 @@ pub(crate) struct Zsl1LowLevel {
 #[pymethods]
 impl Zsl1LowLevel {
     /// Not connected until `initRobot`. `record` (not the vendor's): a path or a
-    /// `robowire.Recorder` to record every datagram both ways into (`dog/low_level`).
+    /// `robowire.Recorder` to record every datagram both ways into (`zsl1/low_level`).
     #[new]
     #[pyo3(signature = (*, record = None))]
     fn new(record: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {

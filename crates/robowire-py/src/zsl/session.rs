@@ -63,10 +63,10 @@ facade!(
     facade::HighLevel,
     "HighLevel",
     ClientOptions::high_level,
-    "dog/high_level",
+    "zsl1/high_level",
     zsl_proto::description::HIGH_LEVEL
 );
-facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level, "dog/low_level", zsl_proto::description::LOW_LEVEL);
+facade!(facade::LowLevel, "LowLevel", ClientOptions::low_level, "zsl1/low_level", zsl_proto::description::LOW_LEVEL);
 
 /// A `ConnectError` as the exception a Python user expects; `what` says who failed.
 pub(crate) fn connect_error(what: &str, e: &ConnectError) -> PyErr {

@@ -24,7 +24,7 @@ pub(crate) struct DeviceArgs {
     #[arg(long, default_value_t = 5.0)]
     connect_timeout_s: f64,
     /// Record the device's links, both ways, named after the device (`kmc/serial`,
-    /// `dog/high_level`, `go2/low_level`, `g1/low_level`, `spline/spline`, …).
+    /// `zsl1/high_level`, `go2/low_level`, `g1/low_level`, `spline/spline`, …).
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
 }

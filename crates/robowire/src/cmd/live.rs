@@ -1,4 +1,4 @@
-//! What `dog watch` and `go2 watch` share: a state line ten times a second and the connection's
+//! What `zsl1 watch` and `go2 watch` share: a state line ten times a second and the connection's
 //! changes, until Ctrl-C.
 
 use std::time::Duration;

@@ -5,7 +5,6 @@ pub(crate) mod dds_args;
 pub(crate) mod decode;
 pub(crate) mod demo;
 pub(crate) mod device;
-pub(crate) mod dog;
 pub(crate) mod encode;
 pub(crate) mod g1;
 pub(crate) mod go2;
@@ -19,6 +18,7 @@ pub(crate) mod shm;
 pub(crate) mod sim;
 pub(crate) mod sim_body;
 pub(crate) mod unitree;
+pub(crate) mod zsl1;
 
 /// A duration argument in seconds, 0–3600.
 pub(crate) fn seconds(name: &str, value: f64) -> anyhow::Result<std::time::Duration> {

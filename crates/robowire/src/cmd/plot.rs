@@ -21,7 +21,7 @@ pub(crate) struct PlotArgs {
     /// The image to write: .svg or .png (one page per device, stacked).
     #[arg(long, value_name = "FILE.svg|FILE.png")]
     out: PathBuf,
-    /// Only this device (the first part of its links' names: kmc, dog, go2, spline, …).
+    /// Only this device (the first part of its links' names: kmc, zsl1, go2, spline, …).
     #[arg(long)]
     device: Option<String>,
     /// Seconds from the capture's first frame to start at.
@@ -84,11 +84,12 @@ pub(crate) fn plot_capture(file: &Path, out: &Path, selection: &Selection) -> an
     Ok(pages.into_iter().map(|p| p.title.split(' ').next().unwrap_or_default().to_string()).collect())
 }
 
-/// The frames of each device: the first part of their links' names.
+/// The frames of each device: the first part of their links' names, under the device's current
+/// name (an old capture's `dog/…` links are the `zsl1` device's).
 fn devices(frames: &[RecordedFrame]) -> BTreeMap<&str, Vec<&RecordedFrame>> {
     let mut devices: BTreeMap<&str, Vec<&RecordedFrame>> = BTreeMap::new();
     for frame in frames {
-        devices.entry(frame.link.split('/').next().unwrap_or_default()).or_default().push(frame);
+        devices.entry(crate::cmd::record::device_of(&frame.link)).or_default().push(frame);
     }
     devices
 }
@@ -101,7 +102,7 @@ pub(crate) fn pages(frames: &[RecordedFrame], capture: &str, selection: &Selecti
     let plots = link_plots();
     let mut pages = Vec::new();
     for (device, frames) in devices(frames) {
-        if selection.device.as_deref().is_some_and(|d| d != device) {
+        if selection.device.as_deref().is_some_and(|d| crate::cmd::record::current_device(d) != device) {
             continue;
         }
         let mut links: BTreeMap<&str, Vec<(f64, &RecordedFrame)>> = BTreeMap::new();

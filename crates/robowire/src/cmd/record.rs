@@ -22,6 +22,33 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
     .concat()
 }
 
+/// Devices whose links were recorded under another name: the ZSL-1's were `dog/…` until issue 34
+/// renamed them `zsl1/…`. A capture made then still reads (kept for one release, as the `dog`
+/// command alias): its links belong to the device's current name, and a link asked for under
+/// either name is found.
+const OLD_DEVICE_NAMES: [(&str, &str); 1] = [("dog", "zsl1")];
+
+/// A device's current name (`dog`: `zsl1`; any other name: itself).
+pub(crate) fn current_device(name: &str) -> &str {
+    OLD_DEVICE_NAMES.iter().find(|(old, _)| *old == name).map_or(name, |(_, new)| new)
+}
+
+/// The device a link belongs to: the first part of its name, under the device's current name
+/// (`zsl1/high_level` and an old capture's `dog/high_level`: `zsl1`).
+pub(crate) fn device_of(link: &str) -> &str {
+    current_device(link.split('/').next().unwrap_or_default())
+}
+
+/// Whether a capture's link `recorded` is the link `asked` for, under its current or old name
+/// (`dog/high_level` is `zsl1/high_level`).
+pub(crate) fn same_link(recorded: &str, asked: &str) -> bool {
+    fn current(link: &str) -> (&str, &str) {
+        let (device, rest) = link.split_once('/').unwrap_or((link, ""));
+        (current_device(device), rest)
+    }
+    recorded == asked || current(recorded) == current(asked)
+}
+
 /// `--record FILE.mcap`, for the commands that record.
 #[derive(Debug, Clone, Args)]
 pub(crate) struct RecordArgs {
@@ -268,5 +295,18 @@ mod tests {
                 && names.contains(&"unitree_go.low_level")
                 && names.contains(&"stream.skipped")
         );
+    }
+
+    #[test]
+    fn the_zsl1_links_of_an_old_capture_read_under_the_new_name() {
+        use super::{current_device, device_of, same_link};
+        assert_eq!(
+            [device_of("dog/high_level"), device_of("zsl1/high_level"), device_of("kmc/serial")],
+            ["zsl1", "zsl1", "kmc"]
+        );
+        assert_eq!([current_device("dog"), current_device("zsl1"), current_device("go2")], ["zsl1", "zsl1", "go2"]);
+        assert!(same_link("dog/high_level", "zsl1/high_level") && same_link("zsl1/low_level", "dog/low_level"));
+        assert!(same_link("kmc/serial", "kmc/serial"));
+        assert!(!same_link("dog/high_level", "zsl1/low_level") && !same_link("kmc/serial", "dog/serial"));
     }
 }

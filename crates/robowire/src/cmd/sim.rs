@@ -14,8 +14,10 @@ pub(crate) enum SimCommand {
     Kmc(KmcSimArgs),
     /// The ZSL-1 spline daemon: a 1 kHz loop on /spline_shm and /imu_shm with a PD joint model.
     Spline(SplineSimArgs),
-    /// A ZSL-1 / ZSL-1W dog on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
-    Dog(DogSimArgs),
+    /// A ZSL-1 / ZSL-1W on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
+    // `dog`: its old name, kept for one release (issue 34).
+    #[command(alias = "dog")]
+    Zsl1(Zsl1SimArgs),
     /// A Unitree Go2 on DDS (rt/lowcmd, rt/lowstate at 500 Hz, motion_switcher and sport), booted
     /// with its sport mode owning the motors, as Unitree's software expects; --physics: its body
     /// in MuJoCo (a build with the `mujoco` feature).
@@ -84,7 +86,7 @@ pub(crate) struct Go2SimArgs {
 }
 
 #[derive(Debug, Args)]
-pub(crate) struct DogSimArgs {
+pub(crate) struct Zsl1SimArgs {
     /// Address to listen on (both ports).
     #[arg(long, default_value = "127.0.0.1")]
     bind: std::net::IpAddr,
@@ -93,7 +95,7 @@ pub(crate) struct DogSimArgs {
     client: Option<std::net::SocketAddr>,
     /// Robot model.
     #[arg(long, value_enum, default_value = "zsl-1")]
-    model: crate::cmd::dog::ModelArg,
+    model: crate::cmd::zsl1::ModelArg,
     /// HighLevel port (0: any free port).
     #[arg(long, default_value_t = zsl_proto::udp::HIGH_LEVEL_PORT)]
     high_level_port: u16,
@@ -153,7 +155,7 @@ pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
     match command {
         SimCommand::Kmc(args) => run_kmc(&args),
         SimCommand::Spline(args) => run_spline(&args),
-        SimCommand::Dog(args) => run_dog(&args),
+        SimCommand::Zsl1(args) => run_zsl1(&args),
         SimCommand::Go2(args) => run_go2(&args),
         SimCommand::G1(args) => run_g1(&args),
     }
@@ -260,26 +262,26 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
-    use robowire_sim::dog::{DogSim, DogSimConfig};
+fn run_zsl1(args: &Zsl1SimArgs) -> anyhow::Result<ExitCode> {
+    use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
     use zsl_proto::description::{HIGH_LEVEL, LOW_LEVEL};
-    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire sim dog")?;
-    let config = DogSimConfig {
+    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire sim zsl1")?;
+    let config = Zsl1SimConfig {
         bind: args.bind,
         high_level_port: args.high_level_port,
         low_level_port: args.low_level_port,
         client: args.client,
         model: args.model.into(),
-        high_level_tap: recorder.as_ref().map(|r| r.link("dog/high_level", &HIGH_LEVEL)),
-        low_level_tap: recorder.as_ref().map(|r| r.link("dog/low_level", &LOW_LEVEL)),
-        ..DogSimConfig::default()
+        high_level_tap: recorder.as_ref().map(|r| r.link("zsl1/high_level", &HIGH_LEVEL)),
+        low_level_tap: recorder.as_ref().map(|r| r.link("zsl1/low_level", &LOW_LEVEL)),
+        ..Zsl1SimConfig::default()
     };
-    let sim = DogSim::spawn(config).context("starting the dog simulator")?;
+    let sim = Zsl1Sim::spawn(config).context("starting the ZSL-1 simulator")?;
     // The first line is the two addresses, alone, for scripts.
     println!("{} {}", sim.high_level_addr(), sim.low_level_addr());
     eprintln!(
-        "{:?} dog simulator: HighLevel on {}, LowLevel on {}, state at 500 Hz to {}. Try: robowire dog --dog-ip {} stand. Ctrl-C stops.",
-        sim.snapshot().dog.model(),
+        "{} simulator: HighLevel on {}, LowLevel on {}, state at 500 Hz to {}. Try: robowire zsl1 --dog-ip {} stand. Ctrl-C stops.",
+        if args.model == crate::cmd::zsl1::ModelArg::Zsl1W { "ZSL-1W" } else { "ZSL-1" },
         sim.high_level_addr(),
         sim.low_level_addr(),
         args.client.map_or("the address commands come from".to_string(), |c| c.to_string()),
@@ -287,13 +289,13 @@ fn run_dog(args: &DogSimArgs) -> anyhow::Result<ExitCode> {
     );
     until_ctrl_c(args.report_every_s, || {
         let s = sim.snapshot();
-        let [x, y, z] = s.dog.position_m();
+        let [x, y, z] = s.robot.position_m();
         eprintln!(
             "mode {:>2} {:?} | pos {x:+.2} {y:+.2} {z:+.2} m yaw {:+.2} rad | battery {:.1} % | HL cmds {} invalid {} states {} | LL cmds {} invalid {} states {}",
-            s.dog.mode().raw(),
-            s.dog.activity(),
-            s.dog.yaw_rad(),
-            s.dog.battery_percent(),
+            s.robot.mode().raw(),
+            s.robot.activity(),
+            s.robot.yaw_rad(),
+            s.robot.battery_percent(),
             s.high_level.commands,
             s.high_level.invalid,
             s.high_level.states_sent,

@@ -1,13 +1,13 @@
 //! `robowire demo`: every simulated device, driven through its client API, with checks that
 //! what was commanded was observed.
 
-mod dog;
 mod g1;
 mod kmc;
 mod lowcmd;
 mod progress;
 mod report;
 mod spline;
+mod zsl1;
 
 pub(crate) use progress::{Progress, Status};
 pub(crate) use report::{Check, DeviceReport, InjectedFault};
@@ -58,7 +58,7 @@ pub(crate) struct DemoArgs {
     /// Record every device's links, both ways, into this one MCAP file.
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
-    /// Draw the run: one PNG per device (DIR/kmc.png, DIR/dog.png, …), from its capture (the
+    /// Draw the run: one PNG per device (DIR/kmc.png, DIR/zsl1.png, …), from its capture (the
     /// --record file, else DIR/demo.mcap).
     #[arg(long, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
@@ -66,7 +66,7 @@ pub(crate) struct DemoArgs {
 
 /// One PNG per device of the run's capture into `dir`.
 fn draw(dir: &std::path::Path, capture: &std::path::Path, out: &Output) -> anyhow::Result<()> {
-    for device in ["kmc", "dog", "spline", "go2", "g1"] {
+    for device in ["kmc", "zsl1", "spline", "go2", "g1"] {
         let image = dir.join(format!("{device}.png"));
         let selection = crate::cmd::plot::Selection { device: Some(device.into()), ..Default::default() };
         // A device whose scenario did not run (--only) has nothing to draw.
@@ -82,12 +82,15 @@ enum Device {
     /// KMC wheeled chassis on a pseudo-terminal.
     Kmc,
     /// ZSL-1 on loopback UDP (the HighLevel client).
-    Dog,
+    // `dog`: its old name, kept for one release (issue 34).
+    #[value(alias = "dog")]
+    Zsl1,
     /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).
     Spline,
     /// A Unitree Go2 on DDS (simulated): sport mode release, stand-up, CRC faults on the wire.
-    #[value(alias = "go2")]
-    Lowcmd,
+    // `lowcmd`: its old name, kept for one release.
+    #[value(alias = "lowcmd")]
+    Go2,
     /// A Unitree G1 humanoid on DDS (simulated): rt/arm_sdk, release, zero posture, ankle swing
     /// in PR and AB mode, frames the robot ignores refused and counted.
     G1,
@@ -102,7 +105,7 @@ impl DemoArgs {
 
 impl Device {
     fn uses_dds(self) -> bool {
-        matches!(self, Self::Lowcmd | Self::G1)
+        matches!(self, Self::Go2 | Self::G1)
     }
 }
 
@@ -133,9 +136,9 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
     }
     let scenarios: [(Device, Scenario); 5] = [
         (Device::Kmc, kmc::run),
-        (Device::Dog, dog::run),
+        (Device::Zsl1, zsl1::run),
         (Device::Spline, spline::run),
-        (Device::Lowcmd, lowcmd::run),
+        (Device::Go2, lowcmd::run),
         (Device::G1, g1::run),
     ];
     if let Some(dir) = &args.plot {

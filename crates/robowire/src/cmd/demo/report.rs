@@ -245,9 +245,9 @@ mod tests {
 
     #[test]
     fn table_has_a_column_per_device_and_multi_line_cells() {
-        let text = table(&[report("kmc", true), report("dog", false)]);
+        let text = table(&[report("kmc", true), report("zsl1", false)]);
         let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[0].contains("kmc") && lines[0].contains("dog"), "{text}");
+        assert!(lines[0].contains("kmc") && lines[0].contains("zsl1"), "{text}");
         let result = lines.iter().find(|l| l.trim_start().starts_with("result")).unwrap();
         assert!(result.contains("ok 1/1 checks") && result.contains("FAIL 0/1 checks"), "{text}");
         let observed = lines.iter().position(|l| l.trim_start().starts_with("observed")).unwrap();
@@ -255,13 +255,13 @@ mod tests {
         assert!(text.contains("lateness 12/45/80") && text.contains("control 100.0 Hz"), "{text}");
         assert!(text.contains("-> MISSED: skipped 64"), "an undetected fault stands out: {text}");
         // Columns line up: every row's second cell starts where the header's does.
-        let column = lines[0].find("dog").unwrap();
+        let column = lines[0].find("zsl1").unwrap();
         assert!(result[column..].starts_with("FAIL"), "{text}");
     }
 
     #[test]
     fn json_carries_checks_and_per_device_figures() {
-        let value = json(&[report("kmc", true), report("dog", false)]);
+        let value = json(&[report("kmc", true), report("zsl1", false)]);
         assert_eq!(value["passed"], false);
         assert_eq!(value["failed"], 1);
         assert_eq!(value["checks"].as_array().unwrap().len(), 2);

@@ -33,6 +33,8 @@ use unitree_proto::{CdrEncoding, LowState, Message};
 use zsl_proto::description::{HIGH_LEVEL, IMU, LOW_LEVEL, SPLINE_CLIENT, SPLINE_DAEMON};
 use zsl_proto::udp::AnyDatagram;
 
+use crate::cmd::record::same_link;
+
 /// A device robowire plays the side of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Device {
@@ -154,9 +156,13 @@ fn pick<'f>(
         };
         return Ok((first.link.clone(), device, device_frames(&first.link, device)));
     };
-    let Some(protocol) = frames.iter().find(|f| f.link == link).map(|f| f.protocol.protocol()) else {
+    // The link by its name in the capture, else under its old or new name (an old capture's
+    // `dog/high_level` is `zsl1/high_level`).
+    let recorded = frames.iter().find(|f| f.link == link).or_else(|| frames.iter().find(|f| same_link(&f.link, link)));
+    let Some(recorded) = recorded else {
         bail!("no link {link:?}: {}", found(frames));
     };
+    let (link, protocol) = (recorded.link.as_str(), recorded.protocol.protocol());
     let Some(device) = Device::of(protocol) else {
         bail!("link {link} is {protocol}, which has no device side to play; --as-device plays {PLAYABLE}");
     };
@@ -237,5 +243,23 @@ mod tests {
             picked(Some("go2/low_level")).unwrap(),
             ("go2/low_level".into(), Device::Go2, vec![Direction::Sent])
         );
+    }
+
+    #[test]
+    fn a_link_of_an_old_capture_is_found_under_its_new_name() {
+        // Before issue 34 the ZSL-1's links were recorded as `dog/…`.
+        let state = robowire_sim::zsl1::Zsl1Model::new(zsl_proto::udp::Model::Zsl1).high_level_state().encode();
+        let command = zsl_proto::udp::HighLevelCommand::stand_up().encode(zsl_proto::udp::Model::Zsl1);
+        let frames = [
+            frame("dog/high_level", &HIGH_LEVEL, Direction::Sent, command.to_vec()),
+            frame("dog/high_level", &HIGH_LEVEL, Direction::Received, state.to_vec()),
+        ];
+        for asked in ["zsl1/high_level", "dog/high_level"] {
+            let (link, device, picked) = pick(&frames, Some(asked)).unwrap();
+            assert_eq!((link.as_str(), device, picked.len()), ("dog/high_level", Device::Zsl1, 1), "{asked}");
+            assert_eq!(picked[0].direction, Direction::Received);
+        }
+        let error = pick(&frames, Some("zsl1/low_level")).unwrap_err().to_string();
+        assert!(error.contains("no link \"zsl1/low_level\"") && error.contains("dog/high_level"), "{error}");
     }
 }

@@ -1,10 +1,11 @@
-//! `robowire.sim.Dog`: the ZSL-1 / ZSL-1W on its two UDP ports.
+//! `robowire.sim.Zsl1` (`robowire.sim.Dog`, its old name, kept one release): the ZSL-1 / ZSL-1W
+//! on its two UDP ports.
 
 use std::net::{IpAddr, SocketAddr};
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robowire_sim::dog::{Activity, DogFault, DogSim, DogSimConfig, PortStats};
+use robowire_sim::zsl1::{Activity, PortStats, Zsl1Fault, Zsl1Sim, Zsl1SimConfig};
 use zsl_proto::udp::{Model, ReturnCode};
 
 use crate::errors::{Kind, error};
@@ -19,13 +20,13 @@ use crate::stats::{dict, lateness};
 /// finds it; pick another `ip` in 127.0.0.0/8 to run several side by side.
 ///
 /// ```python
-/// with robowire.sim.Dog(ip="127.0.0.2") as dog:
+/// with robowire.sim.Zsl1(ip="127.0.0.2") as sim:
 ///     robot = robowire.zsl1.HighLevel()
-///     robot.initRobot("127.0.0.1", 43988, dog.ip)
+///     robot.initRobot("127.0.0.1", 43988, sim.ip)
 /// ```
 #[pyclass(module = "robowire.sim", frozen)]
-pub(crate) struct Dog {
-    sim: Owned<DogSim>,
+pub(crate) struct Zsl1 {
+    sim: Owned<Zsl1Sim>,
     ip: String,
     high_level: SocketAddr,
     low_level: SocketAddr,
@@ -71,11 +72,11 @@ fn port<'py>(py: Python<'py>, p: &PortStats) -> PyResult<Bound<'py, PyDict>> {
 }
 
 #[pymethods]
-impl Dog {
+impl Zsl1 {
     /// Binds both ports on `ip` and starts the robot lying down. `model` `"zsl1"` or `"zsl1w"`;
     /// port 0 picks a free one. Raises `BindError` if a port is taken. `record`: a path or a
-    /// `robowire.Recorder` to record both ports' datagrams into (`dog/high_level`,
-    /// `dog/low_level`).
+    /// `robowire.Recorder` to record both ports' datagrams into (`zsl1/high_level`,
+    /// `zsl1/low_level`).
     #[new]
     #[pyo3(signature = (model = "zsl1", *, ip = "127.0.0.1", high_level_port = 43997, low_level_port = 43900, state_period_s = 0.002, record = None))]
     fn new(
@@ -94,20 +95,20 @@ impl Dog {
             return Err(error(Kind::Argument, "state_period_s must be above 0"));
         }
         let model = self::model(model)?;
-        let (links, capture) = record_arg(record, "robowire.sim.Dog")?;
-        let config = DogSimConfig {
+        let (links, capture) = record_arg(record, "robowire.sim.Zsl1")?;
+        let config = Zsl1SimConfig {
             bind,
             high_level_port,
             low_level_port,
             model,
             state_period,
-            high_level_tap: links.as_ref().map(|r| r.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL)),
-            low_level_tap: links.as_ref().map(|r| r.link("dog/low_level", &zsl_proto::description::LOW_LEVEL)),
-            ..DogSimConfig::default()
+            high_level_tap: links.as_ref().map(|r| r.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL)),
+            low_level_tap: links.as_ref().map(|r| r.link("zsl1/low_level", &zsl_proto::description::LOW_LEVEL)),
+            ..Zsl1SimConfig::default()
         };
-        let sim = py.detach(|| DogSim::spawn(config)).map_err(|e| error(Kind::Bind, e))?;
+        let sim = py.detach(|| Zsl1Sim::spawn(config)).map_err(|e| error(Kind::Bind, e))?;
         let (high_level, low_level) = (sim.high_level_addr(), sim.low_level_addr());
-        Ok(Self { sim: Owned::new("dog simulator", sim), ip: bind.to_string(), high_level, low_level, capture })
+        Ok(Self { sim: Owned::new("ZSL-1 simulator", sim), ip: bind.to_string(), high_level, low_level, capture })
     }
 
     /// The IP both ports are bound on (the `dog_ip` of `initRobot`).
@@ -134,22 +135,22 @@ impl Dog {
         if code == 0 {
             return Err(error(Kind::Argument, "error word 0 is no fault; use clear_faults()"));
         }
-        self.sim.with(|s| s.inject(DogFault::ErrorWord(ReturnCode::from_raw(code))))
+        self.sim.with(|s| s.inject(Zsl1Fault::ErrorWord(ReturnCode::from_raw(code))))
     }
 
     /// Raise the "SDK mismatch" flag: a HighLevel client stops streaming for good.
     fn inject_sdk_mismatch(&self) -> PyResult<()> {
-        self.sim.with(|s| s.inject(DogFault::SdkMismatch))
+        self.sim.with(|s| s.inject(Zsl1Fault::SdkMismatch))
     }
 
     /// Send no state at all (the client's watchdog reports the robot lost after 3 s).
     fn inject_silence(&self) -> PyResult<()> {
-        self.sim.with(|s| s.inject(DogFault::Silence))
+        self.sim.with(|s| s.inject(Zsl1Fault::Silence))
     }
 
     /// Send 600-byte junk datagrams instead of state.
     fn inject_garbage(&self) -> PyResult<()> {
-        self.sim.with(|s| s.inject(DogFault::Garbage))
+        self.sim.with(|s| s.inject(Zsl1Fault::Garbage))
     }
 
     /// Clear every fault.
@@ -168,19 +169,19 @@ impl Dog {
     /// The robot and its ports now: mode, activity, pose, battery, faults, counters.
     fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.sim.with(|s| s.snapshot())?;
-        let dog = &s.dog;
-        let faults = dog.faults();
+        let robot = &s.robot;
+        let faults = robot.faults();
         Ok(dict!(py, {
-            "model" => if dog.model() == Model::Zsl1 { "zsl1" } else { "zsl1w" },
-            "mode" => dog.mode().raw(),
-            "activity" => activity(dog.activity()),
-            "position_m" => dog.position_m().to_vec(),
-            "yaw_rad" => dog.yaw_rad(),
-            "velocity_mps" => dog.velocity_mps().to_vec(),
-            "yaw_rate_radps" => dog.yaw_rate_radps(),
-            "distance_m" => dog.distance_m(),
-            "tricks_done" => dog.tricks_done(),
-            "battery_percent" => dog.battery_percent(),
+            "model" => if robot.model() == Model::Zsl1 { "zsl1" } else { "zsl1w" },
+            "mode" => robot.mode().raw(),
+            "activity" => activity(robot.activity()),
+            "position_m" => robot.position_m().to_vec(),
+            "yaw_rad" => robot.yaw_rad(),
+            "velocity_mps" => robot.velocity_mps().to_vec(),
+            "yaw_rate_radps" => robot.yaw_rate_radps(),
+            "distance_m" => robot.distance_m(),
+            "tricks_done" => robot.tricks_done(),
+            "battery_percent" => robot.battery_percent(),
             "faults" => dict!(py, {
                 "error_word" => faults.error_word.map(ReturnCode::raw),
                 "sdk_mismatch" => faults.sdk_mismatch,
@@ -197,8 +198,8 @@ impl Dog {
 
     fn __repr__(&self) -> String {
         let state = if self.sim.is_open() { "running" } else { "closed" };
-        format!("Dog(ip={:?}, high_level={}, low_level={}, {state})", self.ip, self.high_level, self.low_level)
+        format!("Zsl1(ip={:?}, high_level={}, low_level={}, {state})", self.ip, self.high_level, self.low_level)
     }
 }
 
-closeable!(Dog, sim, capture, "Stops the simulator and frees its ports, then finishes its own capture. Idempotent.");
+closeable!(Zsl1, sim, capture, "Stops the simulator and frees its ports, then finishes its own capture. Idempotent.");

@@ -1,11 +1,11 @@
-//! The dog simulator from the client end of the UDP transport, with the ZSL-1 client codec:
+//! The ZSL-1 simulator from the client end of the UDP transport, with the ZSL-1 client codec:
 //! strict state, answers at once to a changed command, injected faults seen on the wire.
 
 mod hammer;
 
 use std::time::{Duration, Instant};
 
-use robowire_sim::dog::{DogFault, DogSim, DogSimConfig};
+use robowire_sim::zsl1::{Zsl1Fault, Zsl1Sim, Zsl1SimConfig};
 use robowire_udp::{Peer, UdpError, UdpLink};
 use zsl_proto::codec::{ClientCodec, StateDecoding};
 use zsl_proto::udp::{ControlMode, DatagramError, HighLevelCommand, HighLevelState, Model, ReturnCode};
@@ -14,7 +14,7 @@ const WATCHDOG: Duration = Duration::from_secs(10);
 
 type Link = UdpLink<ClientCodec<HighLevelCommand, HighLevelState>>;
 
-async fn client(sim: &DogSim) -> Link {
+async fn client(sim: &Zsl1Sim) -> Link {
     let codec = ClientCodec::new(Model::Zsl1, StateDecoding::Strict);
     UdpLink::bind("127.0.0.1:0".parse().unwrap(), Peer::AnyPortOf(sim.high_level_addr()), codec).await.unwrap()
 }
@@ -30,12 +30,12 @@ async fn until(link: &mut Link, command: HighLevelCommand, accept: impl Fn(&High
             }
         }
     };
-    tokio::time::timeout(WATCHDOG, run).await.expect("the dog reached the state in time")
+    tokio::time::timeout(WATCHDOG, run).await.expect("the robot reached the state in time")
 }
 
 #[tokio::test]
 async fn stands_up_from_lying_with_strictly_decoded_state() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let mut link = client(&sim).await;
     let standing = until(&mut link, HighLevelCommand::stand_up(), |s| s.mode() == ControlMode::Stand).await;
     assert_eq!(standing.error(), None);
@@ -45,22 +45,22 @@ async fn stands_up_from_lying_with_strictly_decoded_state() {
     let stats = link.stats();
     assert_eq!((stats.decode_errors, stats.foreign_dropped), (0, 0));
     let snapshot = sim.snapshot();
-    assert_eq!(snapshot.high_level.invalid, 0, "every command decoded strictly by the dog");
-    assert_eq!(snapshot.high_level.client, link.local_addr().ok(), "the dog learned whom to answer");
+    assert_eq!(snapshot.high_level.invalid, 0, "every command decoded strictly by the robot");
+    assert_eq!(snapshot.high_level.client, link.local_addr().ok(), "the robot learned whom to answer");
 }
 
 #[tokio::test]
 async fn faults_show_on_the_wire() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let mut link = client(&sim).await;
     until(&mut link, HighLevelCommand::default(), |_| true).await;
 
-    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+    sim.inject(Zsl1Fault::ErrorWord(ReturnCode::MotorFault));
     let faulted = until(&mut link, HighLevelCommand::default(), |s| s.error().is_some()).await;
     assert_eq!(faulted.error(), Some(ReturnCode::MotorFault));
     sim.clear_faults();
 
-    sim.inject(DogFault::Garbage);
+    sim.inject(Zsl1Fault::Garbage);
     let junk = async {
         loop {
             // States already on their way come first.
@@ -74,20 +74,20 @@ async fn faults_show_on_the_wire() {
     assert!(matches!(junk, UdpError::Decode(DatagramError::Length { expected: 560, found: 561 })), "{junk:?}");
     sim.clear_faults();
 
-    sim.inject(DogFault::Silence);
+    sim.inject(Zsl1Fault::Silence);
     // Drain what was already on its way, then nothing more arrives.
     while tokio::time::timeout(Duration::from_millis(50), link.recv()).await.is_ok() {}
-    assert!(tokio::time::timeout(Duration::from_millis(100), link.recv()).await.is_err(), "a silent dog");
+    assert!(tokio::time::timeout(Duration::from_millis(100), link.recv()).await.is_err(), "a silent robot");
     sim.clear_faults();
     until(&mut link, HighLevelCommand::default(), |_| true).await;
 }
 
 #[test]
 fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
-    let sim = DogSim::spawn(DogSimConfig::loopback()).unwrap();
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
     let api = || {
         let _ = sim.snapshot();
-        sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+        sim.inject(Zsl1Fault::ErrorWord(ReturnCode::MotorFault));
         sim.set_battery_percent(50.0);
         sim.clear_faults();
     };
@@ -98,7 +98,7 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
             let mut link = client(&sim).await;
             let start = Instant::now();
             loop {
-                // A command now and then: the dog streams to whoever commands it.
+                // A command now and then: the robot streams to whoever commands it.
                 link.send(&HighLevelCommand::default()).await.unwrap();
                 let _ = tokio::time::timeout(Duration::from_millis(20), link.recv()).await;
                 let now = sim.snapshot();
@@ -112,7 +112,25 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
     let (ran, missed) = (after.cycles - before.cycles, after.missed_cycles - before.missed_cycles);
     assert!(missed < ran / 2, "{missed} ticks skipped while {ran} ran");
     // The hammer's last call was a clear, after the battery was set: both in force.
-    let last = sim.snapshot().dog;
+    let last = sim.snapshot().robot;
     assert_eq!(last.faults(), Default::default());
     assert_eq!(last.battery_percent().ceil(), 50.0);
+}
+
+/// The module's old name and its `Dog*` types, kept as deprecated aliases for one release
+/// (issue 34): code written against them still builds and drives the same simulator.
+#[tokio::test]
+#[allow(deprecated)]
+async fn the_old_dog_names_still_work() {
+    use robowire_sim::dog::{DogFault, DogModel, DogSim, DogSimConfig, DogSnapshot};
+    let sim: DogSim = DogSim::spawn(DogSimConfig { model: Model::Zsl1, ..DogSimConfig::loopback() }).unwrap();
+    let _: &Zsl1Sim = &sim;
+    let mut link = client(&sim).await;
+    until(&mut link, HighLevelCommand::default(), |_| true).await;
+    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+    let faulted = until(&mut link, HighLevelCommand::default(), |s| s.error().is_some()).await;
+    assert_eq!(faulted.error(), Some(ReturnCode::MotorFault));
+    let snapshot: DogSnapshot = sim.snapshot();
+    let robot: DogModel = snapshot.robot;
+    assert_eq!(robot.faults().error_word, Some(ReturnCode::MotorFault));
 }

@@ -1,4 +1,5 @@
-//! `robowire dog …`: drive a ZSL-1 / ZSL-1W over UDP through the HighLevel client.
+//! `robowire zsl1 …` (alias `robowire dog`, its old name, kept one release): drive a ZSL-1 /
+//! ZSL-1W over UDP through the HighLevel client.
 
 use std::net::{IpAddr, SocketAddr};
 use std::process::ExitCode;
@@ -31,7 +32,7 @@ impl From<ModelArg> for Model {
 }
 
 #[derive(Debug, Args)]
-pub(crate) struct DogArgs {
+pub(crate) struct Zsl1Args {
     /// The robot's IP address.
     #[arg(long, default_value = "192.168.234.1")]
     dog_ip: IpAddr,
@@ -57,11 +58,11 @@ pub(crate) struct DogArgs {
     #[arg(long, value_name = "FILE.mcap")]
     record: Option<std::path::PathBuf>,
     #[command(subcommand)]
-    command: DogCommand,
+    command: Zsl1Command,
 }
 
 #[derive(Debug, Subcommand)]
-enum DogCommand {
+enum Zsl1Command {
     /// Stand up (mode 1).
     Stand,
     /// Lie down, joints locked (mode 51).
@@ -124,7 +125,7 @@ enum DogCommand {
     Watch,
 }
 
-pub(crate) fn run(args: DogArgs) -> anyhow::Result<ExitCode> {
+pub(crate) fn run(args: Zsl1Args) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
         args.connect_timeout_s.is_finite() && args.connect_timeout_s > 0.0,
         "--connect-timeout-s must be positive"
@@ -133,7 +134,7 @@ pub(crate) fn run(args: DogArgs) -> anyhow::Result<ExitCode> {
     runtime.block_on(run_async(args))
 }
 
-fn options(args: &DogArgs) -> ClientOptions {
+fn options(args: &Zsl1Args) -> ClientOptions {
     let options = ClientOptions::high_level(args.local_ip, args.local_port, args.dog_ip).with_model(args.model.into());
     let options = if args.strict { options.with_state_decoding(StateDecoding::Strict) } else { options };
     ClientOptions { dog: SocketAddr::new(args.dog_ip, args.dog_port), ..options }
@@ -141,11 +142,11 @@ fn options(args: &DogArgs) -> ClientOptions {
 
 use crate::cmd::seconds as duration;
 
-async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
-    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire dog")?;
+async fn run_async(args: Zsl1Args) -> anyhow::Result<ExitCode> {
+    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire zsl1")?;
     let mut options = options(&args);
     if let Some(recorder) = &recorder {
-        options = options.with_tap(recorder.link("dog/high_level", &zsl_proto::description::HIGH_LEVEL));
+        options = options.with_tap(recorder.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL));
     }
     let dog = HighLevel::open(options).context("starting the HighLevel client")?;
     let timeout = Duration::from_secs_f64(args.connect_timeout_s);
@@ -159,10 +160,10 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let outcome = match args.command {
-        DogCommand::Stand => call(&dog, "stand_up", dog.stand_up(), Some(ControlMode::Stand)).await,
-        DogCommand::Lie => call(&dog, "lie_down", dog.lie_down(), Some(ControlMode::LieDown)).await,
-        DogCommand::Passive => call(&dog, "passive", dog.passive(), Some(ControlMode::Passive)).await,
-        DogCommand::Move { vx_mps, vy_mps, yaw_rate_radps, duration: seconds } => {
+        Zsl1Command::Stand => call(&dog, "stand_up", dog.stand_up(), Some(ControlMode::Stand)).await,
+        Zsl1Command::Lie => call(&dog, "lie_down", dog.lie_down(), Some(ControlMode::LieDown)).await,
+        Zsl1Command::Passive => call(&dog, "passive", dog.passive(), Some(ControlMode::Passive)).await,
+        Zsl1Command::Move { vx_mps, vy_mps, yaw_rate_radps, duration: seconds } => {
             let walk = duration("--duration", seconds)?;
             let start = dog.position();
             let result = dog.move_velocity(vx_mps, vy_mps, yaw_rate_radps);
@@ -181,16 +182,16 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             }
             ok
         }
-        DogCommand::Jump => trick(&dog, "jump", dog.jump()).await,
-        DogCommand::FrontJump => trick(&dog, "front_jump", dog.front_jump()).await,
-        DogCommand::Backflip => trick(&dog, "backflip", dog.backflip()).await,
-        DogCommand::ShakeHand => trick(&dog, "shake_hand", dog.shake_hand()).await,
-        DogCommand::TwoLegStand { vx_mps, yaw_rate_radps } => {
+        Zsl1Command::Jump => trick(&dog, "jump", dog.jump()).await,
+        Zsl1Command::FrontJump => trick(&dog, "front_jump", dog.front_jump()).await,
+        Zsl1Command::Backflip => trick(&dog, "backflip", dog.backflip()).await,
+        Zsl1Command::ShakeHand => trick(&dog, "shake_hand", dog.shake_hand()).await,
+        Zsl1Command::TwoLegStand { vx_mps, yaw_rate_radps } => {
             let result = dog.two_leg_stand(vx_mps, yaw_rate_radps);
             call(&dog, "two_leg_stand", result, Some(ControlMode::Action)).await
         }
-        DogCommand::CancelTwoLegStand => call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand(), None).await,
-        DogCommand::Attitude { roll_radps, pitch_radps, yaw_radps, height_mps, duration: seconds } => {
+        Zsl1Command::CancelTwoLegStand => call(&dog, "cancel_two_leg_stand", dog.cancel_two_leg_stand(), None).await,
+        Zsl1Command::Attitude { roll_radps, pitch_radps, yaw_radps, height_mps, duration: seconds } => {
             let hold = duration("--duration", seconds)?;
             let result = dog.attitude_control(roll_radps, pitch_radps, yaw_radps, height_mps);
             let ok = call(&dog, "attitude_control", result, Some(ControlMode::Action)).await;
@@ -201,7 +202,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             }
             ok
         }
-        DogCommand::Status { json } => {
+        Zsl1Command::Status { json } => {
             let missing = "the connection dropped before a state arrived";
             if json {
                 // The datagram's JSON, as `robowire decode zsl --json` prints it.
@@ -211,7 +212,7 @@ async fn run_async(args: DogArgs) -> anyhow::Result<ExitCode> {
             }
             true
         }
-        DogCommand::Watch => {
+        Zsl1Command::Watch => {
             crate::cmd::live::watch_until_ctrl_c(dog.connection_events(), || dog.status_line()).await?;
             true
         }

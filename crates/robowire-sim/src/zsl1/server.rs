@@ -1,7 +1,7 @@
-//! [`DogSim`]: the [`DogModel`] on the two UDP ports of the ZSL-1, through `robowire-udp`'s
-//! device side and the ZSL-1 dog codecs, so that the transport is exercised from both ends.
+//! [`Zsl1Sim`]: the [`Zsl1Model`] on the two UDP ports of the ZSL-1, through `robowire-udp`'s
+//! device side and the ZSL-1 codecs, so that the transport is exercised from both ends.
 //!
-//! The dog lives on its state stream (robowire's runner): it sends state to each client every
+//! The robot lives on its state stream (robowire's runner): it sends state to each client every
 //! `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted) and
 //! answers a command that changes something at once. A thread runs a small tokio runtime that
 //! receives commands on both ports and hands them over in a lock-free queue, waking the stream
@@ -27,13 +27,13 @@ use tokio::sync::watch;
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
 use zsl_proto::udp::{HIGH_LEVEL_PORT, HighLevelCommand, LOW_LEVEL_PORT, LowLevelCommand, Model};
 
-use super::model::{DogFault, DogModel, Faults};
+use super::model::{Faults, Zsl1Fault, Zsl1Model};
 use crate::handover::{Published, Requests, StreamStats};
 use stream::{Receive, StateStream};
 
 /// Simulator settings.
 #[derive(Debug, Clone, PartialEq)]
-pub struct DogSimConfig {
+pub struct Zsl1SimConfig {
     /// Address to bind both ports on. Default 127.0.0.1.
     pub bind: IpAddr,
     /// HighLevel port (default 43997; 0 picks a free one).
@@ -54,7 +54,7 @@ pub struct DogSimConfig {
     pub low_level_tap: Option<robowire_tap::Tap>,
 }
 
-impl Default for DogSimConfig {
+impl Default for Zsl1SimConfig {
     fn default() -> Self {
         Self {
             bind: Ipv4Addr::LOCALHOST.into(),
@@ -70,7 +70,7 @@ impl Default for DogSimConfig {
     }
 }
 
-impl DogSimConfig {
+impl Zsl1SimConfig {
     /// On 127.0.0.1 with free ports (tests, demos): several can run at once.
     pub fn loopback() -> Self {
         Self { high_level_port: 0, low_level_port: 0, ..Self::default() }
@@ -100,9 +100,9 @@ pub struct PortStats {
 
 /// What the simulator has seen and done.
 #[derive(Debug, Clone)]
-pub struct DogSnapshot {
+pub struct Zsl1Snapshot {
     /// The robot.
-    pub dog: DogModel,
+    pub robot: Zsl1Model,
     /// HighLevel port.
     pub high_level: PortStats,
     /// LowLevel port.
@@ -129,7 +129,7 @@ enum Command {
 /// What the API asks of the state stream.
 #[derive(Debug, Clone, Copy)]
 enum Request {
-    Inject(DogFault),
+    Inject(Zsl1Fault),
     ClearFaults,
     SetBatteryPercent(f32),
 }
@@ -163,7 +163,7 @@ impl PortCounters {
 /// What the state stream publishes: the robot and whom each port answers.
 #[derive(Debug, Clone)]
 struct View {
-    dog: DogModel,
+    robot: Zsl1Model,
     high_level_client: Option<SocketAddr>,
     low_level_client: Option<SocketAddr>,
 }
@@ -172,7 +172,7 @@ struct View {
 /// stream takes.
 #[derive(Debug)]
 struct Handover {
-    /// Commands in arrival order: each may change what the dog does.
+    /// Commands in arrival order: each may change what the robot does.
     commands: ArrayQueue<Command>,
     requests: Requests<Request>,
     view: Published<View>,
@@ -207,8 +207,8 @@ fn send_state<C: DatagramCodec>(
     }
 }
 
-/// The dog on two UDP ports, on its own threads; stopped on drop.
-pub struct DogSim {
+/// The robot on two UDP ports, on its own threads; stopped on drop.
+pub struct Zsl1Sim {
     handover: Arc<Handover>,
     stream: Option<Runner<StateStream>>,
     waker: Waker,
@@ -218,9 +218,9 @@ pub struct DogSim {
     low_level_addr: SocketAddr,
 }
 
-impl std::fmt::Debug for DogSim {
+impl std::fmt::Debug for Zsl1Sim {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("DogSim")
+        f.debug_struct("Zsl1Sim")
             .field("high_level", &self.high_level_addr)
             .field("low_level", &self.low_level_addr)
             .finish_non_exhaustive()
@@ -231,14 +231,14 @@ type Senders = (UdpSender<HighLevelDogCodec>, UdpSender<LowLevelDogCodec>);
 type Receivers = (UdpReceiver<HighLevelDogCodec>, UdpReceiver<LowLevelDogCodec>);
 
 /// Binds both ports inside `runtime`.
-fn bind(runtime: &tokio::runtime::Runtime, config: &DogSimConfig) -> io::Result<(Senders, Receivers)> {
+fn bind(runtime: &tokio::runtime::Runtime, config: &Zsl1SimConfig) -> io::Result<(Senders, Receivers)> {
     let reply = Peer::Any { reply_to: config.client };
     let bind_error = |port: u16, e: UdpError<zsl_proto::udp::DatagramError>| {
         let kind = match &e {
             UdpError::Bind { source, .. } => source.kind(),
             _ => io::ErrorKind::Other,
         };
-        io::Error::new(kind, format!("dog simulator cannot bind {}:{port}: {}", config.bind, error_chain(&e)))
+        io::Error::new(kind, format!("ZSL-1 simulator cannot bind {}:{port}: {}", config.bind, error_chain(&e)))
     };
     runtime.block_on(async {
         let mut high =
@@ -267,22 +267,22 @@ fn error_chain(e: &dyn std::error::Error) -> String {
     text
 }
 
-impl DogSim {
+impl Zsl1Sim {
     /// Binds both ports and starts the robot lying down.
-    pub fn spawn(config: DogSimConfig) -> io::Result<Self> {
+    pub fn spawn(config: Zsl1SimConfig) -> io::Result<Self> {
         let (started_tx, started) = std::sync::mpsc::sync_channel(1);
         let (waker_tx, waker_rx) = std::sync::mpsc::sync_channel::<Waker>(1);
         let (stop_receiving, mut stop_rx) = watch::channel(false);
-        let dog = DogModel::new(config.model);
+        let robot = Zsl1Model::new(config.model);
         let handover = Arc::new(Handover {
             commands: ArrayQueue::new(COMMANDS),
             requests: Requests::new(REQUESTS),
-            view: Published::new(&View { dog: dog.clone(), high_level_client: None, low_level_client: None }),
+            view: Published::new(&View { robot: robot.clone(), high_level_client: None, low_level_client: None }),
             stream: StreamStats::default(),
             high_level: PortCounters::default(),
             low_level: PortCounters::default(),
         });
-        let receiver = std::thread::Builder::new().name("dog-sim-rx".into()).spawn({
+        let receiver = std::thread::Builder::new().name("zsl1-sim-rx".into()).spawn({
             let (config, handover) = (config.clone(), handover.clone());
             move || {
                 let setup = || -> io::Result<_> {
@@ -308,10 +308,10 @@ impl DogSim {
                 runtime.block_on(receive.run(high, low, &mut stop_rx));
             }
         })?;
-        let (high, low) = started.recv().map_err(|_| io::Error::other("the dog simulator thread died"))??;
+        let (high, low) = started.recv().map_err(|_| io::Error::other("the ZSL-1 simulator thread died"))??;
         let (high_level_addr, low_level_addr) = (high.local_addr()?, low.local_addr()?);
         let job = StateStream {
-            dog,
+            robot,
             high,
             low,
             handover: handover.clone(),
@@ -319,7 +319,7 @@ impl DogSim {
             last_step: None,
         };
         let placement = robowire_rt::Placement { cpu: config.cpu, ..Default::default() };
-        let stream = Runner::spawn(RunnerOptions::placed("dog-sim-state", placement), job)
+        let stream = Runner::spawn(RunnerOptions::placed("zsl1-sim-state", placement), job)
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
         let waker = stream.waker();
         let _ = waker_tx.send(waker.clone());
@@ -350,7 +350,7 @@ impl DogSim {
     }
 
     /// Injects a fault; in force when this returns.
-    pub fn inject(&self, fault: DogFault) {
+    pub fn inject(&self, fault: Zsl1Fault) {
         self.call(Request::Inject(fault));
     }
 
@@ -365,12 +365,12 @@ impl DogSim {
     }
 
     /// The robot and the counters now.
-    pub fn snapshot(&self) -> DogSnapshot {
+    pub fn snapshot(&self) -> Zsl1Snapshot {
         let h = &self.handover;
         let view = h.view.read();
         let stream = h.stream.summary();
-        DogSnapshot {
-            dog: view.dog,
+        Zsl1Snapshot {
+            robot: view.robot,
             high_level: h.high_level.stats(view.high_level_client),
             low_level: h.low_level.stats(view.low_level_client),
             cycles: stream.cycles,
@@ -380,7 +380,7 @@ impl DogSim {
     }
 }
 
-impl Drop for DogSim {
+impl Drop for Zsl1Sim {
     fn drop(&mut self) {
         if let Some(stream) = self.stream.take() {
             stream.stop();

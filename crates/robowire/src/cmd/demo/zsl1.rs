@@ -1,4 +1,4 @@
-//! The dog scenario: a ZSL-1 on loopback UDP driven through the HighLevel client the way a
+//! The ZSL-1 scenario: a ZSL-1 on loopback UDP driven through the HighLevel client the way a
 //! user's program would: stand, walk a square (closed loop on the reported position and
 //! heading), attitude, a trick, faults (error word, silence), lie down.
 
@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use robowire_devices::{OpenOptions, SimKind, Simulator};
-use robowire_sim::dog::{DogFault, DogSim, STANDING_HEIGHT_M};
+use robowire_sim::zsl1::{STANDING_HEIGHT_M, Zsl1Fault, Zsl1Sim};
 use zsl::udp::{Action, CallError, Connection, ControlMode, Device, HighLevel, Latched, ReturnCode};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
@@ -104,7 +104,7 @@ pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
 
 /// The live line, until the scenario ends.
 async fn show_progress(dog: &HighLevel, out: &Output) -> std::convert::Infallible {
-    let mut progress = Progress::new("dog", out);
+    let mut progress = Progress::new("zsl1", out);
     loop {
         tokio::time::sleep(Duration::from_millis(50)).await;
         if progress.due() {
@@ -121,14 +121,14 @@ async fn show_progress(dog: &HighLevel, out: &Output) -> std::convert::Infallibl
 }
 
 async fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
-    out.line(format_args!("== ZSL-1 high level (dog on loopback UDP, 500 Hz) =="));
+    out.line(format_args!("== ZSL-1 high level (simulator on loopback UDP, 500 Hz) =="));
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
     let watchdog = Duration::from_millis(500);
     let device = super::open_simulated(
         SimKind::Zsl1,
         &OpenOptions { state_timeout: Some(watchdog), record: record.cloned(), ..Default::default() },
     )?;
-    let (Some(Simulator::Dog(sim)), Some(dog)) = (device.simulator(), device.zsl()) else {
+    let (Some(Simulator::Zsl1(sim)), Some(dog)) = (device.simulator(), device.zsl()) else {
         anyhow::bail!("sim:zsl1 opened something other than a simulated ZSL-1");
     };
     out.line(format_args!("simulator HighLevel {} · client {}", sim.high_level_addr(), dog.local_addr()));
@@ -139,7 +139,7 @@ async fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
 }
 
 async fn steps(
-    sim: &DogSim,
+    sim: &Zsl1Sim,
     dog: &HighLevel,
     watchdog: Duration,
     duration_s: f64,
@@ -147,7 +147,7 @@ async fn steps(
 ) -> anyhow::Result<DeviceReport> {
     let started = Instant::now();
     let mut calls = Calls::default();
-    let mut report = DeviceReport::new("dog");
+    let mut report = DeviceReport::new("zsl1");
 
     let mut phase = Instant::now();
     let mut lap = move || {
@@ -156,8 +156,12 @@ async fn steps(
         format!("({seconds:.1} s)")
     };
     let connected = dog.wait_connected(WAIT).await;
-    report.checks.push(Check::new("dog: state arrives, client connects", connected, format!("{:?}", dog.connection())));
-    anyhow::ensure!(connected, "the dog simulator sends no state");
+    report.checks.push(Check::new(
+        "zsl1: state arrives, client connects",
+        connected,
+        format!("{:?}", dog.connection()),
+    ));
+    anyhow::ensure!(connected, "the ZSL-1 simulator sends no state");
 
     // Stand up.
     let stood = stand(dog, &mut calls, "stand_up").await?;
@@ -167,7 +171,7 @@ async fn steps(
         dog.control_mode().unwrap_or(ControlMode::Passive),
         lap()
     ));
-    report.checks.push(Check::new("dog: stands up (mode 1, standing height)", stood, format!("height {height:.2} m")));
+    report.checks.push(Check::new("zsl1: stands up (mode 1, standing height)", stood, format!("height {height:.2} m")));
     report.commanded.push("stand_up".into());
     report.observed.push(format!("standing, body {height:.2} m"));
     tokio::time::sleep(Duration::from_millis(200)).await;
@@ -186,7 +190,7 @@ async fn steps(
     let end = dog.position().context("no state")?;
     let closure_m = (end[0] - origin[0]).hypot(end[1] - origin[1]);
     let heading_error = wrap(dog.rpy().context("no state")?[2] - heading0).abs();
-    let walked = sim.snapshot().dog.distance_m();
+    let walked = sim.snapshot().robot.distance_m();
     out.line(format_args!(
         "  square   {side_m:.2} m sides: corners {} · back within {:.3} m, heading error {:.3} rad, walked {walked:.2} m {}",
         corners.iter().map(|(x, y)| format!("({x:+.2}, {y:+.2})")).collect::<Vec<_>>().join(" "),
@@ -195,7 +199,7 @@ async fn steps(
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: walks a square and returns to the start",
+        "zsl1: walks a square and returns to the start",
         closure_m < 0.05 && heading_error < 0.02 && walked > 3.5 * side_m,
         format!("closure {closure_m:.3} m, heading {heading_error:.3} rad, walked {walked:.2} m"),
     ));
@@ -218,7 +222,7 @@ async fn steps(
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: attitude rates roll the body and back",
+        "zsl1: attitude rates roll the body and back",
         result.is_ok() && result_back.is_ok() && rolled > 0.15 && back.abs() < 0.05,
         format!("roll {rolled:+.2} rad, then {back:+.2} rad"),
     ));
@@ -226,20 +230,20 @@ async fn steps(
     report.observed.push(format!("roll {rolled:+.2}, {back:+.2} rad"));
 
     // A trick: jump, back to standing.
-    let tricks_before = sim.snapshot().dog.tricks_done();
+    let tricks_before = sim.snapshot().robot.tricks_done();
     let result = dog.jump();
     calls.record("jump", &result);
     let airborne = dog.wait_for_state(WAIT, move |s| s.body.position_m[2] > STANDING_HEIGHT_M + 0.05).await.is_some();
     let landed =
         dog.wait_for_state(WAIT, move |s| (s.body.position_m[2] - STANDING_HEIGHT_M).abs() < 0.01).await.is_some();
     let action_cleared = dog.wire_command().action_code() == Action::None;
-    let tricks = sim.snapshot().dog.tricks_done() - tricks_before;
+    let tricks = sim.snapshot().robot.tricks_done() - tricks_before;
     out.line(format_args!(
         "  trick    jump -> airborne {airborne}, landed standing {landed}, action cleared after 6 datagrams {action_cleared} {}",
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: jumps and lands standing",
+        "zsl1: jumps and lands standing",
         result.is_ok() && airborne && landed && tricks == 1,
         format!("{tricks} trick done"),
     ));
@@ -247,7 +251,7 @@ async fn steps(
     report.observed.push(format!("{} and landed", if airborne { "airborne" } else { "not airborne" }));
 
     // Fault: a motor fault in the error word refuses calls with the robot's word.
-    sim.inject(DogFault::ErrorWord(ReturnCode::MotorFault));
+    sim.inject(Zsl1Fault::ErrorWord(ReturnCode::MotorFault));
     dog.wait_for_state(WAIT, move |s| s.body.error.is_some()).await;
     let refused = dog.stand_up();
     calls.record("stand_up during motor fault", &refused);
@@ -259,7 +263,7 @@ async fn steps(
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: motor fault reported as the call's return code",
+        "zsl1: motor fault reported as the call's return code",
         code == Some(ReturnCode::MotorFault),
         format!("{code:?}"),
     ));
@@ -274,7 +278,7 @@ async fn steps(
     dog.wait_for_state(WAIT, move |s| s.body.body_velocity_mps[0] > 0.35).await;
     let mut events = dog.connection_events();
     events.borrow_and_update();
-    sim.inject(DogFault::Silence);
+    sim.inject(Zsl1Fault::Silence);
     let silent_at = Instant::now();
     let lost = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Disconnected)).await.is_ok();
     let noticed = silent_at.elapsed();
@@ -283,17 +287,17 @@ async fn steps(
     let back = tokio::time::timeout(WAIT, events.wait_for(|c| *c == Connection::Connected)).await.is_ok();
     let stopped = settle(dog).await;
     out.line(format_args!(
-        "  fault    dog silent -> Disconnected after {:.0} ms, latched vx {latched_vx} m/s, reconnected {back}, dog stopped {stopped} {}",
+        "  fault    robot silent -> Disconnected after {:.0} ms, latched vx {latched_vx} m/s, reconnected {back}, robot stopped {stopped} {}",
         noticed.as_secs_f64() * 1e3,
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: silence noticed, walk stopped, reconnected",
+        "zsl1: silence noticed, walk stopped, reconnected",
         lost && latched_vx == 0.0 && back && stopped,
         format!("after {:.0} ms (watchdog {} ms)", noticed.as_secs_f64() * 1e3, watchdog.as_millis()),
     ));
     report.checks.push(Check::timing(
-        "dog: silence noticed within 500 ms of the watchdog",
+        "zsl1: silence noticed within 500 ms of the watchdog",
         noticed < watchdog + Duration::from_millis(500),
         format!("after {:.0} ms (watchdog {} ms)", noticed.as_secs_f64() * 1e3, watchdog.as_millis()),
     ));
@@ -319,7 +323,7 @@ async fn steps(
         lap()
     ));
     report.checks.push(Check::new(
-        "dog: lies down (mode 51, body low)",
+        "zsl1: lies down (mode 51, body low)",
         result.is_ok() && lying,
         format!("{:?}", dog.control_mode()),
     ));
@@ -328,39 +332,39 @@ async fn steps(
 
     let stats = dog.stats();
     let snapshot = sim.snapshot();
-    let [x, y, _] = snapshot.dog.position_m();
+    let [x, y, _] = snapshot.robot.position_m();
     out.line(format_args!(
         "  calls    {}",
         calls.0.iter().map(|(n, c)| format!("{n} 0x{c:04x}")).collect::<Vec<_>>().join(", ")
     ));
     out.line(format_args!(
         "  body     at ({x:+.2}, {y:+.2}) m, walked {:.2} m, battery {:.1} %, {} tricks",
-        snapshot.dog.distance_m(),
-        snapshot.dog.battery_percent(),
-        snapshot.dog.tricks_done()
+        snapshot.robot.distance_m(),
+        snapshot.robot.battery_percent(),
+        snapshot.robot.tricks_done()
     ));
     let seconds = started.elapsed().as_secs_f64();
     report.rates_hz =
         vec![("commands sent", stats.link.sent as f64 / seconds), ("states in", stats.states as f64 / seconds)];
     report.timings = vec![
         ("send lateness", stats.stream_lateness),
-        ("at dog |Δ-2ms|", snapshot.high_level.command_jitter),
-        ("dog send lateness", snapshot.state_lateness),
+        ("at sim |Δ-2ms|", snapshot.high_level.command_jitter),
+        ("sim send lateness", snapshot.state_lateness),
         ("state gap", stats.state_gap),
     ];
-    report.checks.push(Check::on_time("dog: client command stream", &stats.stream_lateness));
-    report.checks.push(Check::on_time("dog: simulator state stream", &snapshot.state_lateness));
+    report.checks.push(Check::on_time("zsl1: client command stream", &stats.stream_lateness));
+    report.checks.push(Check::on_time("zsl1: simulator state stream", &snapshot.state_lateness));
     report.counters = vec![
         ("states", stats.states),
         ("decode errors", stats.link.decode_errors),
         ("short states", stats.short_states),
         ("foreign dropped", stats.link.foreign_dropped),
         ("disconnects", stats.disconnects),
-        ("dog commands", snapshot.high_level.commands),
-        ("dog invalid", snapshot.high_level.invalid),
+        ("sim commands", snapshot.high_level.commands),
+        ("sim invalid", snapshot.high_level.invalid),
     ];
     report.checks.push(Check::new(
-        "dog: every command decoded strictly by the dog",
+        "zsl1: every command decoded strictly by the simulator",
         snapshot.high_level.invalid == 0 && snapshot.high_level.commands > 0,
         format!("{} commands, {} invalid", snapshot.high_level.commands, snapshot.high_level.invalid),
     ));

@@ -1,7 +1,7 @@
-//! The dog's two loops: the receive task (commands in, handed over in arrival order) and the
+//! The robot's two loops: the receive task (commands in, handed over in arrival order) and the
 //! state stream on robowire's runner (the model stepped, state out on absolute deadlines).
 
-use crate::dog::model::DogModel;
+use crate::zsl1::model::Zsl1Model;
 use robowire_core::schedule::{Periodic, Time};
 use robowire_rt::runner::{Job, Waker};
 use robowire_rt::stats::micros;
@@ -15,7 +15,7 @@ use super::{Command, Handover, PortCounters, Request, View, send_state};
 
 /// The receive task: counts and hands every valid command to the state stream in arrival order,
 /// and wakes the stream for one that differs from the port's previous command, so that a
-/// command that changes what the dog does is answered at once (the stream answers it before
+/// command that changes what the robot does is answered at once (the stream answers it before
 /// taking the next). A repeated command is taken at the next tick.
 pub(super) struct Receive<'a> {
     pub(super) handover: &'a Handover,
@@ -97,11 +97,11 @@ impl<T: PartialEq> Arrivals<T> {
     }
 }
 
-/// The state stream: owns the dog and the sending halves; applies the API's requests and the
-/// commands as they come, answers a command that changed something at once, and steps the dog
+/// The state stream: owns the robot and the sending halves; applies the API's requests and the
+/// commands as they come, answers a command that changed something at once, and steps the robot
 /// and sends state on each tick of the grid.
 pub(super) struct StateStream {
-    pub(super) dog: DogModel,
+    pub(super) robot: Zsl1Model,
     pub(super) high: UdpSender<HighLevelDogCodec>,
     pub(super) low: UdpSender<LowLevelDogCodec>,
     pub(super) handover: Arc<Handover>,
@@ -109,26 +109,26 @@ pub(super) struct StateStream {
     pub(super) last_step: Option<Time>,
 }
 
-/// Longest step of the model, s: after a stall the dog does not jump.
+/// Longest step of the model, s: after a stall the robot does not jump.
 const MAX_STEP_S: f32 = 0.05;
 
 impl StateStream {
     pub(super) fn publish(&self) {
         self.handover.view.publish(&View {
-            dog: self.dog.clone(),
+            robot: self.robot.clone(),
             high_level_client: self.high.destination(),
             low_level_client: self.low.destination(),
         });
     }
 
     pub(super) fn send_high_level(&mut self) {
-        let dog = &self.dog;
-        send_state(&mut self.high, &self.handover.high_level, dog.faults(), || dog.high_level_state());
+        let robot = &self.robot;
+        send_state(&mut self.high, &self.handover.high_level, robot.faults(), || robot.high_level_state());
     }
 
     pub(super) fn send_low_level(&mut self) {
-        let dog = &self.dog;
-        send_state(&mut self.low, &self.handover.low_level, dog.faults(), || dog.low_level_state());
+        let robot = &self.robot;
+        send_state(&mut self.low, &self.handover.low_level, robot.faults(), || robot.low_level_state());
     }
 }
 
@@ -142,22 +142,22 @@ impl Job for StateStream {
         let taken = self.handover.requests.take(|request| {
             requested = true;
             match request {
-                Request::Inject(fault) => self.dog.inject(fault),
-                Request::ClearFaults => self.dog.clear_faults(),
-                Request::SetBatteryPercent(percent) => self.dog.set_battery_percent(percent),
+                Request::Inject(fault) => self.robot.inject(fault),
+                Request::ClearFaults => self.robot.clear_faults(),
+                Request::SetBatteryPercent(percent) => self.robot.set_battery_percent(percent),
             }
         });
         while let Some(command) = self.handover.commands.pop() {
             match command {
                 Command::High(command, model) => {
-                    if self.dog.on_high_level(&command, model) {
+                    if self.robot.on_high_level(&command, model) {
                         // Published first: a client that got the answer sees its effect.
                         self.publish();
                         self.send_high_level();
                     }
                 }
                 Command::Low(command) => {
-                    if self.dog.on_low_level(&command) {
+                    if self.robot.on_low_level(&command) {
                         self.publish();
                         self.send_low_level();
                     }
@@ -167,7 +167,7 @@ impl Job for StateStream {
         if let Some(tick) = self.grid.poll(now) {
             let dt = self.last_step.replace(now).map_or(0.0, |last| now.saturating_duration_since(last).as_secs_f32());
             self.handover.stream.record(&tick, true);
-            self.dog.step(dt.min(MAX_STEP_S));
+            self.robot.step(dt.min(MAX_STEP_S));
             self.publish();
             self.send_high_level();
             self.send_low_level();

@@ -1,4 +1,4 @@
-//! The dog's body: velocity with a first-order lag, position and heading integrated from it,
+//! The robot's body: velocity with a first-order lag, position and heading integrated from it,
 //! attitude, height, and the twelve (sixteen on the ZSL-1W) joints through the shared PD model.
 
 use zsl_proto::udp::{Action, HighLevelCommand, LowLevelCommand, Model};
@@ -56,7 +56,7 @@ pub(crate) struct Drive<'a> {
     pub(crate) remaining_s: f32,
     /// The latched HighLevel command.
     pub(crate) command: &'a HighLevelCommand,
-    /// No HighLevel command for the dog's timeout: stop.
+    /// No HighLevel command for the robot's timeout: stop.
     pub(crate) stale: bool,
     /// LowLevel control, if active.
     pub(crate) low_level: Option<&'a LowLevelCommand>,

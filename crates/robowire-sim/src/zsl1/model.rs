@@ -1,12 +1,12 @@
 //! The robot, sans I/O: a state machine over the vendor's modes with timed transitions, the
 //! HighLevel and LowLevel commands it was given, battery drain and injectable faults, and the
-//! state datagrams it reports. The body that moves (trunk and joints) is stepped by the dog's
+//! state datagrams it reports. The body that moves (trunk and joints) is stepped by the robot's
 //! body module.
 //!
 //! The reported mode mirrors the commanded mode as soon as a command changes it (spec §11.4: the
 //! vendor's client counts a call as unacknowledged until it does); what the body does takes
 //! time: standing up [`STAND_UP_S`], lying down [`LIE_DOWN_S`], tricks [`JUMP_S`] to
-//! [`SHAKE_HAND_S`], after which the dog stands.
+//! [`SHAKE_HAND_S`], after which the robot stands.
 
 use zsl_proto::udp::{
     Action, ControlMode, HIGH_LEVEL_STATE_HEADER, HighLevelCommand, HighLevelState, LowLevelCommand, LowLevelState,
@@ -41,7 +41,7 @@ struct Drain {
 const DRAIN: Drain = Drain { lying: 0.005, standing: 0.01, walking: 0.02, walking_per_mps: 0.02, trick: 0.1 };
 /// A LowLevel command keeps the motors under LowLevel control this long, s.
 const LOW_LEVEL_HOLD_S: f32 = 0.1;
-/// Without a HighLevel command for this long the dog stops walking (it keeps its mode), s.
+/// Without a HighLevel command for this long the robot stops walking (it keeps its mode), s.
 pub const COMMAND_TIMEOUT_S: f32 = 0.5;
 
 /// What the body is doing (the mode says what was asked).
@@ -71,7 +71,7 @@ pub enum Activity {
 
 /// A fault the simulator can inject.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DogFault {
+pub enum Zsl1Fault {
     /// Report this error word at state 0x1F4 (e.g. 0x3011 motor fault).
     ErrorWord(ReturnCode),
     /// Raise the "SDK mismatch" flag (state 0x1F8 = 1).
@@ -97,7 +97,7 @@ pub struct Faults {
 
 /// The robot, sans I/O. Feed it commands and time; read its state datagrams.
 #[derive(Debug, Clone)]
-pub struct DogModel {
+pub struct Zsl1Model {
     model: Model,
     mode: ControlMode,
     activity: Activity,
@@ -113,8 +113,8 @@ pub struct DogModel {
     tricks_done: u32,
 }
 
-impl DogModel {
-    /// A dog of `model` lying on the floor with a full battery.
+impl Zsl1Model {
+    /// A robot of `model` lying on the floor with a full battery.
     pub fn new(model: Model) -> Self {
         Self {
             model,
@@ -193,12 +193,12 @@ impl DogModel {
     }
 
     /// Injects a fault.
-    pub fn inject(&mut self, fault: DogFault) {
+    pub fn inject(&mut self, fault: Zsl1Fault) {
         match fault {
-            DogFault::ErrorWord(word) => self.faults.error_word = Some(word),
-            DogFault::SdkMismatch => self.faults.sdk_mismatch = true,
-            DogFault::Silence => self.faults.silence = true,
-            DogFault::Garbage => self.faults.garbage = true,
+            Zsl1Fault::ErrorWord(word) => self.faults.error_word = Some(word),
+            Zsl1Fault::SdkMismatch => self.faults.sdk_mismatch = true,
+            Zsl1Fault::Silence => self.faults.silence = true,
+            Zsl1Fault::Garbage => self.faults.garbage = true,
         }
     }
 
@@ -215,10 +215,10 @@ impl DogModel {
     }
 
     /// A HighLevel command arrived (decoded strictly; `model` from its magic). Returns whether it
-    /// changed what the dog was told to do.
+    /// changed what the robot was told to do.
     ///
     /// The idle stream a client sends before its first call (mode 0, no action, flag 0) is no
-    /// request: the dog keeps doing what it did (robowire's reading of the flag word, which the
+    /// request: the robot keeps doing what it did (robowire's reading of the flag word, which the
     /// vendor sets to 1 on every call that asks for something).
     pub fn on_high_level(&mut self, command: &HighLevelCommand, model: Model) -> bool {
         if model != self.model {
