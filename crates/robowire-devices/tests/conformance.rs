@@ -23,7 +23,7 @@ use std::time::Duration;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_devices::{AnyDevice, Connection, DeviceAddress, Observation, OpenOptions, SimKind, Simulator, open};
 use robowire_fixtures::wait::{one_at_a_time, runtime_two_workers, until_async};
-use robowire_sim::dog::DogFault;
+use robowire_sim::zsl1::Zsl1Fault;
 use robowire_sim::g1::G1Fault;
 use robowire_sim::go2::Go2Fault;
 use robowire_sim::kmc::Fault as KmcFault;
@@ -285,8 +285,8 @@ fn set_silent(device: &AnyDevice, silent: bool) {
     match simulator(device) {
         Simulator::Kmc(sim) if silent => sim.inject(KmcFault::DropResponses { count: SILENT_ANSWERS }),
         Simulator::Kmc(_) => {}
-        Simulator::Dog(sim) if silent => sim.inject(DogFault::Silence),
-        Simulator::Dog(sim) => sim.clear_faults(),
+        Simulator::Zsl1(sim) if silent => sim.inject(Zsl1Fault::Silence),
+        Simulator::Zsl1(sim) => sim.clear_faults(),
         Simulator::Go2(sim) if silent => sim.inject(Go2Fault::Silence),
         Simulator::Go2(sim) => sim.clear_faults(),
         Simulator::G1(sim) if silent => sim.inject(G1Fault::Silence),
@@ -330,7 +330,7 @@ fn commander(device: &AnyDevice) -> Option<Box<dyn FnMut() -> bool + '_>> {
             let _ = device.drive(FORWARD_MPS, 0.0, 0.0);
             match sim {
                 Simulator::Kmc(sim) => sim.state().commanded_velocity_mps > 0.0,
-                Simulator::Dog(sim) => sim.snapshot().dog.velocity_mps()[0] > 0.0,
+                Simulator::Zsl1(sim) => sim.snapshot().robot.velocity_mps()[0] > 0.0,
                 other => panic!("a drivable simulator this suite does not know: {other:?}"),
             }
         }));
@@ -372,7 +372,7 @@ fn held(device: &AnyDevice) -> Held {
     let interface = || "lo".to_owned();
     match simulator(device) {
         Simulator::Kmc(sim) => Held::Address(DeviceAddress::Kmc(sim.path())),
-        Simulator::Dog(sim) => {
+        Simulator::Zsl1(sim) => {
             Held::Socket { local: device.zsl().unwrap().local_addr(), simulator: sim.high_level_addr() }
         }
         Simulator::Go2(_) => Held::Address(DeviceAddress::Go2(interface())),
