@@ -1,5 +1,6 @@
 //! One module per subcommand, as `robowire --help` lists them.
 
+pub(crate) mod captures;
 pub(crate) mod dds;
 pub(crate) mod dds_args;
 pub(crate) mod decode;

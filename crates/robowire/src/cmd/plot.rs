@@ -58,7 +58,7 @@ pub(crate) fn run(args: &PlotArgs) -> anyhow::Result<ExitCode> {
     let pages = plot_capture(&args.file, &args.out, &selection)?;
     if pages.is_empty() {
         let bytes = std::fs::read(&args.file)?;
-        let frames = robowire_record::read_frames(&bytes, &crate::cmd::record::descriptions())?;
+        let frames = robowire_record::read_frames(&bytes, &crate::cmd::captures::descriptions())?;
         let devices: Vec<&str> = devices(&frames).into_keys().collect();
         anyhow::bail!(
             "nothing to plot: the capture's devices are {devices:?}, and none has frames in the window asked for"
@@ -73,7 +73,7 @@ pub(crate) fn run(args: &PlotArgs) -> anyhow::Result<ExitCode> {
 /// Draws the capture at `file` into `out`; the devices drawn (none: nothing was written).
 pub(crate) fn plot_capture(file: &Path, out: &Path, selection: &Selection) -> anyhow::Result<Vec<String>> {
     let bytes = std::fs::read(file).with_context(|| format!("reading {}", file.display()))?;
-    let frames = robowire_record::read_frames(&bytes, &crate::cmd::record::descriptions())
+    let frames = robowire_record::read_frames(&bytes, &crate::cmd::captures::descriptions())
         .with_context(|| format!("{}", file.display()))?;
     let title = file.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let pages = pages(&frames, &title, selection);
@@ -89,7 +89,7 @@ pub(crate) fn plot_capture(file: &Path, out: &Path, selection: &Selection) -> an
 fn devices(frames: &[RecordedFrame]) -> BTreeMap<&str, Vec<&RecordedFrame>> {
     let mut devices: BTreeMap<&str, Vec<&RecordedFrame>> = BTreeMap::new();
     for frame in frames {
-        devices.entry(crate::cmd::record::device_of(&frame.link)).or_default().push(frame);
+        devices.entry(crate::cmd::captures::device_of(&frame.link)).or_default().push(frame);
     }
     devices
 }
@@ -102,7 +102,7 @@ pub(crate) fn pages(frames: &[RecordedFrame], capture: &str, selection: &Selecti
     let plots = link_plots();
     let mut pages = Vec::new();
     for (device, frames) in devices(frames) {
-        if selection.device.as_deref().is_some_and(|d| crate::cmd::record::current_device(d) != device) {
+        if selection.device.as_deref().is_some_and(|d| crate::cmd::captures::current_device(d) != device) {
             continue;
         }
         let mut links: BTreeMap<&str, Vec<(f64, &RecordedFrame)>> = BTreeMap::new();

@@ -33,7 +33,7 @@ use unitree_proto::{CdrEncoding, LowState, Message};
 use zsl_proto::description::{HIGH_LEVEL, IMU, LOW_LEVEL, SPLINE_CLIENT, SPLINE_DAEMON};
 use zsl_proto::udp::AnyDatagram;
 
-use crate::cmd::record::same_link;
+use crate::cmd::captures::same_link;
 
 /// A device robowire plays the side of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
