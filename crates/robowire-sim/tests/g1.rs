@@ -10,7 +10,7 @@ use std::time::Instant;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions, Reader, Writer};
-use robowire_sim::g1::{G1Fault, G1Sim, G1SimConfig, G1Snapshot, JOINTS, STAND_POSE_RAD};
+use robowire_sim::g1::{G1Fault, G1Sim, G1SimConfig, G1Snapshot, HOLDING_ACTIONS, JOINTS, STAND_POSE_RAD, SimClock};
 use unitree_proto::api::{self, g1_arm, g1_loco, motion_switcher, status};
 use unitree_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, ModePr, slot};
 use unitree_proto::{HgLowCmd, HgLowState, Message};
@@ -64,12 +64,17 @@ impl Client {
     /// code and data.
     fn call(&mut self, service: &str, api_id: i64, parameter: &str) -> (i32, String) {
         self.next_id += 1;
+        self.call_as(self.next_id, service, api_id, parameter)
+    }
+
+    /// As [`call`](Self::call), under `id` (the last call's: the request written again).
+    fn call_as(&mut self, id: i64, service: &str, api_id: i64, parameter: &str) -> (i32, String) {
         let client = match service {
             motion_switcher::SERVICE => &mut self.switcher,
             g1_loco::SERVICE => &mut self.loco,
             _ => &mut self.arm,
         };
-        let answer = self.runtime.block_on(client.call(self.next_id, api_id, parameter));
+        let answer = self.runtime.block_on(client.call(id, api_id, parameter));
         (answer.code, answer.data)
     }
 
@@ -333,5 +338,113 @@ fn a_23_dof_g1_reports_mode_machine_4_and_drives_only_its_joints() {
         let mut wrong = all;
         wrong.mode_machine = 5;
         c.drive_until(&sim, |c| c.lowcmd.write(wrong).unwrap(), |_, s| s.lowcmd.bad_mode_machine > 0);
+    });
+}
+
+#[test]
+fn a_mode_that_withstands_release_mode_is_named_until_it_lets_go() {
+    with_loopback_multicast(|| {
+        let sim = sim(G1Variant::Dof29);
+        let mut c = Client::new();
+        let switcher = motion_switcher::SERVICE;
+        let mode = |c: &mut Client| {
+            let (_, data) = c.call(switcher, motion_switcher::CHECK_MODE, "{}");
+            motion_switcher::mode_name(&data).unwrap().to_owned()
+        };
+        // The next two ReleaseModes are answered and let nothing go; the third does.
+        sim.inject(G1Fault::ModeHeld { releases: 2 });
+        for _ in 0..2 {
+            assert_eq!(c.call(switcher, motion_switcher::RELEASE_MODE, "{}").0, status::OK);
+            assert_eq!(mode(&mut c), "ai");
+        }
+        assert_eq!(sim.snapshot().mode, "ai");
+        assert_eq!(c.call(g1_loco::SERVICE, g1_loco::GET_FSM_ID, "{}").0, status::OK, "still the controller's");
+        c.release();
+        let log = sim.take_log().join("\n");
+        assert!(log.contains("fault injected: ModeHeld { releases: 2 }"), "{log}");
+        assert_eq!(log.matches("does not let go").count(), 2, "{log}");
+
+        // A ReleaseMode written again (its answer lost: the same id) is answered again, acted
+        // on once.
+        assert_eq!(c.call(switcher, motion_switcher::SELECT_MODE, r#"{"name":"ai"}"#).0, status::OK);
+        sim.inject(G1Fault::ModeHeld { releases: 1 });
+        let requests = sim.snapshot().stream.requests;
+        assert_eq!(c.call(switcher, motion_switcher::RELEASE_MODE, "{}").0, status::OK);
+        assert_eq!(c.call_as(c.next_id, switcher, motion_switcher::RELEASE_MODE, "{}").0, status::OK);
+        assert_eq!(sim.snapshot().stream.requests, requests + 1);
+        assert_eq!(mode(&mut c), "ai");
+        c.release();
+        // A client that does not number its calls (id 0, as Unitree's ROS 2 examples): each one
+        // is acted on.
+        let requests = sim.snapshot().stream.requests;
+        for _ in 0..2 {
+            assert_eq!(c.call_as(0, switcher, motion_switcher::CHECK_MODE, "{}").0, status::OK);
+        }
+        assert!(sim.snapshot().stream.requests >= requests + 2);
+
+        // Never: until the fault is cleared.
+        assert_eq!(c.call(switcher, motion_switcher::SELECT_MODE, r#"{"name":"ai"}"#).0, status::OK);
+        sim.inject(G1Fault::ModeHeld { releases: u32::MAX });
+        for _ in 0..12 {
+            assert_eq!(c.call(switcher, motion_switcher::RELEASE_MODE, "{}").0, status::OK);
+        }
+        assert_eq!(mode(&mut c), "ai");
+        sim.clear_faults();
+        c.release();
+        assert_eq!(sim.snapshot().mode, "");
+    });
+}
+
+#[test]
+fn arm_actions_wait_for_a_held_pose_and_for_rt_arm_sdk() {
+    with_loopback_multicast(|| {
+        // Lock-step: the arm_sdk weight stays where it is while the services are called.
+        let config = G1SimConfig {
+            participant: ParticipantOptions::new(0, Some("lo")),
+            clock: SimClock::LockStep,
+            ..G1SimConfig::new(G1Variant::Dof29)
+        };
+        let sim = G1Sim::spawn(config).expect("simulator");
+        let mut c = Client::new();
+        let (arm, execute) = (g1_arm::SERVICE, g1_arm::EXECUTE_ACTION);
+        let action = |c: &mut Client, id: i64| c.call(arm, execute, &format!(r#"{{"data":{id}}}"#)).0;
+        assert!(HOLDING_ACTIONS.contains(&19) && !HOLDING_ACTIONS.contains(&17));
+
+        // A hug holds its pose: only the release (99) or the hug again until then.
+        assert_eq!(action(&mut c, 19), status::OK);
+        assert_eq!(action(&mut c, 17), g1_arm::error::HOLDING);
+        assert_eq!(action(&mut c, 5), g1_arm::error::INVALID_ACTION_ID);
+        assert_eq!(action(&mut c, 19), status::OK);
+        assert_eq!(action(&mut c, 17), g1_arm::error::HOLDING);
+        assert_eq!(action(&mut c, g1_arm::RELEASE_ARM), status::OK);
+        assert_eq!(action(&mut c, 17), status::OK);
+        assert_eq!(action(&mut c, 26), status::OK, "a clap and a wave hold nothing");
+        // A held pose is let go with the motors.
+        assert_eq!(action(&mut c, 27), status::OK);
+        c.release();
+        assert_eq!(c.call(motion_switcher::SERVICE, motion_switcher::SELECT_MODE, r#"{"name":"ai"}"#).0, status::OK);
+        assert_eq!(action(&mut c, 17), status::OK);
+
+        // rt/arm_sdk blended in (its weight above 0): no action runs.
+        let with_weight = |weight: f32| {
+            let mut frame = HgLowCmd::default();
+            frame.motor_cmd[slot::ARM_SDK_WEIGHT].q = weight.into();
+            frame
+        };
+        let weighted = |c: &Client, weight: f32, done: fn(f32) -> bool| {
+            let start = Instant::now();
+            while !done(sim.snapshot().arm_sdk.weight) {
+                c.arm_sdk.write(with_weight(weight)).unwrap();
+                sim.advance(std::time::Duration::from_millis(2)).unwrap();
+                assert!(start.elapsed() < WAIT, "rt/arm_sdk at {weight} not taken: {:?}", sim.snapshot().arm_sdk);
+            }
+        };
+        weighted(&c, 0.2, |w| w == 0.2);
+        assert_eq!(action(&mut c, 17), g1_arm::error::ARM_SDK_OCCUPIED);
+        assert_eq!(action(&mut c, 5), g1_arm::error::ARM_SDK_OCCUPIED);
+        // At weight 0 the controller has the arms again.
+        weighted(&c, 0.0, |w| w == 0.0);
+        assert_eq!(action(&mut c, 17), status::OK);
+        assert!(sim.snapshot().arm_sdk.accepted > 0);
     });
 }

@@ -24,10 +24,11 @@ pub(crate) fn ros2_row(meta: &Value) -> anyhow::Result<Row> {
     })
 }
 
-/// Recording: the stream's send lateness with its link recorded and without, and the
-/// recorder's throughput.
-pub(crate) fn record_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
-    let n = |key: &str| meta[key].as_f64().with_context(|| format!("record meta {key}"));
+/// Recording: the streams' send lateness with their links recorded and without (`recorded`,
+/// the `robowire` crate's bench `recorded`), and the recorder's throughput (`meta`,
+/// `robowire-record`'s bench `record`).
+pub(crate) fn record_rows(recorded: &Value, meta: &Value) -> anyhow::Result<Vec<Row>> {
+    let n = |key: &str| recorded[key].as_f64().with_context(|| format!("recorded meta {key}"));
     let (p50, p99) = (n("lateness_recorded_p50_us")?, n("lateness_recorded_p99_us")?);
     let (b50, b99) = (n("lateness_plain_p50_us")?, n("lateness_plain_p99_us")?);
     let dropped = n("stream_frames_dropped")?;
@@ -40,9 +41,9 @@ pub(crate) fn record_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
             target: "–".into(),
             met: None,
         },
-        stream_row(&meta["kmc_stream"], "KMC Driver 0xA5 stream (100 Hz) send lateness, its serial link recorded")?,
+        stream_row(&recorded["kmc_stream"], "KMC Driver 0xA5 stream (100 Hz) send lateness, its serial link recorded")?,
         stream_row(
-            &meta["spline_stream"],
+            &recorded["spline_stream"],
             "spline daemon simulator (1 kHz) send lateness, its shared memory recorded",
         )?,
         throughput_row(&meta["unpaced_raw"], "Recorder capacity: 560-byte frames as fast as one thread taps, raw")?,
@@ -103,7 +104,7 @@ fn paced_row(run: &Value, path: &str) -> anyhow::Result<Row> {
 
 /// A stream recorded and not, alternating: its lateness each way.
 fn stream_row(run: &Value, path: &str) -> anyhow::Result<Row> {
-    let n = |key: &str| run[key].as_f64().with_context(|| format!("record meta {key}"));
+    let n = |key: &str| run[key].as_f64().with_context(|| format!("recorded meta {key}"));
     let (p99, b99) = (n("recorded_p99_us")?, n("plain_p99_us")?);
     Ok(Row {
         path: path.into(),
@@ -221,4 +222,35 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     }
     rows.extend(super::stalled_reader_rows(&meta["stalled_reader"])?);
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    #[test]
+    fn the_recording_rows_take_the_streams_from_one_bench_and_the_recorder_from_the_other() {
+        let stream =
+            json!({"plain_p50_us": 1, "plain_p99_us": 50, "recorded_p50_us": 2, "recorded_p99_us": 60, "dropped": 0});
+        let recorded = json!({
+            "lateness_plain_p50_us": 0, "lateness_plain_p99_us": 40, "lateness_recorded_p50_us": 0,
+            "lateness_recorded_p99_us": 45, "stream_frames_dropped": 0, "kmc_stream": stream, "spline_stream": stream,
+        });
+        let run = json!({
+            "offered": 100, "offered_per_s": 1e6, "written": 100, "written_per_s": 1e6, "mb_per_s": 560,
+            "dropped": 0, "json_skipped": 0,
+        });
+        let record = json!({
+            "unpaced_raw": run, "unpaced_json": run, "paced_1m_raw": run, "paced_1m_raw_64b": run,
+            "links_100_at_1khz": run, "links_100_at_1khz_zstd": run,
+        });
+        let rows = record_rows(&recorded, &record).unwrap();
+        assert_eq!(rows.len(), 9);
+        assert_eq!(rows[0].ratio, "p99 +5 µs");
+        assert_eq!(rows[1].ratio, "p99 +10 µs");
+        assert_eq!(rows[8].met, Some(true));
+        assert!(record_rows(&record, &recorded).is_err(), "the two benches' figures apart");
+    }
 }

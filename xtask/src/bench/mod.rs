@@ -31,6 +31,7 @@ pub(crate) const BENCHES: &[(&str, &str)] = &[
     ("robowire", "dds"),
     ("robowire-ros2", "cmd_vel"),
     ("robowire-record", "record"),
+    ("robowire", "recorded"),
 ];
 
 /// One row of the table.
@@ -75,6 +76,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let dds_meta_path = target.join("bench-meta-dds.json");
     let ros2_meta_path = target.join("bench-meta-ros2.json");
     let record_meta_path = target.join("bench-meta-record.json");
+    let recorded_meta_path = target.join("bench-meta-recorded.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -104,6 +106,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META_DDS", &dds_meta_path)
             .env("ROBOWIRE_BENCH_META_ROS2", &ros2_meta_path)
             .env("ROBOWIRE_BENCH_META_RECORD", &record_meta_path)
+            .env("ROBOWIRE_BENCH_META_RECORDED", &recorded_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -170,8 +173,11 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let ros2: Value = serde_json::from_str(&std::fs::read_to_string(&ros2_meta_path).context("ROS 2 bench metadata")?)?;
     rows.push(apps::ros2_row(&ros2)?);
     let record: Value =
-        serde_json::from_str(&std::fs::read_to_string(&record_meta_path).context("recording bench metadata")?)?;
-    rows.extend(apps::record_rows(&record)?);
+        serde_json::from_str(&std::fs::read_to_string(&record_meta_path).context("recorder bench metadata")?)?;
+    let recorded: Value = serde_json::from_str(
+        &std::fs::read_to_string(&recorded_meta_path).context("recorded streams bench metadata")?,
+    )?;
+    rows.extend(apps::record_rows(&recorded, &record)?);
     let physics: Option<Value> = match mujoco {
         Some(_) => {
             Some(serde_json::from_str(&std::fs::read_to_string(&physics_meta_path).context("physics bench metadata")?)?)

@@ -26,17 +26,22 @@
 //!   ([`battery`]).
 //! - Services on `rt/api/<service>/…`: `motion_switcher`, `sport` (the G1 loco API, Unitree's
 //!   `LocoClient`) and `arm` (the arm actions). After ReleaseMode the loco service answers
-//!   `LOCO_STATE_UNAVAILABLE` and arm actions `INVALID_FSM_ID` until SelectMode.
+//!   `LOCO_STATE_UNAVAILABLE` and arm actions `INVALID_FSM_ID` until SelectMode. Arm actions
+//!   run in FSM 500, 501 and 801 only (`INVALID_FSM_ID`), not while `rt/arm_sdk` is blended in
+//!   with a weight above 0 (`ARM_SDK_OCCUPIED`), and not while the arms hold an action's pose
+//!   (`HOLDING`, until the release action 99 or the held action again).
 //!
 //! robowire's choices where the robot's behaviour is not public: the controller's gains
 //! ([`CONTROLLER_GAINS`], unitree_rl_gym's); `rt/arm_sdk` frames are taken without a CRC check
 //! (Unitree's Python example seals them, its C++ one does not; a wrong CRC is counted as
 //! `unsealed`); a silent `rt/arm_sdk` (no frame for [`COMMAND_HOLD_S`]) keeps its last targets
 //! while its weight decays to 0 at `ARM_SDK_WEIGHT_RATE_PER_S` (0.5/s): the controller takes
-//! the arms back, never at a jump; the AB mapping is robowire's linearised model of the linkage
-//! (gains and torques of a pair act on its pitch and roll joints slot by slot); the motors'
-//! voltage is a constant [`SUPPLY_V`]; a failed motor reports `mode` 0 and `motorstate` 1; the
-//! state's `version` is 0. Faults: silence, a motor fault, bit flips on the wire.
+//! the arms back, never at a jump; which actions end holding their pose ([`HOLDING_ACTIONS`]);
+//! the AB mapping is robowire's linearised model of the linkage (gains and torques of a pair
+//! act on its pitch and roll joints slot by slot); the motors' voltage is a constant
+//! [`SUPPLY_V`]; a failed motor reports `mode` 0 and `motorstate` 1; the state's `version` is
+//! 0. Faults: silence, a motor fault, bit flips on the wire, a mode that withstands ReleaseMode
+//! ([`G1Fault::ModeHeld`]).
 //!
 //! Everything runs on `robowire-dds` (the transport), never on a facade. Create it inside a
 //! network namespace whose loopback has multicast when testing on one machine
@@ -64,6 +69,7 @@ pub use crate::unitree::{
     StreamCounters,
 };
 pub use model::{CONTROLLER_GAINS, G1Body, JOINTS, STAND_POSE_RAD, SUPPLY_V, has_disabled_motor};
+pub use services::HOLDING_ACTIONS;
 
 use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};
 

@@ -64,6 +64,12 @@ const ARM_ACTIONS: [(i64, &str); 16] = [
     (27, "shake hand"),
 ];
 
+/// The actions that end holding their pose: until the release action ([`g1_arm::RELEASE_ARM`],
+/// 99) or the same action again, every other action is refused with `HOLDING` (7401).
+/// robowire's choice, since which of the robot's actions hold is not public: the poses held
+/// out to someone (15 hands up, 19 hug, 20 heart, 21 right heart, 27 shake hand).
+pub const HOLDING_ACTIONS: [i64; 5] = [15, 19, 20, 21, 27];
+
 /// The loco service's settings (what its Get* calls answer).
 #[derive(Debug)]
 struct Loco {
@@ -85,6 +91,9 @@ struct Services {
     mode_machine_logged: bool,
     /// `rt/arm_sdk` after ReleaseMode was said (once per release).
     arm_sdk_logged: bool,
+    /// The action whose pose the arms hold ([`HOLDING_ACTIONS`]); forgotten when the
+    /// controller lets the motors go.
+    held_action: Option<i64>,
 }
 
 impl Services {
@@ -147,6 +156,14 @@ impl Services {
             self.arm_sdk_logged = false;
             self.set_fsm(g1_loco::fsm::START);
         }
+        if !owns {
+            self.held_action = None;
+        }
+    }
+
+    /// The weight `rt/arm_sdk` is blended in with, as the state stream last stepped the body.
+    fn arm_sdk_weight(&self) -> f32 {
+        self.handover.published.read().map_or(0.0, |(_, published)| published[super::JOINTS])
     }
 
     fn set_fsm(&mut self, id: i64) {
@@ -178,6 +195,7 @@ pub(super) async fn run(
         loco: loco_state,
         mode_machine_logged: false,
         arm_sdk_logged: false,
+        held_action: None,
     }));
     let answered = &handover.requests_answered;
     // Each LowCmd is taken on the participant's background thread as it arrives: no task to wake
@@ -345,13 +363,18 @@ fn answer_arm(s: &mut Services, request: &ApiRequest) -> (i32, String) {
             if !s.owner.owns() || !ARM_ACTION_FSMS.contains(&s.loco.fsm_id) {
                 return (g1_arm::error::INVALID_FSM_ID, String::new());
             }
-            match ARM_ACTIONS.iter().find(|(known, _)| *known == id) {
-                Some((_, name)) => {
-                    s.owner.say(format!("arm action {id} ({name})"));
-                    ok()
-                }
-                None => (g1_arm::error::INVALID_ACTION_ID, String::new()),
+            if s.arm_sdk_weight() > 0.0 {
+                return (g1_arm::error::ARM_SDK_OCCUPIED, String::new());
             }
+            let Some((_, name)) = ARM_ACTIONS.iter().find(|(known, _)| *known == id) else {
+                return (g1_arm::error::INVALID_ACTION_ID, String::new());
+            };
+            if s.held_action.is_some_and(|held| id != held && id != g1_arm::RELEASE_ARM) {
+                return (g1_arm::error::HOLDING, String::new());
+            }
+            s.held_action = HOLDING_ACTIONS.contains(&id).then_some(id);
+            s.owner.say(format!("arm action {id} ({name})"));
+            ok()
         }
         _ => (status::SERVER_API_NOT_IMPLEMENTED, String::new()),
     }

@@ -5,7 +5,8 @@
 //! `motion_switcher` and `sport` services answer on `rt/api/*`; `rt/lowstate` goes out at
 //! 500 Hz on robowire's runner with a correct CRC; LowCmds with a bad CRC or a wrong head are
 //! dropped and counted; the 12 joints follow accepted LowCmds through the shared PD joint model
-//! ([`Go2Body`]), starting lying down. Faults: silence, a motor fault, bit flips on the wire.
+//! ([`Go2Body`]), starting lying down. Faults: silence, a motor fault, bit flips on the wire,
+//! a mode that withstands ReleaseMode ([`Go2Fault::ModeHeld`]).
 //! Unlike a real Go2, its LowState's `reserve` echoes the last accepted LowCmd's `reserve`, and
 //! it can answer each LowCmd at once ([`Go2SimConfig::answer_lowcmd`]): for round trips.
 //!

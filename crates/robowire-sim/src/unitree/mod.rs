@@ -48,6 +48,13 @@ pub enum Fault {
         /// Period in samples (at least 1).
         every: u32,
     },
+    /// The mode owning the motors withstands the next `releases` `motion_switcher` ReleaseModes:
+    /// each is answered OK and lets nothing go, so CheckMode still names the mode (a client's
+    /// release loop calls again); `u32::MAX`: it never lets go. A SelectMode does not reset it.
+    ModeHeld {
+        /// ReleaseModes answered without effect (`u32::MAX`: all of them).
+        releases: u32,
+    },
 }
 
 /// How a simulator's time runs.
@@ -105,7 +112,7 @@ pub struct StreamCounters {
     pub lowstate: TopicStats,
     /// LowStates sent with a flipped bit.
     pub corrupted_states: u64,
-    /// Service requests answered.
+    /// Service requests answered (one written again, as it was under its id, counted once).
     pub requests: u64,
     /// Lateness of the state stream against its absolute deadlines, µs.
     pub state_lateness: LatenessSummary,
@@ -144,13 +151,15 @@ pub enum SimError {
 pub(crate) struct Report {
     /// The `motion_switcher` mode owning the motors; empty once released.
     pub(crate) mode: String,
+    /// ReleaseModes the mode still withstands ([`Fault::ModeHeld`]; `u32::MAX`: all).
+    pub(crate) held_releases: u32,
     log: Vec<String>,
 }
 
 impl Report {
     /// Booted with `mode` owning the motors, the log's first line `booted`.
     pub(crate) fn booted(mode: &str, booted: String) -> Self {
-        Self { mode: mode.into(), log: vec![booted] }
+        Self { mode: mode.into(), held_releases: 0, log: vec![booted] }
     }
 
     pub(crate) fn say(&mut self, line: impl Into<String>) {
@@ -388,16 +397,25 @@ impl<B: StreamBody> Sim<B> {
         Ok(())
     }
 
-    /// Injects a fault; in force when this returns.
+    /// Injects a fault; in force when this returns. A fault of the services
+    /// ([`Fault::ModeHeld`]) is set where the services thread reads it; the others go to the
+    /// state stream.
     pub(crate) fn inject(&self, fault: Fault) {
-        self.handover.requests.call(Request::Inject(fault), || self.waker.wake());
+        match fault {
+            Fault::ModeHeld { releases } => lock(&self.report).held_releases = releases,
+            Fault::Silence | Fault::MotorFault { .. } | Fault::BitFlips { .. } => {
+                self.handover.requests.call(Request::Inject(fault), || self.waker.wake());
+            }
+        }
         lock(&self.report).say(format!("fault injected: {fault:?}"));
     }
 
     /// Clears every fault.
     pub(crate) fn clear_faults(&self) {
         self.handover.requests.call(Request::ClearFaults, || self.waker.wake());
-        lock(&self.report).say("faults cleared");
+        let mut report = lock(&self.report);
+        report.held_releases = 0;
+        report.say("faults cleared");
     }
 
     /// The log lines since the last call.

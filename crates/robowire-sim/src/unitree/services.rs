@@ -59,16 +59,44 @@ where
     })
 }
 
-/// Answers every request of one service with `answer`, counting them in `answered`.
+/// Requests of one service whose answers are kept, to answer them again when written again.
+const ANSWERS_KEPT: usize = 8;
+
+/// A request as a client writes it again: its id, API and parameter.
+type Written = (i64, i64, String);
+
+/// Answers every request of one service with `answer`, counting them in `answered`. A request
+/// written again (its answer lost or late, a client resends it as it was, under its id) is
+/// answered again with the answer it had, and neither acted on nor counted twice; a request
+/// with id 0 (a client that does not number its calls, as Unitree's ROS 2 examples) is always
+/// acted on.
 pub(crate) async fn serve<S>(
     mut server: ServiceServer,
     services: &Mutex<S>,
     answered: &Counter,
     answer: fn(&mut S, &ApiRequest) -> (i32, String),
 ) {
+    // The latest numbered requests acted on, and their answers, newest last.
+    let mut kept: std::collections::VecDeque<(Written, (i32, String))> =
+        std::collections::VecDeque::with_capacity(ANSWERS_KEPT);
     while let Ok(request) = server.next_request().await {
-        let (code, data) = answer(&mut lock(services), &request);
-        answered.add(1);
+        let written =
+            (request.header.id != 0).then(|| (request.header.id, request.header.api_id, request.parameter.clone()));
+        let again = written.as_ref().and_then(|w| kept.iter().find(|(k, _)| k == w)).map(|(_, a)| a.clone());
+        let (code, data) = match again {
+            Some(again) => again,
+            None => {
+                let fresh = answer(&mut lock(services), &request);
+                answered.add(1);
+                if let Some(written) = written {
+                    if kept.len() == ANSWERS_KEPT {
+                        kept.pop_front();
+                    }
+                    kept.push_back((written, fresh.clone()));
+                }
+                fresh
+            }
+        };
         // A lost answer: the client writes its request again. No answer when none is asked for.
         if !request.header.noreply {
             let _ = server.answer(Response::to(&request.header, code, &data).into());
@@ -137,6 +165,18 @@ impl Owner {
             },
             motion_switcher::RELEASE_MODE => {
                 if self.owns() {
+                    let mut report = lock(&self.report);
+                    if report.held_releases > 0 {
+                        if report.held_releases != u32::MAX {
+                            report.held_releases -= 1;
+                        }
+                        report.say(format!(
+                            "ReleaseMode: sport mode \"{}\" does not let go (fault ModeHeld); CheckMode still names it",
+                            self.mode
+                        ));
+                        return (status::OK, String::new());
+                    }
+                    drop(report);
                     self.say(format!(
                         "ReleaseMode: sport mode \"{}\" released; LowCmds now drive the motors",
                         self.mode

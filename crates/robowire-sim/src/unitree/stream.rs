@@ -140,6 +140,8 @@ fn apply<B: StreamBody>(body: &mut B, wire: &mut WireFaults, request: Request) {
         Request::Inject(Fault::Silence) => wire.silent = true,
         Request::Inject(Fault::MotorFault { motor }) => body.set_motor_fault(motor, true),
         Request::Inject(Fault::BitFlips { every }) => wire.bit_flip_every = every.max(1),
+        // The services' fault: never sent to the stream (`Sim::inject` sets it).
+        Request::Inject(Fault::ModeHeld { .. }) => {}
         Request::ClearFaults => {
             *wire = WireFaults::default();
             body.clear_motor_faults();
