@@ -13,9 +13,9 @@
 use std::time::{Duration, Instant};
 
 use robowire_record::Recorder;
-use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use robowire_sim::spline::{SplineSim, SplineSimConfig};
+use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 use serde_json::json;
 use zsl::udp::{ClientOptions, Device, HighLevel};
 use zsl_proto::description::HIGH_LEVEL;
