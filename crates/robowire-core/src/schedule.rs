@@ -161,6 +161,17 @@ pub enum Connection {
     Disconnected,
 }
 
+impl Connection {
+    /// `"waiting"`, `"connected"` or `"disconnected"`: as status lines, JSON and Python say it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Waiting => "waiting",
+            Self::Connected => "connected",
+            Self::Disconnected => "disconnected",
+        }
+    }
+}
+
 /// A change of the connection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Event {

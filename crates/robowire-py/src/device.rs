@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robowire_devices::{AnyDevice, Connection, DeviceAddress, DeviceError, Observation, OpenOptions};
+use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, Observation, OpenOptions};
 use zsl::udp::{CallError, Refusal};
 
 use crate::errors::{Kind, chain, error};
@@ -21,7 +21,7 @@ use crate::stats::dict;
 fn raise(e: DeviceError) -> PyErr {
     match e {
         DeviceError::Kmc(e) => crate::kmc::raise(e),
-        DeviceError::Unitree(e) => crate::go2::raise(e),
+        DeviceError::Unitree(e) => crate::errors::unitree_error(e),
         DeviceError::ZslConnect(e) => crate::zsl::connect_error("ZSL-1 client", &e),
         e @ (DeviceError::Address(_)
         | DeviceError::NoSuchService { .. }
@@ -155,12 +155,7 @@ impl Device {
     /// `"closed"`.
     #[getter]
     fn connection(&self) -> &'static str {
-        match self.device().map(|d| d.connection()) {
-            Err(_) => "closed",
-            Ok(Connection::Waiting) => "waiting",
-            Ok(Connection::Connected) => "connected",
-            Ok(Connection::Disconnected) => "disconnected",
-        }
+        self.device().map_or("closed", |d| d.connection().name())
     }
 
     /// Waits up to `timeout_s` for a first state; whether one arrived. Ctrl-C interrupts.

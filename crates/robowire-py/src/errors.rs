@@ -9,6 +9,7 @@ use std::fmt::Display;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
+use unitree::UnitreeError;
 
 /// A class of `robowire.errors`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,3 +102,17 @@ pub(crate) fn service_error(message: impl Display, service: &str, api_id: i64, c
 
 /// An error and its sources, `: `-joined.
 pub(crate) use robowire_devices::error_chain as chain;
+
+/// A `UnitreeError` as the exception a Python user expects.
+pub(crate) fn unitree_error(e: UnitreeError) -> PyErr {
+    match &e {
+        UnitreeError::Command(_) | UnitreeError::Option { .. } => error(Kind::Argument, chain(&e)),
+        UnitreeError::Refused { service, api_id, code } => service_error(chain(&e), service, *api_id, *code),
+        UnitreeError::Service { service, api_id, .. } => service_error(chain(&e), service, *api_id, -1),
+        UnitreeError::NotReleased { .. } | UnitreeError::Unexpected { .. } => {
+            service_error(chain(&e), "motion_switcher", 0, -1)
+        }
+        UnitreeError::Closed => error(Kind::Closed, chain(&e)),
+        _ => error(Kind::Error, chain(&e)),
+    }
+}

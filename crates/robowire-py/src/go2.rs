@@ -1,19 +1,18 @@
 //! `robowire.go2`: a Unitree robot's low-level interface over DDS (the Go2, or an HG robot:
-//! G1, H1-2), over the `go2` facade.
+//! G1, H1-2), over the `unitree` facade.
 
 use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use unitree::{Connection, Device, Go2, Hg, LowLevel, LowLevelOptions, LowLevelStats, UnitreeError};
+use unitree::{Connection, Device, Go2, Hg, LowLevel, LowLevelOptions};
 
-use crate::errors::{Kind, chain, error, service_error};
+use crate::errors::{Kind, error, unitree_error};
 use crate::joints::JointArgs;
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
-use crate::sim::topic;
-use crate::stats::{dict, lateness};
+use crate::stats::low_level_stats;
 use crate::unitree::{PyHgLowCmd, PyHgLowState, PyLowCmd, PyLowState};
 
 /// The client of either robot family.
@@ -30,28 +29,6 @@ macro_rules! with_client {
             Client::Hg($c) => $body,
         }
     };
-}
-
-/// A `UnitreeError` as the exception a Python user expects.
-pub(crate) fn raise(e: UnitreeError) -> PyErr {
-    match &e {
-        UnitreeError::Command(_) | UnitreeError::Option { .. } => error(Kind::Argument, chain(&e)),
-        UnitreeError::Refused { service, api_id, code } => service_error(chain(&e), service, *api_id, *code),
-        UnitreeError::Service { service, api_id, .. } => service_error(chain(&e), service, *api_id, -1),
-        UnitreeError::NotReleased { .. } | UnitreeError::Unexpected { .. } => {
-            service_error(chain(&e), "motion_switcher", 0, -1)
-        }
-        UnitreeError::Closed => error(Kind::Closed, chain(&e)),
-        _ => error(Kind::Error, chain(&e)),
-    }
-}
-
-pub(crate) fn connection(c: Connection) -> &'static str {
-    match c {
-        Connection::Waiting => "waiting",
-        Connection::Connected => "connected",
-        Connection::Disconnected => "disconnected",
-    }
 }
 
 /// A Unitree robot's low-level interface over DDS, as Unitree's low-level examples use it,
@@ -113,8 +90,10 @@ impl Go2LowLevel {
             low_level,
         );
         let (client, robot) = match robot {
-            "go2" => (Client::Go2(Arc::new(py.detach(|| LowLevel::<Go2>::open(options)).map_err(raise)?)), "go2"),
-            _ => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(raise)?)), "hg"),
+            "go2" => {
+                (Client::Go2(Arc::new(py.detach(|| LowLevel::<Go2>::open(options)).map_err(unitree_error)?)), "go2")
+            }
+            _ => (Client::Hg(Arc::new(py.detach(|| LowLevel::<Hg>::open(options)).map_err(unitree_error)?)), "hg"),
         };
         Ok(Self { client: Owned::new("Go2 client", client), robot, capture })
     }
@@ -132,13 +111,13 @@ impl Go2LowLevel {
     fn release_sport_mode(&self, py: Python<'_>) -> PyResult<u32> {
         let outcome =
             with_client!(self.client()?, |c| runtime::wait(py, None, async move { c.release_sport_mode().await })?);
-        outcome.expect("no timeout").map_err(raise)
+        outcome.expect("no timeout").map_err(unitree_error)
     }
 
     /// The sport mode that owns the motors (`""`: none).
     fn sport_mode(&self, py: Python<'_>) -> PyResult<String> {
         let outcome = with_client!(self.client()?, |c| runtime::wait(py, None, async move { c.sport_mode().await })?);
-        outcome.expect("no timeout").map_err(raise)
+        outcome.expect("no timeout").map_err(unitree_error)
     }
 
     /// Go2: latches a command for the 12 joints (motor order FR, FL, RR, RL × hip, thigh, calf),
@@ -159,7 +138,7 @@ impl Go2LowLevel {
         };
         let joints = JointArgs { q, kp, kd, dq, tau }
             .commands::<12>("motor order FR, FL, RR, RL × hip, thigh, calf", |_| true)?;
-        c.set_joints(&joints).map_err(raise)
+        c.set_joints(&joints).map_err(unitree_error)
     }
 
     /// Latches a whole `robowire.unitree.LowCmd` (Go2) or `HgLowCmd` (HG), checked like
@@ -170,13 +149,13 @@ impl Go2LowLevel {
                 let cmd = command
                     .cast::<PyLowCmd>()
                     .map_err(|_| error(Kind::Argument, "a Go2 takes a robowire.unitree.LowCmd"))?;
-                c.set_command(cmd.get().message()).map_err(raise)
+                c.set_command(cmd.get().message()).map_err(unitree_error)
             }
             Client::Hg(c) => {
                 let cmd = command
                     .cast::<PyHgLowCmd>()
                     .map_err(|_| error(Kind::Argument, "an HG robot takes a robowire.unitree.HgLowCmd"))?;
-                c.set_command(cmd.get().message()).map_err(raise)
+                c.set_command(cmd.get().message()).map_err(unitree_error)
             }
         }
     }
@@ -248,7 +227,7 @@ impl Go2LowLevel {
     /// `"waiting"`, `"connected"` or `"disconnected"` (no state for 100 ms).
     #[getter]
     fn connection(&self) -> PyResult<&'static str> {
-        Ok(connection(with_client!(self.client()?, |c| c.connection())))
+        Ok(with_client!(self.client()?, |c| c.connection()).name())
     }
 
     /// Topics, commands sent, damping, timeouts, lost states, timing.
@@ -267,26 +246,6 @@ closeable!(
     capture,
     "Sends damping last, leaves the domain, then finishes its own capture. Idempotent."
 );
-
-/// A low-level client's stats as a dict: topics, commands sent, damping, timeouts, lost states,
-/// timing (µs).
-pub(crate) fn low_level_stats<'py>(py: Python<'py>, s: &LowLevelStats) -> PyResult<Bound<'py, PyDict>> {
-    Ok(dict!(py, {
-        "lowcmd" => topic(py, &s.lowcmd)?,
-        "lowstate" => topic(py, &s.lowstate)?,
-        "commands_sent" => s.commands_sent,
-        "damping_sent" => s.damping_sent,
-        "command_timeouts" => s.command_timeouts,
-        "missed_ticks" => s.missed_ticks,
-        "write_drops" => s.write_drops,
-        "lost_by_tick" => s.lost_by_tick,
-        "late_by_tick" => s.late_by_tick,
-        "disconnects" => s.disconnects,
-        "reconnects" => s.reconnects,
-        "send_lateness_us" => lateness(py, &s.send_lateness)?,
-        "state_gap_us" => lateness(py, &s.state_gap)?,
-    }))
-}
 
 /// Adds the classes to the extension module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -1,59 +1,26 @@
-//! `robowire.g1`: the Unitree G1 humanoid over DDS, over the `g1` facade (`rt/lowcmd` with the
+//! `robowire.g1`: the Unitree G1 humanoid over DDS, over the `unitree` facade's G1 (`rt/lowcmd` with the
 //! robot's `mode_machine`, `rt/arm_sdk` with a ramped weight, the loco and arm services).
 
 mod services;
+pub(crate) mod variant;
 
 use std::future::Future;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use unitree::g1::{
-    ARM_JOINTS, ARM_SDK_JOINTS, Connection, Device, G1, G1Error, G1Options, G1Variant, JOINTS, LowLevelOptions,
-};
+use unitree::g1::{ARM_JOINTS, ARM_SDK_JOINTS, Connection, Device, G1, G1Error, G1Options, JOINTS, LowLevelOptions};
 use unitree_proto::api::{g1_arm, g1_loco};
 
 use crate::errors::{Kind, chain, error, service_error};
-use crate::go2::{connection, low_level_stats};
 use crate::joints::{JointArgs, per_joint};
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
 use crate::runtime::{self, seconds};
-use crate::sim::topic;
-use crate::stats::{dict, lateness};
+use crate::stats::{dict, lateness, low_level_stats, topic};
 use crate::unitree::{PyHgLowCmd, PyHgLowState};
 use services::{ArmActions, Loco};
-
-/// The G1 variants by their Python name and joint count (Unitree's names: "27-dof" is the
-/// 29-dof body with its waist locked, "14-dof" the dual-arm G1).
-const VARIANTS: [(&str, u8, G1Variant); 4] = [
-    ("29dof", 29, G1Variant::Dof29),
-    ("23dof", 23, G1Variant::Dof23),
-    ("29dof_waist_locked", 27, G1Variant::Dof29WaistLocked),
-    ("dual_arm", 14, G1Variant::DualArm),
-];
-
-/// The Python name of `variant`.
-pub(crate) fn variant_name(variant: G1Variant) -> &'static str {
-    VARIANTS.iter().find(|(_, _, v)| *v == variant).map_or("29dof", |(name, _, _)| name)
-}
-
-/// The variant named `name`, or `ArgumentError`.
-fn variant_named(name: &str) -> PyResult<G1Variant> {
-    VARIANTS.iter().find(|(n, _, _)| *n == name).map(|(_, _, v)| *v).ok_or_else(|| {
-        let names: Vec<_> = VARIANTS.iter().map(|(n, _, _)| format!("{n:?}")).collect();
-        error(Kind::Argument, format!("variant = {name:?}: one of {}", names.join(", ")))
-    })
-}
-
-/// The variant with `dof` joints, or `ArgumentError`.
-pub(crate) fn variant_of_dof(dof: u8) -> PyResult<G1Variant> {
-    VARIANTS
-        .iter()
-        .find(|(_, d, _)| *d == dof)
-        .map(|(_, _, v)| *v)
-        .ok_or_else(|| error(Kind::Argument, format!("dof = {dof}: 29, 27 (waist locked), 23 or 14 (dual arm)")))
-}
+use variant::{variant_name, variant_named};
 
 /// A `G1Error` as the exception a Python user expects: a refused command or argument
 /// `ArgumentError`; a refusal of the `sport` or `arm` service `ServiceError` with its service,
@@ -62,7 +29,7 @@ pub(crate) fn raise(e: G1Error) -> PyErr {
     use g1_arm::error as arm;
     use g1_loco::error as loco;
     let e = match e {
-        G1Error::LowLevel(e) => return crate::go2::raise(e),
+        G1Error::LowLevel(e) => return crate::errors::unitree_error(e),
         e => e,
     };
     let refused = |service, api_id, code| service_error(chain(&e), service, api_id, code);
@@ -220,7 +187,7 @@ impl PyG1 {
     /// `"waiting"`, `"connected"` or `"disconnected"` (no state for 100 ms).
     #[getter]
     fn connection(&self) -> PyResult<&'static str> {
-        Ok(connection(client(&self.client)?.connection()))
+        Ok(client(&self.client)?.connection().name())
     }
 
     /// Latches a whole `robowire.unitree.HgLowCmd` for `rt/lowcmd` if the G1's rules allow it

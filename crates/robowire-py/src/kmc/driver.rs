@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use std::sync::{Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::{Duration, Instant};
 
-use kmc::{ChassisFrame, ChassisState, Connection, Device, DriverOptions, LinkState, Placement, SerialPortOptions};
+use kmc::{ChassisFrame, ChassisState, Device, DriverOptions, LinkState, Placement, SerialPortOptions};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use robowire_rt::lock;
@@ -246,11 +246,7 @@ impl Driver {
     /// `"disconnected"` (silent for 500 ms, or the port vanished).
     #[getter]
     fn connection(&self) -> PyResult<&'static str> {
-        self.word(|driver| match driver.connection() {
-            Connection::Waiting => "waiting",
-            Connection::Connected => "connected",
-            Connection::Disconnected => "disconnected",
-        })
+        self.word(|driver| driver.connection().name())
     }
 
     /// Streams `velocity_mps` forward and `yaw_rate_radps`, as the vendor maps them: curvature

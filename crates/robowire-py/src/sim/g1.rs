@@ -6,14 +6,13 @@ use robowire_dds::ParticipantOptions;
 use robowire_sim::g1::{G1Sim, G1SimConfig};
 use unitree_proto::g1::G1Variant;
 
-use super::go2::topic;
 use super::unitree::faults;
 use crate::errors::{Kind, chain, error};
-use crate::g1::{variant_name, variant_of_dof};
+use crate::g1::variant::{variant_name, variant_of_dof};
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
-use crate::stats::{dict, lateness};
+use crate::stats::{dict, lateness, topic};
 
 /// A simulated Unitree G1 on DDS: `rt/lowstate` at 500 Hz with its `mode_machine`, `rt/lowcmd`
 /// obeyed once the controller is released (and only with the robot's `mode_machine`, per motor

@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robowire_dds::{ParticipantOptions, TopicStats};
+use robowire_dds::ParticipantOptions;
 use robowire_sim::go2::{Go2Sim, Go2SimConfig};
 
 use super::unitree::faults;
@@ -10,7 +10,7 @@ use crate::errors::{Kind, chain, error};
 use crate::owned::{Owned, closeable};
 use crate::record::{Capture, record_arg};
 use crate::runtime::seconds;
-use crate::stats::{dict, lateness};
+use crate::stats::{dict, lateness, topic};
 
 /// A simulated Unitree Go2 on DDS: `rt/lowstate` at 500 Hz, `rt/lowcmd` obeyed once the sport
 /// mode is released, the motion_switcher and sport services. Unitree's own SDK and
@@ -22,15 +22,6 @@ pub(crate) struct Go2 {
     sim: Owned<Go2Sim>,
     domain: u16,
     capture: Capture,
-}
-
-pub(crate) fn topic<'py>(py: Python<'py>, t: &TopicStats) -> PyResult<Bound<'py, PyDict>> {
-    Ok(dict!(py, {
-        "samples" => t.samples,
-        "write_errors" => t.write_errors,
-        "decode_errors" => t.decode_errors,
-        "checksum_errors" => t.checksum_errors,
-    }))
 }
 
 #[pymethods]

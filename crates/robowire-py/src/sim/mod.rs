@@ -6,7 +6,6 @@ mod go2;
 mod unitree;
 mod zsl1;
 
-pub(crate) use go2::topic;
 pub(crate) use spline::state_dict;
 mod spline;
 

@@ -222,12 +222,7 @@ impl<T: Facade> Session<T> {
 
     /// `"waiting"`, `"connected"`, `"disconnected"`, or `"closed"`.
     pub(crate) fn connection(&self) -> &'static str {
-        match self.client().map(|c| c.connection()) {
-            None => "closed",
-            Some(Connection::Waiting) => "waiting",
-            Some(Connection::Connected) => "connected",
-            Some(Connection::Disconnected) => "disconnected",
-        }
+        self.client().map_or("closed", |c| c.connection().name())
     }
 
     /// The bound address as `(ip, port)`.
