@@ -3,7 +3,7 @@
 
 use zsl_proto::udp::{Action, HighLevelCommand, LowLevelCommand, Model};
 
-use super::model::{Activity, LIE_DOWN_S, STAND_UP_S};
+use super::activity::{Activity, LIE_DOWN_S, STAND_UP_S};
 use crate::joints::{JointModel, PdTarget};
 use crate::spline::{LYING_POSE_RAD, STANDING_POSE_RAD};
 

@@ -7,6 +7,7 @@
 //!   attitude, height, and the joints through the shared PD joint model.
 //! - [`Zsl1Sim`] (`server.rs`): the model on two UDP ports through `robowire-udp`'s device side.
 
+mod activity;
 mod body;
 pub mod model;
 mod server;

@@ -14,20 +14,9 @@ use zsl_proto::udp::{
 };
 use zsl_proto::zerocopy::little_endian::F32;
 
+pub use super::activity::{Activity, BACKFLIP_S, FRONT_JUMP_S, JUMP_S, LIE_DOWN_S, SHAKE_HAND_S, STAND_UP_S};
 use super::body::{Body, Drive};
 
-/// Standing up takes this long, s.
-pub const STAND_UP_S: f32 = 1.2;
-/// Lying down takes this long, s.
-pub const LIE_DOWN_S: f32 = 1.0;
-/// `jump()` takes this long, s.
-pub const JUMP_S: f32 = 0.8;
-/// `frontJump()` takes this long, s.
-pub const FRONT_JUMP_S: f32 = 1.0;
-/// `backflip()` takes this long, s.
-pub const BACKFLIP_S: f32 = 1.5;
-/// `shakeHand()` takes this long, s.
-pub const SHAKE_HAND_S: f32 = 2.0;
 /// Battery drain by activity, %/s.
 struct Drain {
     lying: f32,
@@ -43,31 +32,6 @@ const DRAIN: Drain = Drain { lying: 0.005, standing: 0.01, walking: 0.02, walkin
 const LOW_LEVEL_HOLD_S: f32 = 0.1;
 /// Without a HighLevel command for this long the robot stops walking (it keeps its mode), s.
 pub const COMMAND_TIMEOUT_S: f32 = 0.5;
-
-/// What the body is doing (the mode says what was asked).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Activity {
-    /// Lying, joints locked (mode 51) or free (10).
-    Lying,
-    /// Motors damped (mode 0).
-    Passive,
-    /// Getting up.
-    StandingUp,
-    /// Standing still or walking in place.
-    Standing,
-    /// Walking (mode 18); ZSL-1W crawling or climbing too.
-    Walking,
-    /// Lying down.
-    LyingDown,
-    /// A trick in progress.
-    Trick(Action),
-    /// Standing on the hind legs (sticky action 7).
-    TwoLegStand,
-    /// Attitude control in mode 21.
-    Attitude,
-    /// The twelve motors follow LowLevel commands.
-    LowLevel,
-}
 
 /// A fault the simulator can inject.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
