@@ -9,13 +9,13 @@
 //! cargo run --example g1_low_level
 //! ```
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, ensure};
 use clap::Parser;
 use robowire_sim::g1::{G1Sim, G1SimConfig};
 use unitree::g1::slot::{LEFT_ANKLE_PITCH, LEFT_ANKLE_ROLL, RIGHT_ANKLE_PITCH, RIGHT_ANKLE_ROLL};
-use unitree::g1::{G1, G1Options, JOINTS, ParticipantOptions};
+use unitree::g1::{Device, G1, G1Options, G1Variant, JOINTS, ParticipantOptions, from_fn, hold};
 
 /// The ankle swing's amplitudes, rad, at 1 Hz (Unitree's example: 30° pitch, 10° roll).
 const PITCH_RAD: f32 = 30.0 * std::f32::consts::PI / 180.0;
@@ -77,25 +77,32 @@ fn run(args: &Args, participant: ParticipantOptions, sim: Option<&G1Sim>) -> any
         println!("controller {mode:?} released ({calls} ReleaseMode)");
         let stage = Duration::from_secs_f64(args.stage_s);
 
-        // 1. Every joint from where it is to 0 rad, at 500 Hz (robowire's stream sends each
-        // command latched here on its own grid; a command older than 100 ms becomes damping).
+        // 1. Every joint from where it is to 0 rad, with Unitree's example gains, stepped by
+        // robowire's LowCmd stream on its own 2 ms deadlines (each step checked by the G1's rules).
+        let (mode_machine, variant) = (first.mode_machine, robot.variant().unwrap_or(G1Variant::Dof29));
         let from = robot.joint_positions().context("no state")?;
-        let began = Instant::now();
-        let mut ticker = tokio::time::interval(Duration::from_millis(2));
-        while began.elapsed() < stage {
-            ticker.tick().await;
-            let ratio = (began.elapsed().as_secs_f32() / stage.as_secs_f32()).min(1.0);
-            robot.hold(&std::array::from_fn(|i| (1.0 - ratio) * from[i]))?;
-        }
+        let to_zero = from_fn(stage, move |elapsed| {
+            let ratio = (elapsed.as_secs_f32() / stage.as_secs_f32()).min(1.0);
+            hold(&from.map(|q| (1.0 - ratio) * q), mode_machine, variant)
+        });
+        robot.follow(to_zero)?.wait().await?;
         let largest = robot.joint_positions().context("no state")?.iter().fold(0.0f32, |m, q| m.max(q.abs()));
         println!("zero posture: largest |q| {largest:.3} rad");
 
-        // 2. The ankles swing at 1 Hz.
-        let began = Instant::now();
+        // 2. The ankles swing at 1 Hz, stepped by the stream; its left ankle pitch seen with each
+        // LowState meanwhile.
+        let swinging = from_fn(stage, move |elapsed| hold(&swing(elapsed.as_secs_f32()), mode_machine, variant));
+        let end = robot.follow(swinging)?.wait();
+        tokio::pin!(end);
+        let mut states = robot.states();
         let mut pitch = (f32::INFINITY, f32::NEG_INFINITY);
-        while began.elapsed() < stage {
-            ticker.tick().await;
-            robot.hold(&swing(began.elapsed().as_secs_f32()))?;
+        loop {
+            tokio::select! {
+                end = &mut end => break end?,
+                changed = states.changed() => if changed.is_err() {
+                    break (&mut end).await?;
+                }
+            }
             if let Some(q) = robot.joint_positions() {
                 pitch = (pitch.0.min(q[LEFT_ANKLE_PITCH]), pitch.1.max(q[LEFT_ANKLE_PITCH]));
             }

@@ -8,7 +8,7 @@
 //! cargo run --example go2_stand
 //! ```
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, ensure};
 use clap::Parser;
@@ -60,14 +60,11 @@ fn stand(args: &Args, participant: ParticipantOptions, sim: Option<&Go2Sim>) -> 
         let calls = robot.release_sport_mode().await?;
         println!("sport mode released ({calls} ReleaseMode)");
         let (duration, hold) = (Duration::from_secs_f64(args.duration), Duration::from_secs_f64(args.hold));
-        // Unitree's stand: from where the joints are to the stand pose, kp 60, kd 5.
+        // Unitree's stand: from where the joints are to the stand pose, kp 60, kd 5, stepped by
+        // robowire's LowCmd stream on its own 2 ms deadlines; then the pose held by the stream.
         let stand = JointTrajectory::stand_up(start, duration);
-        let began = Instant::now();
-        let mut ticker = tokio::time::interval(Duration::from_millis(2));
-        while began.elapsed() < duration + hold {
-            ticker.tick().await;
-            robot.set_joints(&stand.joints_at(began.elapsed()))?;
-        }
+        robot.follow(stand)?.wait().await?;
+        tokio::time::sleep(hold).await;
         let q = robot.joint_positions().context("no state")?;
         let worst = stand.largest_error_rad(&q);
         println!("standing: largest joint error {worst:.3} rad");

@@ -2,8 +2,8 @@
 //! examples use it, with robowire's safety: validated commands, damping when the command goes
 //! stale, a watchdog on the state.
 
-use std::sync::Arc;
 use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use robowire_core::schedule::Watchdog;
@@ -16,11 +16,11 @@ use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 use robowire_rt::stats::Counter;
 use unitree_proto::go2::MotorCmd;
 use unitree_proto::robot::{Go2, Robot};
-use unitree_proto::stream::CommandStream;
+use unitree_proto::stream::{CommandStream, Motion, MotionState};
 use unitree_proto::{LowCmd, Message};
 
 use crate::services::{ServiceHandle, Services};
-use crate::stream::{StreamJob, StreamShared};
+use crate::stream::{Handed, MotionStatus, StreamJob, StreamShared};
 use crate::{LowLevelOptions, UnitreeError};
 
 /// One joint's command: position target, velocity target, gains, feed-forward torque.
@@ -118,29 +118,31 @@ where
 /// ever sent.
 ///
 /// Nothing is sent until the first [`set_command`](Self::set_command) (or
-/// [`damp`](Self::damp)); from then on the latched command goes out every 2 ms on absolute
-/// deadlines, replaced by damping (kp 0, a small kd, no targets) once it is older than the
-/// command timeout (100 ms), never by the last target.
+/// [`follow`](Self::follow), [`damp`](Self::damp)); from then on the latched command goes out
+/// every 2 ms on absolute deadlines, replaced by damping (kp 0, a small kd, no targets) once it
+/// is older than the command timeout (100 ms), never by the last target. A motion
+/// ([`follow`](Self::follow)) is stepped by the stream itself, on its own deadlines.
 ///
 /// ```no_run
 /// # async fn demo() -> Result<(), unitree::UnitreeError> {
+/// use std::time::Duration;
 /// use unitree::trajectory::JointTrajectory;
-/// use unitree::{JointCommand, LowLevel, LowLevelOptions};
+/// use unitree::{LowLevel, LowLevelOptions};
 /// let robot = LowLevel::<unitree::Go2>::open(LowLevelOptions::on(Some("eth0"), 0))?;
-/// let lying = robot.wait_state(std::time::Duration::from_secs(3), |_| true).await.expect("rt/lowstate");
+/// let lying = robot.wait_state(Duration::from_secs(3), |_| true).await.expect("rt/lowstate");
 /// robot.release_sport_mode().await?; // the robot lies down, its sport mode lets go
-/// let stand = JointTrajectory::stand_up(std::array::from_fn(|i| lying.motor_state[i].q.get()), std::time::Duration::from_secs(2));
-/// let start = std::time::Instant::now();
-/// while start.elapsed() < std::time::Duration::from_secs(3) {
-///     robot.set_joints(&stand.joints_at(start.elapsed()))?;
-///     tokio::time::sleep(std::time::Duration::from_millis(2)).await;
-/// }
+/// let from = std::array::from_fn(|i| lying.motor_state[i].q.get());
+/// // Stepped every 2 ms by the stream; the stand pose held after 2 s.
+/// robot.follow(JointTrajectory::stand_up(from, Duration::from_secs(2)))?.wait().await?;
 /// robot.close(); // damping, then closed
 /// # Ok(()) }
 /// ```
 pub struct LowLevel<R: Robot = Go2> {
     options: LowLevelOptions,
     shared: Arc<StreamShared<R>>,
+    /// The stamp of the last input handed to the stream (command, motion, damping): callers
+    /// take turns, the stream thread never takes it.
+    last_input: Mutex<u64>,
     stream: Option<Runner<StreamJob<R>>>,
     waker: Waker,
     ticks: Arc<TickCounters>,
@@ -205,6 +207,7 @@ where
         Ok(Self {
             options,
             shared,
+            last_input: Mutex::new(0),
             stream: Some(stream),
             waker,
             ticks,
@@ -276,18 +279,61 @@ where
     }
 
     /// Latches `command` if the robot's rules allow it (NaN, infinities, gains, torques, the
-    /// Go2's joint limits): streamed from the next tick on. On error nothing changes.
+    /// Go2's joint limits): streamed from the next tick on, replacing a motion being followed.
+    /// On error nothing changes.
     pub fn set_command(&self, command: R::Cmd) -> Result<(), UnitreeError> {
         R::check(&command)?;
-        self.shared.commands.write(robowire_rt::now(), &command);
-        self.waker.wake();
+        self.hand_over(|at| {
+            self.shared.commands.write(at, &command);
+        });
         Ok(())
     }
 
-    /// Damping from the next tick on, until the next command.
+    /// Hands `motion` to the LowCmd stream, which steps it on its own grid: at each of its
+    /// deadlines it sends `motion.command_at(elapsed)`, `elapsed` the time from the motion's
+    /// first tick to this one (0, one period, two, …, as the stream's clock has it), up to
+    /// `motion.duration()`; from then on it holds that last command, never stale (it is the
+    /// stream's own), until the next [`set_command`](Self::set_command) or `follow` (which
+    /// replace it) or [`damp`](Self::damp) (which ends it). [`close`](Self::close) and drop damp
+    /// as always. No loop on the caller's side: await [`Following::wait`].
+    ///
+    /// The robot's rules: the first and the last steps are checked here, and a refusal returns
+    /// the error with nothing changed and nothing sent (for a move between two poses at fixed
+    /// gains, as [`JointTrajectory`](crate::trajectory::JointTrajectory), that covers every
+    /// step); the stream checks every step again, and a step refused there ends the motion in
+    /// damping ([`MotionState::Refused`]), without a panic. The motion is boxed here; the stream
+    /// thread neither allocates nor frees (a replaced motion is dropped by a later call).
+    pub fn follow(&self, motion: impl Motion<R::Cmd> + Send + 'static) -> Result<Following, UnitreeError> {
+        for elapsed in [Duration::ZERO, motion.duration()] {
+            R::check(&motion.command_at(elapsed)?)?;
+        }
+        // Motions the stream let go, dropped here rather than on its thread.
+        while self.shared.retired.pop().is_some() {}
+        let status = Arc::new(MotionStatus::default());
+        let handed = Handed { motion: Box::new(motion), status: status.clone() };
+        // A motion handed over before and not taken yet is overtaken by this one.
+        if let Some((_, overtaken)) = self.hand_over(|at| self.shared.motions.force_push((at, handed))) {
+            overtaken.status.publish(MotionState::Replaced, None);
+        }
+        let (runtime, period) = (self.receiving.runtime().clone(), self.options.stream.period);
+        Ok(Following { status, runtime, period })
+    }
+
+    /// Damping from the next tick on, until the next command or motion; ends a motion being
+    /// followed.
     pub fn damp(&self) {
-        self.shared.damp_at.store(robowire_rt::now().as_nanos(), Ordering::Release);
+        self.hand_over(|at| self.shared.damp_at.store(at.as_nanos(), Ordering::Release));
+    }
+
+    /// Hands an input over, stamped after every earlier one, and wakes the stream.
+    fn hand_over<T>(&self, publish: impl FnOnce(Time) -> T) -> T {
+        let published = {
+            let mut last = robowire_rt::lock(&self.last_input);
+            *last = robowire_rt::now().as_nanos().max(*last + 1);
+            publish(Time::from_nanos(*last))
+        };
         self.waker.wake();
+        published
     }
 
     /// Waits up to `timeout` for a state that satisfies `accept` (the latest counts). Any
@@ -355,16 +401,82 @@ impl LowLevel<Go2> {
     /// Latches a command for the 12 joints (motor order FR, FL, RR, RL × hip, thigh, calf); the
     /// other 8 slots hold nothing.
     pub fn set_joints(&self, joints: &[JointCommand; 12]) -> Result<(), UnitreeError> {
-        let mut cmd = LowCmd::default();
-        for (m, j) in cmd.motor_cmd.iter_mut().zip(joints) {
-            *m = MotorCmd::servo(j.q_rad, j.dq_radps, j.kp, j.kd, j.tau_nm);
-        }
-        self.set_command(cmd)
+        self.set_command(go2_command(joints))
     }
 
     /// Joint positions of the latest state, rad, motor order.
     pub fn joint_positions(&self) -> Option<[f32; 12]> {
         self.latest().map(|s| std::array::from_fn(|i| s.state.motor_state[i].q.get()))
+    }
+}
+
+/// The Go2's command for its 12 joints (motor order); the other 8 slots hold nothing.
+pub(crate) fn go2_command(joints: &[JointCommand; 12]) -> LowCmd {
+    let mut cmd = LowCmd::default();
+    for (m, j) in cmd.motor_cmd.iter_mut().zip(joints) {
+        *m = MotorCmd::servo(j.q_rad, j.dq_radps, j.kp, j.kd, j.tau_nm);
+    }
+    cmd
+}
+
+/// A motion the LowCmd stream follows ([`LowLevel::follow`]): where it is, and a wait for its
+/// end. Cheap to clone; dropping it changes nothing (the stream goes on following).
+#[derive(Debug, Clone)]
+pub struct Following {
+    status: Arc<MotionStatus>,
+    runtime: tokio::runtime::Handle,
+    period: Duration,
+}
+
+impl Following {
+    /// Where the motion is (after the client closed: [`MotionState::Damped`] unless it had
+    /// reached its end).
+    pub fn state(&self) -> MotionState {
+        self.status.state()
+    }
+
+    /// When its first step was due, on the monotonic clock (`robowire_rt::now`; `None` before
+    /// it went out). Its step at `elapsed` was due at `began + elapsed`.
+    pub fn began(&self) -> Option<Time> {
+        self.status.began()
+    }
+
+    /// Whether the stream is done stepping it: its end reached (its final command held), or it
+    /// ended before.
+    pub fn is_done(&self) -> bool {
+        !matches!(self.state(), MotionState::Pending | MotionState::Moving { .. }) || self.status.is_closed()
+    }
+
+    /// Waits until its last step went out (`Ok`: the stream holds its final command from then
+    /// on), or until it ended before: [`UnitreeError::MotionEnded`] (replaced, damped, a step
+    /// refused), [`UnitreeError::Closed`] (the client closed). Any executor: the wait runs on the
+    /// client's receive thread, which looks every stream period. The future borrows nothing.
+    pub fn wait(&self) -> impl Future<Output = Result<(), UnitreeError>> + Send + 'static {
+        let this = self.clone();
+        async move {
+            if let Some(end) = this.end() {
+                return end;
+            }
+            let runtime = this.runtime.clone();
+            crate::services::on_runtime(&runtime, async move {
+                loop {
+                    if let Some(end) = this.end() {
+                        return end;
+                    }
+                    tokio::time::sleep(this.period).await;
+                }
+            })
+            .await
+        }
+    }
+
+    fn end(&self) -> Option<Result<(), UnitreeError>> {
+        match self.state() {
+            MotionState::Reached => Some(Ok(())),
+            _ if self.status.is_closed() => Some(Err(UnitreeError::Closed)),
+            MotionState::Pending | MotionState::Moving { .. } => None,
+            ended => Some(Err(UnitreeError::MotionEnded(ended))),
+        }
     }
 }
 
@@ -377,6 +489,7 @@ impl<R: Robot> Drop for LowLevel<R> {
             if self.shared.sent.get() > 0 {
                 job.write_closing_damping(job.damping_kd());
             }
+            job.close_motions();
         }
     }
 }

@@ -3,6 +3,7 @@
 use robowire_dds::DdsError;
 use robowire_rt::RtError;
 use unitree_proto::robot::CommandError;
+use unitree_proto::stream::MotionState;
 
 /// Why something failed.
 #[derive(Debug, thiserror::Error)]
@@ -63,7 +64,11 @@ pub enum UnitreeError {
         data: String,
     },
     /// The client's receive thread has ended (the client is being closed): a service call
-    /// cannot be made.
+    /// cannot be made, a motion is not followed any more.
     #[error("the client is closed")]
     Closed,
+    /// A followed motion ended before its last step: a newer command or motion replaced it,
+    /// damping ended it, or the robot's rules refused a step (damping from then on).
+    #[error("the motion ended before its last step: {0}")]
+    MotionEnded(MotionState),
 }

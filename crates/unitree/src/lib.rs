@@ -11,7 +11,7 @@ pub mod services;
 mod stream;
 pub mod trajectory;
 
-pub use client::{JointCommand, LowLevel, LowLevelStats};
+pub use client::{Following, JointCommand, LowLevel, LowLevelStats};
 pub use error::UnitreeError;
 pub use options::{FIRST_STATE_TIMEOUT, LowLevelOptions, STATE_TIMEOUT};
 pub use robowire_core::schedule::Connection;
@@ -19,6 +19,7 @@ pub use robowire_dds::ParticipantOptions;
 pub use robowire_rt::device::{Device, Stamped};
 pub use robowire_rt::{Placement, RtError};
 pub use unitree_proto::robot::{CommandError, GO2_JOINT_LIMITS, GO2_JOINT_NAMES, Go2, Hg, JointLimits, Robot};
+pub use unitree_proto::stream::MotionState;
 pub use unitree_proto::{HgLowCmd, HgLowState, LowCmd, LowState, MotorCmd};
 
 /// The DDS receive path of every Unitree message, for the fuzz target (not public API). Byte 0

@@ -1,7 +1,9 @@
 //! The stand (and lie) motion of Unitree's low-level examples as one sans-IO trajectory: the 12
 //! leg joints moved linearly from where they are to a pose over a duration, then held, with
-//! fixed gains. A pure function of the elapsed time: the caller's loop (a CLI, the demo, an
-//! example, a test on a fake clock) asks for the joints at its own time.
+//! fixed gains. A pure function of the elapsed time, and a [`Motion`] of the Go2: handed to
+//! [`LowLevel::follow`](crate::LowLevel::follow), the LowCmd stream steps it on its own grid
+//! (no loop on the caller's side). Any other motion: a [`Motion`] of the robot's command, or a
+//! function of the elapsed time ([`from_fn`]).
 //!
 //! ```
 //! use std::time::Duration;
@@ -16,6 +18,10 @@
 //! ```
 
 use std::time::Duration;
+
+use unitree_proto::LowCmd;
+use unitree_proto::robot::CommandError;
+pub use unitree_proto::stream::{FromFn, Motion, from_fn};
 
 use crate::JointCommand;
 use crate::go2::STAND_POSE_RAD;
@@ -108,6 +114,18 @@ impl JointTrajectory {
     /// The largest |q − target| over the joints, rad.
     pub fn largest_error_rad(&self, q_rad: &[f32; 12]) -> f32 {
         q_rad.iter().zip(self.to).map(|(q, t)| (q - t).abs()).fold(0.0, f32::max)
+    }
+}
+
+/// The Go2's command at `elapsed`: [`JointTrajectory::joints_at`] on the 12 leg joints (as
+/// [`LowLevel::set_joints`](crate::LowLevel::set_joints) sends them).
+impl Motion<LowCmd> for JointTrajectory {
+    fn command_at(&self, elapsed: Duration) -> Result<LowCmd, CommandError> {
+        Ok(crate::client::go2_command(&self.joints_at(elapsed)))
+    }
+
+    fn duration(&self) -> Duration {
+        self.duration
     }
 }
 

@@ -1,21 +1,33 @@
 //! The Go2 client against the simulated Go2 over real DDS, where loopback carries multicast
 //! (`robowire_dds::netns`): sport mode release, standing up, damping on a stale command, refused
-//! commands, the watchdog, CRC faults on the wire. Conditions are awaited with a generous
-//! timeout; nothing here measures time (the stream's timing is `unitree-proto`'s fake-clock tests).
+//! commands, a motion followed by the stream, the watchdog, CRC faults on the wire. Conditions
+//! are awaited with a generous timeout; nothing here measures time (the stream's timing is
+//! `unitree-proto`'s fake-clock tests).
 
 use std::time::Duration;
 
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_fixtures::wait::{one_at_a_time, until_async};
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
+use robowire_tap::{Direction, TapRing};
 use unitree::go2::STAND_POSE_RAD;
-use unitree::{Connection, Device, Go2, JointCommand, LowLevel, LowLevelOptions, UnitreeError};
+use unitree::trajectory::{JointTrajectory, Motion, from_fn, stand_pose};
+use unitree::{Connection, Device, Go2, JointCommand, LowCmd, LowLevel, LowLevelOptions, MotionState, UnitreeError};
+use unitree_proto::Message;
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 const WAIT: Duration = Duration::from_secs(20);
 
 /// `scenario` with a simulated Go2 and a connected client, in a fresh namespace.
 fn with_go2<F>(scenario: impl FnOnce(Go2Sim, LowLevel<Go2>) -> F + Send)
+where
+    F: Future<Output = ()>,
+{
+    with_go2_options(LowLevelOptions::on(Some("lo"), 0), scenario);
+}
+
+/// [`with_go2`], the client opened with `options`.
+fn with_go2_options<F>(options: LowLevelOptions, scenario: impl FnOnce(Go2Sim, LowLevel<Go2>) -> F + Send)
 where
     F: Future<Output = ()>,
 {
@@ -28,7 +40,7 @@ where
                 ..Default::default()
             })
             .expect("simulator");
-            let client = LowLevel::<Go2>::open(LowLevelOptions::on(Some("lo"), 0)).expect("client");
+            let client = LowLevel::<Go2>::open(options).expect("client");
             scenario(sim, client).await;
         })
     });
@@ -84,6 +96,109 @@ fn bad_commands_are_refused_before_anything_is_sent() {
         torque[0].tau_nm = 100.0;
         assert!(matches!(robot.set_joints(&torque), Err(UnitreeError::Command(_))));
         assert_eq!(robot.stats().commands_sent, 0, "nothing was latched, nothing is streamed");
+    });
+}
+
+/// Whether every leg joint is within 0.02 rad of the stand pose.
+fn standing(q: Option<[f32; 12]>) -> bool {
+    q.is_some_and(|q| q.iter().zip(stand_pose()).all(|(q, s)| (q - s).abs() < 0.02))
+}
+
+#[test]
+fn a_followed_stand_up_is_stepped_on_the_streams_deadlines_and_held() {
+    let ring = TapRing::with_slots(8192);
+    let options = LowLevelOptions { low_level_tap: Some(ring.tap(0)), ..LowLevelOptions::on(Some("lo"), 0) };
+    with_go2_options(options, |sim, robot| async move {
+        assert!(robot.wait_state(WAIT, move |_| true).await.is_some(), "state arrives");
+        robot.release_sport_mode().await.unwrap();
+        let from = robot.joint_positions().unwrap();
+        let stand = JointTrajectory::stand_up(from, Duration::from_millis(400));
+        // Each step carries its slot, in periods from the first, in `reserve`.
+        let period = robot.options().stream.period;
+        let tagged = from_fn(stand.duration(), move |elapsed: Duration| {
+            let mut cmd = stand.command_at(elapsed).unwrap();
+            cmd.reserve = u32::try_from(elapsed.as_nanos() / period.as_nanos()).unwrap().into();
+            cmd
+        });
+        let following = robot.follow(tagged).unwrap();
+        tokio::time::timeout(WAIT, following.wait()).await.expect("the motion's end").unwrap();
+        assert_eq!(following.state(), MotionState::Reached);
+        let began = following.began().expect("its first step went out");
+        until_async(WAIT, "standing", || standing(robot.joint_positions())).await;
+        // Held by the stream, fresh, past the command timeout (50 periods) with no command.
+        let sent = robot.stats().commands_sent;
+        until_async(WAIT, "a hold of 100 periods", || robot.stats().commands_sent > sent + 100).await;
+        assert!(standing(robot.joint_positions()));
+        let stats = robot.stats();
+        assert_eq!((stats.damping_sent, stats.command_timeouts), (0, 0), "{stats:?}");
+
+        // Every LowCmd the stream wrote during the move: the trajectory at its slot, one per
+        // tick, in order, none written before its slot was due.
+        let mut steps = Vec::new();
+        while let Some(frame) = ring.pop(|f| {
+            (f.direction == Direction::Sent).then(|| (f.monotonic_ns, LowCmd::decode_cdr(f.bytes()).unwrap().0))
+        }) {
+            steps.extend(frame);
+        }
+        assert_eq!(ring.counters().dropped(), 0);
+        let last = u32::try_from(stand.duration().as_nanos() / period.as_nanos()).unwrap();
+        let moving: Vec<_> = steps.iter().filter(|(_, c)| c.reserve.get() < last).collect();
+        assert_eq!(moving[0].1.reserve.get(), 0, "the first step at 0");
+        let mut skipped = 0;
+        for pair in moving.windows(2) {
+            let (a, b) = (pair[0].1.reserve.get(), pair[1].1.reserve.get());
+            assert!(b > a, "one step per tick, in order: {a} then {b}");
+            skipped += u64::from(b - a - 1);
+        }
+        assert!(skipped <= stats.missed_ticks, "a step is skipped only with a missed tick");
+        assert!(moving.len() as u64 + stats.missed_ticks >= u64::from(last), "{} steps of {last}", moving.len());
+        for (written_ns, cmd) in &moving {
+            let slot = period * cmd.reserve.get();
+            let mut expected = stand.command_at(slot).unwrap();
+            expected.reserve = cmd.reserve;
+            assert_eq!(cmd.motor_cmd, expected.motor_cmd, "the trajectory at {slot:?}");
+            assert!(*written_ns >= (began + slot).as_nanos(), "written at or after its slot");
+        }
+        assert!(steps.iter().any(|(_, c)| c.reserve.get() == last), "its end, then held");
+        let lowcmd = sim.snapshot().lowcmd;
+        assert!(lowcmd.accepted > 0 && lowcmd.bad_crc == 0, "{lowcmd:?}");
+    });
+}
+
+#[test]
+fn a_motion_is_refused_replaced_damped_and_closed() {
+    with_go2(|sim, robot| async move {
+        assert!(robot.wait_state(WAIT, move |_| true).await.is_some(), "state arrives");
+        // A target the robot's rules refuse (a calf bent forward): nothing sent, nothing changed.
+        let mut reckless = stand_pose();
+        reckless[2] = 0.5;
+        let refused = JointTrajectory::new(stand_pose(), reckless, Duration::from_secs(1), 60.0, 5.0);
+        assert!(matches!(robot.follow(refused), Err(UnitreeError::Command(_))));
+        assert_eq!(robot.stats().commands_sent, 0, "nothing is streamed");
+
+        let long = || JointTrajectory::new(stand_pose(), stand_pose(), Duration::from_secs(60), 60.0, 5.0);
+        let first = robot.follow(long()).unwrap();
+        // A newer command replaces it.
+        until_async(WAIT, "moving", || matches!(first.state(), MotionState::Moving { .. })).await;
+        robot.set_joints(&stand()).unwrap();
+        let end = tokio::time::timeout(WAIT, first.wait()).await.unwrap();
+        assert!(matches!(end, Err(UnitreeError::MotionEnded(MotionState::Replaced))), "{end:?}");
+        // Damping ends one.
+        let second = robot.follow(long()).unwrap();
+        until_async(WAIT, "moving", || matches!(second.state(), MotionState::Moving { .. })).await;
+        robot.damp();
+        let end = tokio::time::timeout(WAIT, second.wait()).await.unwrap();
+        assert!(matches!(end, Err(UnitreeError::MotionEnded(MotionState::Damped))), "{end:?}");
+        // Closing ends one (in damping, as always).
+        let third = robot.follow(long()).unwrap();
+        until_async(WAIT, "moving", || matches!(third.state(), MotionState::Moving { .. })).await;
+        let waiting = tokio::spawn(third.wait());
+        robot.close();
+        assert!(third.is_done());
+        assert!(matches!(tokio::time::timeout(WAIT, waiting).await.unwrap().unwrap(), Err(UnitreeError::Closed)));
+        assert!(matches!(third.wait().await, Err(UnitreeError::Closed)));
+        assert_eq!(third.state(), MotionState::Damped);
+        drop(sim);
     });
 }
 

@@ -6,10 +6,10 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use robowire_devices::Describe;
-use unitree::g1::{Device, G1, G1Options, G1Variant, JOINT_NAMES, JOINTS};
+use unitree::g1::{Device, G1, G1Options, G1Variant, JOINT_NAMES, JOINTS, from_fn};
 
 use crate::cmd::seconds;
-use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};
+use crate::cmd::unitree::{DAMP_FOR, RobotArgs, follow_then_hold};
 
 #[derive(Debug, Args)]
 pub(crate) struct G1Args {
@@ -121,10 +121,12 @@ fn driven(variant: G1Variant) -> impl Iterator<Item = usize> {
 }
 
 /// Releases the controller, moves every driven joint linearly from where it is to 0 rad over
-/// `duration` with Unitree's example gains ([`G1::hold`]), holds for `hold`, damps.
+/// `duration` with Unitree's example gains ([`G1::hold`]), followed by the LowCmd stream, holds
+/// for `hold`, damps.
 async fn zero(robot: &G1, duration: Duration, hold: Duration) -> anyhow::Result<()> {
     release(robot).await?;
     let variant = robot.variant().context("no state")?;
+    let mode_machine = robot.mode_machine().context("no state")?;
     let from = robot.joint_positions().context("no state")?;
     println!(
         "moving the {} joints of a {variant:?} G1 to 0 rad over {:.1} s (largest |q| {})",
@@ -132,12 +134,13 @@ async fn zero(robot: &G1, duration: Duration, hold: Duration) -> anyhow::Result<
         duration.as_secs_f64(),
         largest(&from, variant)
     );
-    command_for(robot, duration + hold, "moving to 0 rad", |elapsed| {
+    let to_zero = from_fn(duration, move |elapsed| {
         let remaining =
             if duration.is_zero() { 0.0 } else { 1.0 - (elapsed.as_secs_f32() / duration.as_secs_f32()).min(1.0) };
-        robot.hold(&from.map(|q| q * remaining)).context("the robot refused the command to 0 rad")
-    })
-    .await?;
+        unitree::g1::hold(&from.map(|q| q * remaining), mode_machine, variant)
+    });
+    let following = robot.follow(to_zero).context("the robot refused the command to 0 rad")?;
+    follow_then_hold(robot, following, hold, "moving to 0 rad").await?;
     let reached = robot.joint_positions().context("no state")?;
     println!("held 0 rad {:.1} s: largest |q| {}", hold.as_secs_f64(), largest(&reached, variant));
     robot.damp().context("damping was refused")?;

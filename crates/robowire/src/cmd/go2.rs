@@ -10,7 +10,7 @@ use unitree::trajectory::JointTrajectory;
 use unitree::{Device, Go2, LowLevel};
 
 use crate::cmd::seconds;
-use crate::cmd::unitree::{DAMP_FOR, RobotArgs, command_for};
+use crate::cmd::unitree::{DAMP_FOR, RobotArgs, follow_then_hold};
 
 #[derive(Debug, Args)]
 pub(crate) struct Go2Args {
@@ -100,18 +100,16 @@ async fn release(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Moves from the current pose to the stand pose over `duration` (Unitree's stand trajectory),
-/// holds for `hold`, damps.
+/// Moves from the current pose to the stand pose over `duration` (Unitree's stand trajectory,
+/// followed by the LowCmd stream), holds for `hold`, damps.
 async fn stand(robot: &LowLevel<Go2>, duration: Duration, hold: Duration) -> anyhow::Result<ExitCode> {
     release(robot).await?;
     let start = robot.joint_positions().context("no state")?;
     let stand = JointTrajectory::stand_up(start, duration);
     println!("moving from {} to the stand pose over {:.1} s", pose(&start), duration.as_secs_f64());
-    command_for(robot, duration + hold, "standing up", |elapsed| {
-        robot.set_joints(&stand.joints_at(elapsed)).context("the stand command")
-    })
-    .await
-    .inspect_err(|_| robot.damp())?;
+    // The LowCmd stream steps the move on its own deadlines, then holds the stand pose.
+    let following = robot.follow(stand).context("the stand command")?;
+    follow_then_hold(robot, following, hold, "standing up").await.inspect_err(|_| robot.damp())?;
     let reached = robot.joint_positions().context("no state")?;
     let worst = stand.largest_error_rad(&reached);
     println!("held the stand pose {:.1} s: {} (largest error {worst:.3} rad)", hold.as_secs_f64(), pose(&reached));

@@ -1,22 +1,19 @@
 //! What `robowire go2` and `robowire g1` share: where the robot is, how long to wait for its
-//! first LowState, the recording and the runtime; the 2 ms command loop of a move; how long
-//! damping is sent before exiting.
+//! first LowState, the recording and the runtime; a move followed by the LowCmd stream, then held;
+//! how long damping is sent before exiting.
 
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use clap::Args;
 use robowire_record::RecordLinks;
-use unitree::{Connection, Device, LowLevelOptions};
+use unitree::{Connection, Device, Following, LowLevelOptions};
 
 use crate::cmd::dds_args::DdsArgs;
 use crate::cmd::seconds;
 
 /// Damping sent before exiting, after a move and by `damp`.
 pub(crate) const DAMP_FOR: Duration = Duration::from_millis(500);
-
-/// How often a move sends its command (the robots' 500 Hz).
-const COMMAND_PERIOD: Duration = Duration::from_millis(2);
 
 /// A Unitree robot on DDS: where, how long to wait for it, what to record.
 #[derive(Debug, Args)]
@@ -64,25 +61,24 @@ impl RobotArgs {
     }
 }
 
-/// Calls `step` with the time since the start every 2 ms until `total` has passed (and once at
-/// or after it); fails when `step` does or when `rt/lowstate` stops (`during` says during what).
-pub(crate) async fn command_for(
+/// Waits for the motion the LowCmd stream follows to reach its end, then `hold` more while the
+/// stream holds its final command; fails when the motion ends otherwise (a refused step, the
+/// client closing) or when `rt/lowstate` stops (`during` says during what).
+pub(crate) async fn follow_then_hold(
     robot: &impl Device,
-    total: Duration,
+    following: Following,
+    hold: Duration,
     during: &str,
-    mut step: impl FnMut(Duration) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
-    let began = Instant::now();
-    let mut ticker = tokio::time::interval(COMMAND_PERIOD);
-    loop {
-        ticker.tick().await;
-        let elapsed = began.elapsed();
-        step(elapsed)?;
-        if elapsed >= total {
-            return Ok(());
-        }
-        if robot.connection() == Connection::Disconnected {
-            anyhow::bail!("rt/lowstate stopped while {during}; damping");
+    let mut connection = robot.connection_events();
+    tokio::select! {
+        done = async {
+            following.wait().await?;
+            tokio::time::sleep(hold).await;
+            anyhow::Ok(())
+        } => done,
+        _ = connection.wait_for(|c| *c == Connection::Disconnected) => {
+            anyhow::bail!("rt/lowstate stopped while {during}; damping")
         }
     }
 }

@@ -6,7 +6,8 @@ use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use crate::{Device, Hg, JointCommand, LowLevel, LowLevelStats};
+use crate::trajectory::Motion;
+use crate::{Device, Following, Hg, JointCommand, LowLevel, LowLevelStats};
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
 use robowire_dds::{StatsHandle, TopicStats};
@@ -188,6 +189,21 @@ impl G1 {
         self.set_command(command)
     }
 
+    /// Hands `motion` to the `rt/lowcmd` stream, which steps it on its own grid and holds its
+    /// final command ([`LowLevel::follow`]: no loop on the caller's side; await
+    /// [`Following::wait`]). Its commands carry the robot's `mode_machine`, as
+    /// [`unitree_proto::g1::hold`] makes them; each is checked by
+    /// [`unitree_proto::g1::check_low_cmd`] for the robot's `mode_machine` and variant as they
+    /// are now: the first and the last steps here (a refusal changes nothing and sends nothing),
+    /// every step again on the stream (a refused one ends the motion in damping).
+    /// [`set_command`](Self::set_command), [`set_joints`](Self::set_joints),
+    /// [`hold`](Self::hold) or another `follow` replace it; [`damp`](Self::damp) ends it.
+    /// [`CommandError::NoModeMachine`] before the first LowState.
+    pub fn follow(&self, motion: impl Motion<HgLowCmd> + Send + 'static) -> Result<Following, G1Error> {
+        let (mode_machine, variant) = self.machine()?;
+        Ok(self.low.follow(G1Rules { motion, mode_machine, variant })?)
+    }
+
     /// Holds `q_rad` (by slot, rad) with the gains of Unitree's G1 low-level example
     /// ([`unitree_proto::g1::DEFAULT_GAINS`]) on every joint the variant drives.
     pub fn hold(&self, q_rad: &[f32; JOINTS]) -> Result<(), G1Error> {
@@ -313,6 +329,25 @@ impl G1 {
     /// The arm weight ramped to 0, the LowCmd damping burst, then closed. Dropping does the same.
     pub fn close(self) {
         drop(self);
+    }
+}
+
+/// A motion checked by the G1's rules at each step, for the robot it was handed to.
+struct G1Rules<M> {
+    motion: M,
+    mode_machine: u8,
+    variant: G1Variant,
+}
+
+impl<M: Motion<HgLowCmd>> Motion<HgLowCmd> for G1Rules<M> {
+    fn command_at(&self, elapsed: Duration) -> Result<HgLowCmd, CommandError> {
+        let command = self.motion.command_at(elapsed)?;
+        g1::check_low_cmd(&command, Some(self.mode_machine), self.variant)?;
+        Ok(command)
+    }
+
+    fn duration(&self) -> Duration {
+        self.motion.duration()
     }
 }
 

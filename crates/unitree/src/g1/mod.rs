@@ -21,7 +21,8 @@
 //!   `unitree_proto::g1::check_low_cmd` (the robot's `mode_machine`, joint ranges, speeds and
 //!   torques, disabled and undriven slots) before anything is sent; streamed at 500 Hz; damping
 //!   (keeping `mode_machine`) 100 ms after the last command; [`G1::damp`] damps at once, even before
-//!   any command was sent.
+//!   any command was sent. [`G1::follow`]: a [`Motion`] stepped by the stream on its own grid,
+//!   each step checked by the same rules, its final command held.
 //! - **`rt/arm_sdk`** ([`G1::set_arm_joints`], [`G1::set_arm_weight`]): the arm and waist targets
 //!   blended with the robot's own controller at 50 Hz, the weight (slot 29) ramped at 0.5/s, never
 //!   switched; a stale arm command (no update for 500 ms) is ramped out; the stream goes idle at
@@ -38,21 +39,22 @@
 //!
 //! ```rust,no_run
 //! # async fn demo() -> Result<(), unitree::g1::G1Error> {
-//! use std::time::{Duration, Instant};
-//! use unitree::g1::{Device, G1, G1Options, JointCommand, JOINTS};
+//! use std::time::Duration;
+//! use unitree::g1::{Device, G1, G1Options, JointCommand, JOINTS, from_fn, hold};
 //!
 //! let robot = G1::open(G1Options::on(Some("eth0"), 0))?;
 //! let first = robot.wait_state(Duration::from_secs(3), |_| true).await.expect("rt/lowstate");
 //! println!("mode_machine {} ({:?})", first.mode_machine, robot.variant());
 //! let mode = robot.mode().await?; // e.g. "ai": the robot's controller owns the motors
 //! robot.release().await?;
-//! // Hold where the joints are, with Unitree's example gains, for 3 s.
-//! let q = robot.joint_positions().expect("a LowState");
-//! let start = Instant::now();
-//! while start.elapsed() < Duration::from_secs(3) {
-//!     robot.hold(&q)?;
-//!     tokio::time::sleep(Duration::from_millis(2)).await;
-//! }
+//! // Every joint from where it is to 0 rad over 3 s, Unitree's example gains, stepped by the
+//! // stream at 500 Hz; then held.
+//! let (from, variant) = (robot.joint_positions().expect("a LowState"), robot.variant().expect("a LowState"));
+//! let to_zero = from_fn(Duration::from_secs(3), move |elapsed| {
+//!     let left = 1.0 - elapsed.as_secs_f32() / 3.0;
+//!     hold(&from.map(|q| q * left), first.mode_machine, variant)
+//! });
+//! robot.follow(to_zero)?.wait().await?;
 //! robot.damp()?;
 //! robot.select_mode(&mode).await?; // the robot's controller again
 //! robot.loco().start().await?;
@@ -70,7 +72,10 @@ mod error;
 mod loco;
 mod options;
 
-pub use crate::{Connection, Device, JointCommand, LowLevelOptions, ParticipantOptions, Placement, Stamped};
+pub use crate::trajectory::{Motion, from_fn};
+pub use crate::{
+    Connection, Device, Following, JointCommand, LowLevelOptions, MotionState, ParticipantOptions, Placement, Stamped,
+};
 pub use arm_actions::ArmActions;
 pub use battery::Battery;
 pub use client::{ARM_JOINTS, G1, G1Stats};
@@ -82,7 +87,7 @@ pub use options::G1Options;
 pub use unitree_proto::bms::HgBmsState;
 pub use unitree_proto::g1::arm_stream;
 pub use unitree_proto::g1::{
-    ARM_SDK_JOINTS, DEFAULT_GAINS, G1Variant, JOINT_LIMITS, JOINT_NAMES, JOINTS, ModePr, slot,
+    ARM_SDK_JOINTS, DEFAULT_GAINS, G1Variant, JOINT_LIMITS, JOINT_NAMES, JOINTS, ModePr, hold, slot,
 };
 pub use unitree_proto::robot::CommandError;
 pub use unitree_proto::{HgLowCmd, HgLowState};

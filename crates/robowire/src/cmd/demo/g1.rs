@@ -13,7 +13,7 @@ use robowire_dds::qos::Qos;
 use robowire_record::RecordLinks;
 use robowire_rt::device::Device as _;
 use robowire_sim::g1::G1Sim;
-use unitree::g1::{G1, G1Error, JointCommand};
+use unitree::g1::{G1, G1Error, JointCommand, Motion, from_fn};
 use unitree_proto::g1::{self as rules, ARM_SDK_JOINTS, JOINTS, ModePr, slot};
 use unitree_proto::robot::CommandError;
 use unitree_proto::{HgLowCmd, Message};
@@ -104,22 +104,33 @@ struct Swing {
     max: f32,
 }
 
-/// Runs the 500 Hz loop for `length`, commanding `command(t)` each tick; the left ankle pitch's
-/// range as the simulator reports it.
-async fn stream(
+/// Hands `motion` to the 500 Hz LowCmd stream, which steps it on its own deadlines, and waits
+/// for its end; the left ankle pitch's range as the simulator reports it, looked at with each
+/// LowState.
+async fn follow(
     sim: &G1Sim,
-    length: Duration,
+    robot: &G1,
+    motion: impl Motion<HgLowCmd> + Send + 'static,
     progress: &mut Progress<'_>,
     mode: &str,
-    robot: &G1,
-    mut command: impl FnMut(f32) -> Result<(), G1Error>,
 ) -> anyhow::Result<Swing> {
-    let mut ticker = tokio::time::interval(Duration::from_millis(2));
-    let started = Instant::now();
+    let end = robot.follow(motion)?.wait();
+    tokio::pin!(end);
+    let mut states = robot.states();
     let mut seen = Swing { min: f32::INFINITY, max: f32::NEG_INFINITY };
-    while started.elapsed() < length {
-        ticker.tick().await;
-        command(started.elapsed().as_secs_f32())?;
+    loop {
+        tokio::select! {
+            end = &mut end => {
+                end?;
+                return Ok(seen);
+            }
+            changed = states.changed() => {
+                if changed.is_err() {
+                    (&mut end).await?;
+                    return Ok(seen);
+                }
+            }
+        }
         let pitch = sim.snapshot().joints_rad[slot::LEFT_ANKLE_PITCH];
         seen = Swing { min: seen.min.min(pitch), max: seen.max.max(pitch) };
         if progress.due() {
@@ -133,7 +144,6 @@ async fn stream(
             });
         }
     }
-    Ok(seen)
 }
 
 fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyhow::Result<DeviceReport> {
@@ -196,12 +206,13 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
 
         // 3. The zero posture, from where the joints are, over a phase; held a moment.
         let from = robot.joint_positions().context("no state")?;
-        stream(sim, phase, &mut progress, "zero", robot, |t| {
-            let ratio = (t / phase.as_secs_f32()).clamp(0.0, 1.0);
-            robot.hold(&std::array::from_fn(|i| (1.0 - ratio) * from[i]))
-        })
-        .await?;
-        stream(sim, Duration::from_millis(300), &mut progress, "hold", robot, |_| robot.hold(&[0.0; JOINTS])).await?;
+        let to_zero = from_fn(phase, move |elapsed| {
+            let ratio = (elapsed.as_secs_f32() / phase.as_secs_f32()).clamp(0.0, 1.0);
+            rules::hold(&std::array::from_fn(|i| (1.0 - ratio) * from[i]), mode_machine, rules::G1Variant::Dof29)
+        });
+        follow(sim, robot, to_zero, &mut progress, "zero").await?;
+        let zero = rules::hold(&[0.0; JOINTS], mode_machine, rules::G1Variant::Dof29);
+        follow(sim, robot, from_fn(Duration::from_millis(300), move |_| zero), &mut progress, "hold").await?;
         let zero_error = sim.snapshot().joints_rad.iter().fold(0.0f32, |m, q| m.max(q.abs()));
         out.line(format_args!(
             "  zero     every joint from where it stood to 0 rad over {:.1} s: largest |q| {zero_error:.4} rad",
@@ -209,16 +220,17 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         ));
 
         // 4. The ankles swing at 1 Hz, first as pitch/roll joints (PR), then as their A/B motors.
-        let pr = stream(sim, phase, &mut progress, "swing PR", robot, |t| robot.hold(&swing(t))).await?;
-        let ab = stream(sim, phase, &mut progress, "swing AB", robot, |t| {
-            robot.set_command(hold_ab(mode_machine, &swing(t)))
-        })
-        .await?;
+        let swing_pr = from_fn(phase, move |elapsed| {
+            rules::hold(&swing(elapsed.as_secs_f32()), mode_machine, rules::G1Variant::Dof29)
+        });
+        let pr = follow(sim, robot, swing_pr, &mut progress, "swing PR").await?;
+        let swing_ab = from_fn(phase, move |elapsed| hold_ab(mode_machine, &swing(elapsed.as_secs_f32())));
+        let ab = follow(sim, robot, swing_ab, &mut progress, "swing AB").await?;
         out.line(format_args!(
             "  ankles   ±{SWING_PITCH_RAD} rad pitch at 1 Hz: PR {:+.3}..{:+.3} rad, AB (motors A/B) {:+.3}..{:+.3} rad",
             pr.min, pr.max, ab.min, ab.max
         ));
-        stream(sim, Duration::from_millis(200), &mut progress, "hold", robot, |_| robot.hold(&[0.0; JOINTS])).await?;
+        follow(sim, robot, from_fn(Duration::from_millis(200), move |_| zero), &mut progress, "hold").await?;
 
         // 5. The two frames the robot accepts and ignores: refused by the client; sent anyway.
         let mut wrong_machine = rules::hold(&[0.0; JOINTS], mode_machine, rules::G1Variant::Dof29);

@@ -5,14 +5,14 @@
 //! injected on `rt/lowstate` and caught by the CRC.
 
 use robowire_record::RecordLinks;
-use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use robowire_core::timing::LatenessRing;
 use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_rt::stats::micros;
 use robowire_sim::go2::Go2Fault;
-use unitree::trajectory::{JointTrajectory, STAND_KD, STAND_KP};
+use unitree::trajectory::{JointTrajectory, STAND_KD, STAND_KP, from_fn};
 use unitree::{Device, LowCmd, MotorCmd};
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
@@ -62,35 +62,47 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
             mode_after
         ));
 
-        // Stand up, then hold with bit flips on the wire for a while.
+        // Stand up, then hold with bit flips on the wire for a while: one motion, stepped by the
+        // LowCmd stream on its own deadlines, each step tagged with its slot (the simulator echoes
+        // the tag in its LowState, which times command -> state).
         let move_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
         let hold_time = Duration::from_secs_f64((duration_s / 2.0).max(0.5));
         let stand = JointTrajectory::stand_up(start, move_time);
+        let period = robot.options().stream.period;
+        let tag_of = move |elapsed: Duration| u32::try_from(elapsed.as_nanos() / period.as_nanos() + 1).unwrap_or(u32::MAX);
+        let motion = from_fn(move_time + hold_time, move |elapsed| command(&stand.positions_at(elapsed), tag_of(elapsed)));
         let mut echo: LatenessRing<4096> = LatenessRing::new();
-        let mut pending: VecDeque<(u32, Instant)> = VecDeque::new();
         let mut progress = Progress::new("lowcmd", out);
-        let mut ticker = tokio::time::interval(Duration::from_millis(2));
-        let (mut tag, mut flips_on, mut flips_off) = (0u32, false, false);
+        let (mut echoed, mut flips_on, mut flips_off) = (0u32, false, false);
+        let following = robot.follow(motion)?;
         let started = Instant::now();
+        let end = following.wait();
+        tokio::pin!(end);
+        let mut states = robot.states();
         loop {
-            ticker.tick().await;
-            let elapsed = started.elapsed();
-            if elapsed >= move_time + hold_time {
-                break;
-            }
-            tag += 1;
-            robot.set_command(command(&stand.positions_at(elapsed), tag))?;
-            pending.push_back((tag, Instant::now()));
-            if let Some(state) = robot.latest() {
-                let seen = state.state.reserve.get();
-                while pending.front().is_some_and(|(t, _)| *t <= seen) {
-                    if let Some((t, at)) = pending.pop_front()
-                        && t == seen
-                    {
-                        echo.record(u32::try_from(at.elapsed().as_micros()).unwrap_or(u32::MAX));
+            tokio::select! {
+                end = &mut end => {
+                    end?;
+                    break;
+                }
+                changed = states.changed() => {
+                    if changed.is_err() {
+                        (&mut end).await?;
+                        break;
                     }
                 }
             }
+            // The step tagged `seen` was due at `began + (seen - 1) · period`.
+            let state = *states.borrow_and_update();
+            if let (Some(state), Some(began)) = (state, following.began()) {
+                let seen = state.state.reserve.get();
+                if seen > echoed {
+                    echoed = seen;
+                    let due = began + period.saturating_mul(seen - 1);
+                    echo.record(micros(state.at.saturating_duration_since(due)));
+                }
+            }
+            let elapsed = started.elapsed();
             if !flips_on && elapsed >= move_time {
                 sim.inject(Go2Fault::BitFlips { every: FLIP_EVERY });
                 flips_on = true;
@@ -101,11 +113,12 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
             }
             if progress.due() {
                 let knee = robot.joint_positions().map_or(f32::NAN, |q| q[2]);
+                let stats = robot.stats();
                 progress.show(&Status {
                     mode: if elapsed < move_time { "stand-up" } else { "hold" },
                     motion: format!("FR calf {knee:+.3} rad"),
-                    loop_count: u64::from(tag),
-                    lateness_us: (robot.stats().send_lateness.p99_us, "p99"),
+                    loop_count: stats.commands_sent,
+                    lateness_us: (stats.send_lateness.p99_us, "p99"),
                 });
             }
         }
