@@ -37,71 +37,39 @@ pub fn crc32_words(covered: &[u8]) -> Option<u32> {
 }
 
 /// CRC of `covered` with every byte ANDed with the byte of `mask` at its place first (a
-/// message's padding zeroed without a copy of the message): mask and swap in one pass through a
-/// small stack buffer, each buffer fed to the CRC as it fills. `None` as [`crc32_words`], or for a
-/// `mask` shorter than `covered`.
+/// message's padding zeroed without a copy of the message): masked and swapped in one pass into
+/// a stack buffer no larger than the message needs, then one CRC. `None` as [`crc32_words`], or
+/// for a `mask` shorter than `covered`.
 pub fn crc32_words_masked(covered: &[u8], mask: &[u8]) -> Option<u32> {
-    /// Bytes masked and swapped per CRC update: a few cache lines, in L1.
-    const CHUNK: usize = 512;
     if !covered.len().is_multiple_of(4) || covered.len() > MAX_COVERED_LEN || mask.len() < covered.len() {
         return None;
     }
-    let mut digest = Digest::new();
-    let mut buf = [0u8; CHUNK];
-    for (image, mask) in covered.chunks(CHUNK).zip(mask.chunks(CHUNK)) {
-        let (words, _) = image.as_chunks::<4>();
-        let (masks, _) = mask.as_chunks::<4>();
-        let (out, _) = buf.as_chunks_mut::<4>();
-        for ((o, w), m) in out.iter_mut().zip(words).zip(masks) {
-            *o = (u32::from_le_bytes(*w) & u32::from_le_bytes(*m)).to_be_bytes();
-        }
-        digest.update(&buf[..image.len()]);
+    // A Go2 LowCmd (808 B) or LowState (1176 B) does not pay for zeroing an HG LowState's buffer.
+    Some(if covered.len() <= 1024 {
+        masked::<1024>(covered, mask)
+    } else if covered.len() <= 1280 {
+        masked::<1280>(covered, mask)
+    } else {
+        masked::<MAX_COVERED_LEN>(covered, mask)
+    })
+}
+
+/// [`crc32_words_masked`] through an `N`-byte buffer (`covered.len() <= N`, checked by the caller).
+fn masked<const N: usize>(covered: &[u8], mask: &[u8]) -> u32 {
+    let mut buf = [0u8; N];
+    let (words, _) = covered.as_chunks::<4>();
+    let (masks, _) = mask.as_chunks::<4>();
+    let (out, _) = buf.as_chunks_mut::<4>();
+    for ((o, w), m) in out.iter_mut().zip(words).zip(masks) {
+        *o = (u32::from_le_bytes(*w) & u32::from_le_bytes(*m)).to_be_bytes();
     }
-    Some(digest.finalize())
+    backend(&buf[..covered.len()])
 }
 
 /// CRC of `covered` on the portable table backend (what `no_std` builds use).
 pub fn crc32_words_table(covered: &[u8]) -> Option<u32> {
     let (buf, len) = swapped(covered)?;
     Some(TABLE.checksum(&buf[..len]))
-}
-
-/// The fastest backend built in, fed piece by piece.
-#[cfg(feature = "std")]
-struct Digest(crc_fast::Digest);
-
-#[cfg(feature = "std")]
-impl Digest {
-    fn new() -> Self {
-        Self(crc_fast::Digest::new(crc_fast::CrcAlgorithm::Crc32Mpeg2))
-    }
-
-    fn update(&mut self, bytes: &[u8]) {
-        self.0.update(bytes);
-    }
-
-    fn finalize(self) -> u32 {
-        // A 32-bit algorithm: the u64 result fits in u32.
-        self.0.finalize() as u32
-    }
-}
-
-#[cfg(not(feature = "std"))]
-struct Digest(crc::Digest<'static, u32, crc::Table<16>>);
-
-#[cfg(not(feature = "std"))]
-impl Digest {
-    fn new() -> Self {
-        Self(TABLE.digest())
-    }
-
-    fn update(&mut self, bytes: &[u8]) {
-        self.0.update(bytes);
-    }
-
-    fn finalize(self) -> u32 {
-        self.0.finalize()
-    }
 }
 
 #[cfg(feature = "std")]
