@@ -71,8 +71,9 @@ pub fn fetch(python: &Path, target: &Path) -> anyhow::Result<PathBuf> {
     Ok(dir)
 }
 
-/// The physics tests: robowire-sim's and the CLI's (Unitree's examples against the physics
-/// simulators) and the conformance tests' physics half, with the feature `mujoco`.
+/// The physics tests: robowire-sim's, robowire-devices' (`sim:go2` and `sim:g1` by address) and
+/// the CLI's (Unitree's examples against the physics simulators) and the conformance tests'
+/// physics half, with the feature `mujoco`.
 pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
     let dir = match lib_dir(target) {
         Ok(dir) => dir,
@@ -89,8 +90,9 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
         }
         None => dir.clone().into_os_string(),
     };
-    let runs: [&[&str]; 2] = [
+    let runs: [&[&str]; 3] = [
         &["test", "-p", "robowire-sim", "--features", "mujoco", "--test", "physics", "--test", "unitree_conformance"],
+        &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "physics"],
         &["test", "-p", "robowire", "--features", "mujoco", "--test", "physics"],
     ];
     for args in runs {

@@ -14,6 +14,7 @@ mod observation;
 mod sim;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::path::PathBuf;
 use std::time::Duration;
 
 pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
@@ -59,6 +60,25 @@ pub struct OpenOptions {
     /// (described by `unitree_proto::description::HG_LOW_LEVEL` and `API_CLIENT`), `spline/spline` (the states a
     /// monitor takes from `/spline_shm`).
     pub record: Option<RecordLinks>,
+    /// The body of `sim:go2`'s and `sim:g1`'s simulator: `None`, its kinematic joints; `Some`,
+    /// MuJoCo physics, as `robowire sim go2|g1 --physics` runs it (a build with the `mujoco`
+    /// feature). Physics asked of any other address is [`DeviceError::NoPhysics`], and of a
+    /// build without the feature [`DeviceError::PhysicsNotBuilt`]: never the kinematic body.
+    pub sim_physics: Option<SimPhysics>,
+}
+
+/// MuJoCo physics behind a simulated robot's body (`sim:go2`, `sim:g1`): the robot stands, sinks
+/// and falls under its motors' torques instead of following them joint by joint.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SimPhysics {
+    /// A user's MJCF file (a scene with a floor and the robot, e.g. unitree_mujoco's or MuJoCo
+    /// Menagerie's `scene.xml`), its joints found by the motors' names; `None`: robowire's own
+    /// model of the robot.
+    pub model: Option<PathBuf>,
+    /// The base held where it starts by a stiff spring (as on Unitree's elastic band), or free on
+    /// the floor; `None`: as `robowire sim` has it, a Go2 free (lying on its floor) and a G1
+    /// hanging (its balance controller is not simulated).
+    pub hanging: Option<bool>,
 }
 
 impl Default for OpenOptions {
@@ -70,6 +90,7 @@ impl Default for OpenOptions {
             kmc_polls: true,
             state_timeout: None,
             record: None,
+            sim_physics: None,
         }
     }
 }
@@ -128,6 +149,23 @@ pub enum DeviceError {
     /// A `sim:` address in a build without the `sim` feature.
     #[error("{address}: this build has no simulators (the `sim` feature of robowire-devices is off)")]
     NoSimulators {
+        /// The address.
+        address: DeviceAddress,
+    },
+    /// Physics asked of a device without a simulated body.
+    #[error("{address} has no physics: MuJoCo simulates the bodies of sim:go2 and sim:g1 only")]
+    NoPhysics {
+        /// The address.
+        address: DeviceAddress,
+    },
+    /// Physics asked of a build without MuJoCo.
+    #[error(
+        "{address}: this build is without physics: build it with the `mujoco` feature (robowire's, robowire-py's \
+         or robowire-devices': `cargo build --release -p robowire --features mujoco`), MUJOCO_DYNAMIC_LINK_DIR \
+         naming a directory with MuJoCo 3.17.0's libmujoco.so (`cargo xtask mujoco` fetches it), and run it with \
+         that directory on LD_LIBRARY_PATH"
+    )]
+    PhysicsNotBuilt {
         /// The address.
         address: DeviceAddress,
     },
@@ -190,6 +228,7 @@ impl std::fmt::Debug for AnyDevice {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+    physics_possible(address, options)?;
     let link = match address {
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
         _ => kinds::open(address, options)?,
@@ -200,6 +239,21 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
         #[cfg(feature = "sim")]
         simulator: None,
     })
+}
+
+/// Physics only where there is a simulated body, and only in a build with MuJoCo (which builds
+/// the simulators and the Unitree kinds with it); checked before anything starts.
+fn physics_possible(address: &DeviceAddress, options: &OpenOptions) -> Result<(), DeviceError> {
+    if options.sim_physics.is_none() {
+        return Ok(());
+    }
+    if !matches!(address, DeviceAddress::Sim(SimKind::Go2 | SimKind::G1)) {
+        return Err(DeviceError::NoPhysics { address: address.clone() });
+    }
+    if !cfg!(feature = "mujoco") {
+        return Err(DeviceError::PhysicsNotBuilt { address: address.clone() });
+    }
+    Ok(())
 }
 
 #[cfg(feature = "sim")]
@@ -387,5 +441,37 @@ impl AnyDevice {
         #[cfg(feature = "sim")]
         drop(self.simulator);
         closed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Opens `address` with physics: the error.
+    fn with_physics(address: &str) -> DeviceError {
+        let options = OpenOptions { sim_physics: Some(SimPhysics::default()), ..OpenOptions::default() };
+        open(&address.parse().unwrap(), &options).expect_err(address)
+    }
+
+    #[test]
+    fn physics_is_for_sim_go2_and_sim_g1_only() {
+        for address in ["sim:kmc", "sim:zsl1", "sim:spline", "go2:lo", "g1:lo", "kmc:/dev/robowire-no-such-port"] {
+            let error = with_physics(address);
+            assert!(matches!(&error, DeviceError::NoPhysics { address: a } if a.to_string() == address), "{error:?}");
+            assert!(error.to_string().contains("MuJoCo simulates the bodies of sim:go2 and sim:g1 only"), "{error}");
+        }
+    }
+
+    #[cfg(not(feature = "mujoco"))]
+    #[test]
+    fn physics_in_a_build_without_mujoco_says_how_to_build_it() {
+        for address in ["sim:go2", "sim:g1"] {
+            let error = with_physics(address);
+            assert!(matches!(&error, DeviceError::PhysicsNotBuilt { address: a } if a.to_string() == address));
+            let text = error.to_string();
+            assert!(text.contains("without physics") && text.contains("`mujoco` feature"), "{text}");
+            assert!(text.contains("MUJOCO_DYNAMIC_LINK_DIR") && text.contains("LD_LIBRARY_PATH"), "{text}");
+        }
     }
 }

@@ -78,9 +78,13 @@ pub(crate) fn open(
         SimKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
             let client = crate::kinds::unitree::low_level_options::<unitree::Go2>(Some(interface), options);
-            let sim =
-                Go2Sim::spawn(Go2SimConfig { participant: client.participant.clone(), ..Go2SimConfig::default() })
-                    .map_err(|e| failed(e.into()))?;
+            let sim = Go2Sim::spawn(Go2SimConfig {
+                participant: client.participant.clone(),
+                #[cfg(feature = "mujoco")]
+                physics: physics(options, false),
+                ..Go2SimConfig::default()
+            })
+            .map_err(|e| failed(e.into()))?;
             let client = unitree::LowLevel::<unitree::Go2>::open(client)?;
             (Simulator::Go2(sim), Box::new(client))
         }
@@ -89,12 +93,28 @@ pub(crate) fn open(
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
             let client = crate::kinds::g1::client_options(Some(interface), options);
             let participant = client.low_level.participant.clone();
-            let sim =
-                G1Sim::spawn(G1SimConfig { participant, ..G1SimConfig::default() }).map_err(|e| failed(e.into()))?;
+            let sim = G1Sim::spawn(G1SimConfig {
+                participant,
+                #[cfg(feature = "mujoco")]
+                physics: physics(options, true),
+                ..G1SimConfig::default()
+            })
+            .map_err(|e| failed(e.into()))?;
             let client = unitree::g1::G1::open(client)?;
             (Simulator::G1(sim), Box::new(client))
         }
         #[allow(unreachable_patterns)] // every kind built
         _ => return Err(crate::kinds::not_built(address)),
+    })
+}
+
+/// The simulator's physics (`hanging`: whether the robot hangs unless told), `None` for the
+/// kinematic body. Physics reaches here only in a build with MuJoCo (`crate::physics_possible`).
+#[cfg(feature = "mujoco")]
+fn physics(options: &OpenOptions, hanging: bool) -> Option<robowire_sim::physics::PhysicsOptions> {
+    let physics = options.sim_physics.as_ref()?;
+    Some(robowire_sim::physics::PhysicsOptions {
+        model: physics.model.clone(),
+        hanging: physics.hanging.unwrap_or(hanging),
     })
 }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, Observation, OpenOptions};
+use robowire_devices::{AnyDevice, DeviceAddress, DeviceError, Observation, OpenOptions, SimPhysics};
 use zsl::udp::{CallError, Refusal};
 
 use crate::errors::{Kind, chain, error};
@@ -25,6 +25,7 @@ fn raise(e: DeviceError) -> PyErr {
         DeviceError::ZslConnect(e) => crate::zsl::connect_error("ZSL-1 client", &e),
         e @ (DeviceError::Address(_)
         | DeviceError::NoSuchService { .. }
+        | DeviceError::NoPhysics { .. }
         | DeviceError::ZslCall(CallError::Refused(Refusal::Argument(_)))) => error(Kind::Argument, chain(&e)),
         e => error(Kind::Error, chain(&e)),
     }
@@ -245,18 +246,37 @@ impl Device {
     }
 }
 
+/// `physics`, `model` and `free_base` as `OpenOptions::sim_physics`: the latter two need the first.
+fn sim_physics(physics: bool, model: Option<std::path::PathBuf>, free_base: bool) -> PyResult<Option<SimPhysics>> {
+    if !physics && (model.is_some() || free_base) {
+        return Err(error(Kind::Argument, "model and free_base need physics=True"));
+    }
+    Ok(physics.then(|| SimPhysics { model, hanging: free_base.then_some(false) }))
+}
+
 /// Opens the device at `address` (`kmc:/dev/ttyUSB0`, `zsl1:192.168.234.1`, `zsl1w:IP`,
 /// `go2:eth0`, `hg:eth0`, `sim:kmc|zsl1|zsl1w|go2`); `domain` is the DDS domain of `go2:`, `hg:`
 /// and `sim:go2`. `record`: a path or a `robowire.Recorder` to record the client's links into
 /// (`kmc/serial`, `zsl1/high_level`, `go2/low_level` and `go2/api`, …). A bad address raises
-/// `ArgumentError`.
+/// `ArgumentError`. `physics`: `sim:go2`'s or `sim:g1`'s body in MuJoCo (a wheel built with the
+/// `mujoco` feature; `robowire.Error` without it, `ArgumentError` for any other address), the
+/// G1 hanging by its pelvis unless `free_base`; `model`: a user's MJCF instead of robowire's.
 #[pyfunction]
-#[pyo3(signature = (address, *, domain = 0, record = None))]
-pub(crate) fn open(py: Python<'_>, address: &str, domain: u16, record: Option<&Bound<'_, PyAny>>) -> PyResult<Device> {
+#[pyo3(signature = (address, *, domain = 0, record = None, physics = false, model = None, free_base = false))]
+pub(crate) fn open(
+    py: Python<'_>,
+    address: &str,
+    domain: u16,
+    record: Option<&Bound<'_, PyAny>>,
+    physics: bool,
+    model: Option<std::path::PathBuf>,
+    free_base: bool,
+) -> PyResult<Device> {
     let parsed: DeviceAddress =
         address.parse().map_err(|e: robowire_devices::AddressError| error(Kind::Argument, e))?;
+    let sim_physics = sim_physics(physics, model, free_base)?;
     let (record, capture) = record_arg(record, &format!("robowire.open({address:?})"))?;
-    let options = OpenOptions { domain, record, ..OpenOptions::default() };
+    let options = OpenOptions { domain, record, sim_physics, ..OpenOptions::default() };
     let device = py.detach(|| robowire_devices::open(&parsed, &options)).map_err(raise)?;
     let kind = device.kind().name();
     Ok(Device { device: Owned::new("device", Arc::new(device)), address: parsed.to_string(), kind, capture })

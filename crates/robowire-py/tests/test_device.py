@@ -99,6 +99,18 @@ def test_a_bad_address_is_an_argument_error(address):
     assert isinstance(raised.value, ValueError)
 
 
+@pytest.mark.parametrize("address", ["sim:kmc", "sim:zsl1", "go2:lo", "kmc:/dev/robowire-no-such-port"])
+def test_physics_of_a_device_without_a_simulated_body_is_an_argument_error(address):
+    with pytest.raises(robowire.ArgumentError, match="MuJoCo simulates the bodies of sim:go2 and sim:g1 only"):
+        robowire.open(address, physics=True)
+
+
+def test_a_model_or_a_free_base_needs_physics():
+    for extra in ({"model": "scene.xml"}, {"free_base": True}):
+        with pytest.raises(robowire.ArgumentError, match="physics=True"):
+            robowire.open("sim:go2", **extra)
+
+
 def test_a_missing_serial_port_is_a_port_error():
     with pytest.raises(robowire.PortError) as raised:
         robowire.open("kmc:/dev/robowire-no-such-port")

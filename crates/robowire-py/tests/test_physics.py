@@ -1,7 +1,9 @@
 """robowire.sim.Go2 and robowire.sim.G1 with physics (MuJoCo, a wheel built with the cargo
-feature ``mujoco``; ``cargo xtask test`` builds one when MuJoCo is here). A wheel without it
-refuses ``physics=True`` with robowire.Error."""
+feature ``mujoco``; ``cargo xtask test`` builds one when MuJoCo is here), and the same bodies by
+address (``robowire.open("sim:go2", physics=True)``). A wheel without it refuses ``physics=True``
+with robowire.Error."""
 
+import math
 import time
 
 import pytest
@@ -36,6 +38,42 @@ def test_without_physics_the_simulators_say_so_or_have_a_body(dds):
     with sim:
         body = sim.snapshot()["body"]
         assert body["base"] is not None and 0.05 < body["base"]["position_m"][2] < 0.2, body
+
+
+def test_without_physics_open_by_address_says_so_or_has_a_body(dds):
+    try:
+        go2 = robowire.open("sim:go2", domain=12, physics=True)
+    except robowire.Error as e:
+        assert "without physics" in str(e) and "mujoco" in str(e), e
+        with pytest.raises(robowire.Error, match="without physics"):
+            robowire.open("sim:g1", domain=12, physics=True)
+        return
+    with go2:
+        assert go2.wait_state(timeout_s=10.0)
+        # The hips splay under the body's weight from the lying pose the kinematic body holds
+        # exactly (at 0).
+        q = go2.observe()["joints"]["position_rad"]
+        assert min(abs(q[0]), abs(q[3])) > 0.01, q
+
+
+def tilt_rad(device):
+    """The base's tilt from upright a second from now, by its IMU."""
+    assert device.wait_state(timeout_s=10.0)
+    time.sleep(1.0)
+    x, y, _, _ = device.observe()["imu"]["orientation_xyzw"]
+    return 2.0 * math.asin(min(1.0, math.hypot(x, y)))
+
+
+def test_the_physics_g1_by_address_hangs_unless_its_base_is_free(dds):
+    physics_go2(13).close()  # skips without physics
+    with robowire.open("sim:g1", domain=13, physics=True) as g1:
+        assert tilt_rad(g1) < 0.1, "hanging by its pelvis"
+    with robowire.open("sim:g1", domain=13, physics=True, free_base=True) as g1:
+        deadline = time.monotonic() + 10.0  # a failure bound: it falls in about a second
+        tilt = tilt_rad(g1)
+        while tilt < 0.8 and time.monotonic() < deadline:
+            tilt = tilt_rad(g1)
+        assert tilt > 0.8, f"free, without a balance controller, it falls: {tilt} rad"
 
 
 def test_a_model_needs_physics(dds):

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use robowire_dds::{Participant, ParticipantOptions};
-use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
+use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions, SimPhysics};
 use robowire_record::RecordLinks;
 use tokio::sync::watch;
 
@@ -43,6 +43,10 @@ pub struct BridgeOptions {
     /// The layout of `ros_discovery_info` (the nodes in the ROS graph): Humble's 24-byte GIDs
     /// or Jazzy's 16-byte ones. Default Jazzy.
     pub ros_distro: RosDistro,
+    /// MuJoCo physics behind the `sim:go2` and `sim:g1` devices (`--physics`; robowire-devices'
+    /// feature `mujoco`); any other device asked for it fails to open
+    /// (`robowire_devices::DeviceError::NoPhysics`). `None`: their kinematic bodies.
+    pub sim_physics: Option<SimPhysics>,
 }
 
 impl BridgeOptions {
@@ -59,6 +63,7 @@ impl BridgeOptions {
             record: None,
             record_devices: None,
             ros_distro: RosDistro::default(),
+            sim_physics: None,
         }
     }
 }
@@ -160,6 +165,7 @@ pub async fn run(
                 .record_devices
                 .as_ref()
                 .map(|r| if namespace.is_empty() { r.clone() } else { r.under(namespace) }),
+            sim_physics: options.sim_physics.clone(),
             ..OpenOptions::default()
         };
         opened.push(Arc::new(robowire_devices::open(&device.address, &open_options).map_err(failed)?));

@@ -1,6 +1,7 @@
 //! `robowire status ADDRESS` and `robowire watch ADDRESS` for every kind of address, against
 //! the simulators: a chassis on a pseudo-terminal, a ZSL-1 on loopback UDP, and the `sim:`
-//! addresses. (The Go2 on DDS is in `tests/go2.rs`, in a private network.)
+//! addresses; physics asked of a device without a simulated body. (The Go2 on DDS is in
+//! `tests/go2.rs`, in a private network.)
 
 mod support;
 
@@ -86,4 +87,29 @@ fn a_silent_device_and_a_bad_address_are_one_clear_line_each() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("kmc:/dev/robowire-no-such-port") && err.contains("cannot open serial port"), "{err}");
+}
+
+#[test]
+fn physics_is_for_sim_go2_and_sim_g1_and_asks_for_the_mujoco_build() {
+    let refused = |args: &[&str], code: i32| {
+        let out = robowire().args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        err
+    };
+    let no_body = ["status", "sim:kmc", "--physics"];
+    let no_body_either = ["ros2", "--device", "sim:zsl1", "--physics", "--duration", "0"];
+    for args in [&no_body[..], &["watch", "sim:zsl1", "--physics"], &no_body_either] {
+        let err = refused(args, 1);
+        assert!(err.contains("has no physics: MuJoCo simulates the bodies of sim:go2 and sim:g1 only"), "{err}");
+    }
+    for args in [&["status", "sim:go2", "--model", "scene.xml"][..], &["watch", "sim:g1", "--free-base"]] {
+        assert!(refused(args, 2).contains("--physics"), "a usage error: {args:?}");
+    }
+    #[cfg(not(feature = "mujoco"))]
+    {
+        let err = refused(&["status", "sim:go2", "--physics"], 1);
+        assert!(err.contains("without physics") && err.contains("--features mujoco"), "{err}");
+    }
 }

@@ -4,8 +4,10 @@
 //! `physics_interop/observe_body.py`); `robowire go2 stand` ends in the damping of
 //! `robowire go2 damp`, under which the robot sinks; the G1 low-level example brings the
 //! hanging physics G1 to its zero posture and swings its ankles. Each where loopback carries
-//! multicast (`robowire_dds::netns`). The sans-IO physics checks (a tenth of the gains, the
-//! damped and silent robot, a user's model) are robowire-sim's `tests/physics.rs`.
+//! multicast (`robowire_dds::netns`). `robowire status sim:go2 --physics` reads a LowState of
+//! the body in MuJoCo. The sans-IO physics checks (a tenth of the gains, the damped and silent
+//! robot, a user's model) are robowire-sim's `tests/physics.rs`; `sim:go2` and `sim:g1` with
+//! physics by address, robowire-devices' `tests/physics.rs`.
 
 mod support;
 
@@ -99,4 +101,17 @@ fn unitree_g1_low_level_example_brings_the_hanging_physics_g1_to_its_zero_postur
         let log = sim.interrupt().stdout;
         assert!(log.contains("ReleaseMode: sport mode \"ai\" released"), "{log}");
     });
+}
+
+#[test]
+fn robowire_status_sim_go2_physics_reads_the_body_in_mujoco() {
+    // The CLI finds multicast on loopback for its simulator and client itself.
+    let out = robowire().args(["status", "sim:go2", "--physics", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let state: Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The kinematic body has no feet on a floor and holds its lying pose exactly (hips at 0).
+    let feet: Vec<u64> = state["foot_force"].as_array().unwrap().iter().map(|f| f.as_u64().unwrap()).collect();
+    assert!(feet.iter().all(|f| *f > 0), "MuJoCo's contacts on every foot: {feet:?}");
+    let hip = state["motor_state"][0]["q"].as_f64().unwrap();
+    assert!(hip.abs() > 0.01, "the FR hip splays under the body's weight: {hip}");
 }

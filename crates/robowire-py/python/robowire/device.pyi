@@ -9,9 +9,19 @@ from .record import Recorder
 
 __all__ = ["Device", "open"]
 
-def open(address: str, *, domain: int = 0, record: Union[str, PathLike[str], Recorder, None] = None) -> Device:
+def open(
+    address: str,
+    *,
+    domain: int = 0,
+    record: Union[str, PathLike[str], Recorder, None] = None,
+    physics: bool = False,
+    model: Union[str, PathLike[str], None] = None,
+    free_base: bool = False,
+) -> Device:
     """kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:kmc|zsl1|zsl1w|go2; a bad address raises ArgumentError.
-    record: a path (a capture of its own, finished by close()) or a Recorder."""
+    record: a path (a capture of its own, finished by close()) or a Recorder. physics: sim:go2's or sim:g1's body in
+    MuJoCo (a wheel built with the `mujoco` feature, else robowire.Error; ArgumentError for any other address), the G1
+    hanging by its pelvis unless free_base; model: a user's MJCF instead of robowire's model."""
 
 class Device:
     """A device opened by robowire.open(address)."""

@@ -27,6 +27,9 @@ pub(crate) struct DeviceArgs {
     /// `zsl1/high_level`, `go2/low_level`, `g1/low_level`, `spline/spline`, …).
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
+    /// sim:go2's and sim:g1's body: --physics [--model MJCF] [--free-base].
+    #[command(flatten)]
+    body: crate::cmd::sim_body::SimPhysicsArgs,
 }
 
 #[derive(Debug, Args)]
@@ -66,7 +69,13 @@ impl DeviceArgs {
     /// state.
     async fn open(&self, record: Option<RecordLinks>) -> anyhow::Result<AnyDevice> {
         let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
-        let options = OpenOptions { domain: self.domain, zsl_local: self.local, record, ..OpenOptions::default() };
+        let options = OpenOptions {
+            domain: self.domain,
+            zsl_local: self.local,
+            record,
+            sim_physics: self.body.options(),
+            ..OpenOptions::default()
+        };
         let address = &self.address;
         let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
         if !device.wait_state(timeout).await {

@@ -48,6 +48,10 @@ pub(crate) struct Ros2Args {
     /// device's own links beside it, into FILE-devices.mcap.
     #[command(flatten)]
     record: crate::cmd::record::RecordArgs,
+    /// The body of the sim:go2 and sim:g1 devices: --physics [--model MJCF] [--free-base]
+    /// (then every device must be one of them).
+    #[command(flatten)]
+    body: crate::cmd::sim_body::SimPhysicsArgs,
 }
 
 /// `--ros-distro`, else `$ROS_DISTRO`, else Jazzy.
@@ -91,6 +95,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         record: recorder.as_ref().map(robowire_record::Recorder::links),
         record_devices: devices_recorder.as_ref().map(robowire_record::Recorder::links),
         ros_distro,
+        sim_physics: args.body.options(),
         ..BridgeOptions::new(args.devices.clone())
     };
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;

@@ -1,12 +1,13 @@
-//! The body behind `robowire sim go2|g1`: the kinematic joint model or MuJoCo physics
-//! (`--physics [--model MJCF]`, in a build with the `mujoco` feature), and how its time runs
-//! (`--speed X`).
+//! The body behind `robowire sim go2|g1` and behind `sim:go2`/`sim:g1` opened by address
+//! (`robowire status|watch`, `robowire ros2 --device`): the kinematic joint model or MuJoCo
+//! physics (`--physics [--model MJCF]`, in a build with the `mujoco` feature), and how a
+//! simulator's time runs (`--speed X`).
 
 use clap::Args;
 
-/// How the simulated robot's body and time run.
+/// The simulated robot's body: its kinematic joints or MuJoCo physics.
 #[derive(Debug, Args)]
-pub(crate) struct BodyArgs {
+pub(crate) struct PhysicsArgs {
     /// Simulate the body in MuJoCo (a build with the `mujoco` feature): the robot stands, sinks
     /// and falls under its motors' torques instead of following them joint by joint.
     #[arg(long)]
@@ -16,6 +17,35 @@ pub(crate) struct BodyArgs {
     /// found by the motors' names (FR_hip_joint, …, left_hip_pitch_joint, …).
     #[arg(long, value_name = "MJCF", requires = "physics")]
     model: Option<std::path::PathBuf>,
+}
+
+/// The body of a `sim:go2` or `sim:g1` opened by address (`robowire status|watch`,
+/// `robowire ros2 --device`); physics asked of any other address is an error.
+#[derive(Debug, Args)]
+pub(crate) struct SimPhysicsArgs {
+    #[command(flatten)]
+    body: PhysicsArgs,
+    /// With --physics: the base free on the floor (sim:g1 otherwise hangs by its pelvis, as in
+    /// `robowire sim g1`; sim:go2 is free either way).
+    #[arg(long, requires = "physics")]
+    free_base: bool,
+}
+
+impl SimPhysicsArgs {
+    /// What `robowire_devices::open` is asked for: `None`, the kinematic body.
+    pub(crate) fn options(&self) -> Option<robowire_devices::SimPhysics> {
+        self.body.physics.then(|| robowire_devices::SimPhysics {
+            model: self.body.model.clone(),
+            hanging: self.free_base.then_some(false),
+        })
+    }
+}
+
+/// How the simulated robot's body and time run.
+#[derive(Debug, Args)]
+pub(crate) struct BodyArgs {
+    #[command(flatten)]
+    body: PhysicsArgs,
     /// Simulated seconds per wall second (0 < X <= 100).
     #[arg(long, value_name = "X", default_value_t = 1.0)]
     speed: f32,
@@ -29,7 +59,7 @@ impl BodyArgs {
 
     /// What the startup line says of the body.
     pub(crate) fn describe(&self) -> String {
-        let body = match (&self.physics, &self.model) {
+        let body = match (&self.body.physics, &self.body.model) {
             (false, _) => "kinematic joints".to_string(),
             (true, None) => "MuJoCo physics, robowire's model".to_string(),
             (true, Some(model)) => format!("MuJoCo physics, {}", model.display()),
@@ -40,14 +70,14 @@ impl BodyArgs {
     /// The physics options (`hanging`: the base held), or `None` for the kinematic body.
     #[cfg(feature = "mujoco")]
     pub(crate) fn physics(&self, hanging: bool) -> anyhow::Result<Option<robowire_sim::physics::PhysicsOptions>> {
-        Ok(self.physics.then(|| robowire_sim::physics::PhysicsOptions { model: self.model.clone(), hanging }))
+        Ok(self.body.physics.then(|| robowire_sim::physics::PhysicsOptions { model: self.body.model.clone(), hanging }))
     }
 
     /// Refuses `--physics` in a build without MuJoCo.
     #[cfg(not(feature = "mujoco"))]
     pub(crate) fn physics(&self, _hanging: bool) -> anyhow::Result<Option<()>> {
         anyhow::ensure!(
-            !self.physics,
+            !self.body.physics,
             "this robowire was built without physics: build it with `cargo build --release -p robowire --features \
              mujoco`, MUJOCO_DYNAMIC_LINK_DIR naming a directory with MuJoCo 3.17.0's libmujoco.so (the PyPI wheel \
              mujoco==3.17.0 ships it), and run it with that directory on LD_LIBRARY_PATH"
