@@ -437,10 +437,7 @@ impl AnyDevice {
     /// simulator. When this returns, its port or socket can be opened again.
     pub fn close(self) -> Result<(), DeviceError> {
         // The link first; the simulator (dropped at the end of this scope) hears its last word.
-        let closed = self.link.close();
-        #[cfg(feature = "sim")]
-        drop(self.simulator);
-        closed
+        self.link.close()
     }
 }
 
