@@ -19,7 +19,7 @@ pub enum DeviceAddress {
     /// `hg:eth0` (or `h1:eth0`): a Unitree HG robot's (H1-2; a G1 without its own rules) low-level
     /// interface on that interface. A G1 is `g1:`.
     Hg(String),
-    /// `g1:eth0`: a Unitree G1 humanoid on that interface, through the `g1` facade.
+    /// `g1:eth0`: a Unitree G1 humanoid on that interface, through `unitree::g1`.
     G1(String),
     /// `spline:/spline_shm`: a ZSL-1's spline daemon on shared memory, watched.
     Spline(String),

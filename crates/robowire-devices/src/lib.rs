@@ -7,8 +7,8 @@
 )]
 
 mod address;
+mod facade;
 mod kinds;
-mod link;
 mod observation;
 #[cfg(feature = "sim")]
 mod sim;
@@ -18,19 +18,19 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
+pub use facade::{Describe, Observations, StateChanges};
 #[cfg(feature = "kmc")]
 pub use kinds::kmc::kmc_taps;
 #[cfg(feature = "zsl1")]
 pub use kinds::spline::{SPLINE_IMU_LINK, SPLINE_LINK};
 #[cfg(feature = "zsl1")]
 pub use kinds::zsl1::state_line as zsl_state_line;
-pub use link::{Describe, Observations, StateChanges};
 pub use observation::{BatteryReading, ImuReading, JointReadings, MotorReport, Observation, Odometry, Passthrough};
 pub use robowire_rt::device::Connection;
 #[cfg(feature = "sim")]
 pub use sim::Simulator;
 
-use link::Link;
+use facade::Facade;
 use robowire_tap::RecordLinks;
 use serde_json::Value;
 use tokio::sync::watch;
@@ -205,8 +205,8 @@ pub fn error_chain(error: &dyn std::error::Error) -> String {
 /// simulator, if any).
 pub struct AnyDevice {
     address: DeviceAddress,
-    link: Box<dyn Link>,
-    /// Dropped after the link: the client says its last word to a live simulator.
+    facade: Box<dyn Facade>,
+    /// Dropped after the facade: the client says its last word to a live simulator.
     #[cfg(feature = "sim")]
     simulator: Option<Simulator>,
 }
@@ -229,13 +229,13 @@ impl std::fmt::Debug for AnyDevice {
 /// ```
 pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
     physics_possible(address, options)?;
-    let link = match address {
+    let facade = match address {
         DeviceAddress::Sim(kind) => return open_simulated(address, *kind, options),
         _ => kinds::open(address, options)?,
     };
     Ok(AnyDevice {
         address: address.clone(),
-        link,
+        facade,
         #[cfg(feature = "sim")]
         simulator: None,
     })
@@ -258,8 +258,8 @@ fn physics_possible(address: &DeviceAddress, options: &OpenOptions) -> Result<()
 
 #[cfg(feature = "sim")]
 fn open_simulated(address: &DeviceAddress, kind: SimKind, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
-    let (simulator, link) = sim::open(address, kind, options)?;
-    Ok(AnyDevice { address: address.clone(), link, simulator: Some(simulator) })
+    let (simulator, facade) = sim::open(address, kind, options)?;
+    Ok(AnyDevice { address: address.clone(), facade, simulator: Some(simulator) })
 }
 
 #[cfg(not(feature = "sim"))]
@@ -268,8 +268,8 @@ fn open_simulated(address: &DeviceAddress, _: SimKind, _: &OpenOptions) -> Resul
 }
 
 impl AnyDevice {
-    fn link(&self) -> &dyn Link {
-        self.link.as_ref()
+    fn facade(&self) -> &dyn Facade {
+        self.facade.as_ref()
     }
 
     /// The address it was opened by.
@@ -284,22 +284,22 @@ impl AnyDevice {
 
     /// The connection as the device's watchdog sees it.
     pub fn connection(&self) -> Connection {
-        *self.link().connection_events().borrow()
+        *self.facade().connection_events().borrow()
     }
 
     /// Connection events: `Waiting` → `Connected` → `Disconnected` → `Connected` ….
     pub fn connection_events(&self) -> watch::Receiver<Connection> {
-        self.link().connection_events()
+        self.facade().connection_events()
     }
 
     /// Wakes at every new state.
     pub fn state_changes(&self) -> StateChanges {
-        self.link().changes()
+        self.facade().changes()
     }
 
     /// How long ago the latest state arrived (`None` before the first).
     pub fn state_age(&self) -> Option<Duration> {
-        self.link().age()
+        self.facade().age()
     }
 
     /// Waits up to `timeout` for a first state (needs a tokio runtime with its timer);
@@ -324,100 +324,100 @@ impl AnyDevice {
     /// The latest state as JSON: the fields of the device's own status command
     /// (`robowire zsl1 status --json`, `robowire go2 status --json`).
     pub fn status_json(&self) -> Option<Value> {
-        self.link().status_json()
+        self.facade().status_json()
     }
 
     /// The latest state as a few lines of text.
     pub fn status_text(&self) -> Option<String> {
-        self.link().status_text()
+        self.facade().status_text()
     }
 
     /// The latest state as one line, with its age.
     pub fn status_line(&self) -> Option<String> {
-        self.link().status_line()
+        self.facade().status_line()
     }
 
     /// The client's counters as one line.
     pub fn stats_line(&self) -> String {
-        self.link().stats_line()
+        self.facade().stats_line()
     }
 
     /// The latest state, device-neutral (`None` before the first).
     pub fn observe(&self) -> Option<Observation> {
-        self.link().observe()
+        self.facade().observe()
     }
 
     /// Every state from now on, in order, device-neutral (a bridge publishes each).
     pub fn observations(&self) -> Observations {
-        self.link().observations()
+        self.facade().observations()
     }
 
     /// Whether it is driven by a velocity ([`drive`](Self::drive)).
     pub fn can_drive(&self) -> bool {
-        self.link().can_drive()
+        self.facade().can_drive()
     }
 
     /// Drives a mobile base: forward m/s, left m/s, yaw rate rad/s, checked by the device's own
     /// rules before anything is sent.
     pub fn drive(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), DeviceError> {
-        self.link().drive(vx_mps, vy_mps, yaw_rate_radps)
+        self.facade().drive(vx_mps, vy_mps, yaw_rate_radps)
     }
 
     /// Stops a commanded motion (zero velocity where the device is driven by one).
     pub fn stop_motion(&self) -> Result<(), DeviceError> {
-        self.link().stop_motion()
+        self.facade().stop_motion()
     }
 
     /// A drive command not refreshed within `timeout` stops the device (where it has such a
     /// timeout: the KMC chassis; a ZSL-1 keeps its command until its watchdog).
     pub fn set_drive_timeout(&self, timeout: Duration) -> Result<(), DeviceError> {
-        self.link().set_drive_timeout(timeout)
+        self.facade().set_drive_timeout(timeout)
     }
 
     /// Its named actions (`stand_up`, `lie_down`, `passive` on a ZSL-1).
     pub fn services(&self) -> &'static [&'static str] {
-        self.link().services()
+        self.facade().services()
     }
 
     /// Runs the named action; what the device said.
     pub fn call(&self, service: &str) -> Result<String, DeviceError> {
-        self.link().call(service)
+        self.facade().call(service)
     }
 
     #[cfg(feature = "kmc")]
     /// The KMC driver, if this is a chassis.
     pub fn kmc(&self) -> Option<&::kmc::Driver> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     #[cfg(feature = "zsl1")]
     /// The ZSL-1 HighLevel client, if this is a ZSL-1 or ZSL-1W.
     pub fn zsl(&self) -> Option<&::zsl::udp::HighLevel> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     #[cfg(feature = "unitree")]
     /// The Go2 low-level client, if this is a Go2.
     pub fn go2(&self) -> Option<&unitree::LowLevel<unitree::Go2>> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     #[cfg(feature = "unitree")]
     /// The HG low-level client, if this is an HG robot opened as `hg:`.
     pub fn hg(&self) -> Option<&unitree::LowLevel<unitree::Hg>> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     #[cfg(feature = "unitree")]
     /// The G1 client, if this is a G1 (`g1:`, `sim:g1`).
     pub fn g1(&self) -> Option<&unitree::g1::G1> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     #[cfg(feature = "zsl1")]
     /// The spline monitor, if this is a spline daemon.
     pub fn spline(&self) -> Option<&::zsl::spline::SplineMonitor> {
-        self.link().as_any().downcast_ref()
+        self.facade().as_any().downcast_ref()
     }
 
     /// The simulator behind a `sim:` address.
@@ -430,14 +430,14 @@ impl AnyDevice {
     /// the device sent last (a stop burst, a damping command).
     #[cfg(feature = "sim")]
     pub fn close_keeping_simulator(self) -> (Result<(), DeviceError>, Option<Simulator>) {
-        (self.link.close(), self.simulator)
+        (self.facade.close(), self.simulator)
     }
 
     /// Does the device's safe thing (stop burst, stop, damping) and closes it; then stops its
     /// simulator. When this returns, its port or socket can be opened again.
     pub fn close(self) -> Result<(), DeviceError> {
-        // The link first; the simulator (dropped at the end of this scope) hears its last word.
-        self.link.close()
+        // The facade first; the simulator (dropped at the end of this scope) hears its last word.
+        self.facade.close()
     }
 }
 

@@ -11,7 +11,7 @@ use robowire_sim::spline::{SplineSim, SplineSimConfig};
 #[cfg(feature = "zsl1")]
 use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 
-use crate::link::Link;
+use crate::facade::Facade;
 use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
 
 /// The simulator behind a `sim:` address, for what only a simulator does (faults, snapshots).
@@ -39,7 +39,7 @@ pub(crate) fn open(
     address: &DeviceAddress,
     kind: SimKind,
     options: &OpenOptions,
-) -> Result<(Simulator, Box<dyn Link>), DeviceError> {
+) -> Result<(Simulator, Box<dyn Facade>), DeviceError> {
     let failed =
         |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator { address: address.clone(), source };
     Ok(match kind {

@@ -1,4 +1,4 @@
-//! `sim:g1`: the G1 simulator and the `g1` facade in one process, by address, where loopback
+//! `sim:g1`: the G1 simulator and `unitree::g1` in one process, by address, where loopback
 //! carries multicast (`robowire_dds::netns`): the joints by their names, the battery from
 //! `rt/lf/bmsstate`, the LowState passed through, the facade and the simulator underneath.
 

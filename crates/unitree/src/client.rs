@@ -84,13 +84,13 @@ struct TickCounters {
 }
 
 /// `rt/lowstate` as robowire-rt's receive loop drives it.
-struct StateLink<R: Robot> {
+struct StateReceiver<R: Robot> {
     reader: Reader<R::State>,
     ticks: Ticks,
     counters: Arc<TickCounters>,
 }
 
-impl<R: Robot> Receive for StateLink<R>
+impl<R: Robot> Receive for StateReceiver<R>
 where
     R::State: Send + Sync,
 {
@@ -194,7 +194,7 @@ where
                 let lowstate = reader.stats_handle();
                 // Their answers are read by tasks of this thread's runtime.
                 let services = Arc::new(Services::new(&participant, service_timeout, services_tap.as_ref())?);
-                let link = StateLink::<R> { reader, ticks: Ticks::default(), counters: ticks };
+                let link = StateReceiver::<R> { reader, ticks: Ticks::default(), counters: ticks };
                 Ok::<_, UnitreeError>((link, Opened::<R> { participant, writer, lowstate, services }))
             }
         })?;

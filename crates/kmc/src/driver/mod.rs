@@ -27,7 +27,7 @@ use robowire_rt::runner::{Runner, RunnerOptions};
 use robowire_serial::{Backoff, LinkCounters, SerialLink, SerialPortOptions, SerialTaps};
 
 pub use self::receive::ChassisState;
-use self::receive::{ChassisLink, Inbox};
+use self::receive::{ChassisReceiver, Inbox};
 use self::stream::{Request, StreamJob, StreamShared};
 use crate::KmcError;
 
@@ -267,7 +267,7 @@ impl Driver {
                 *robowire_rt::lock(&stream.writer) = Some(link.sync_writer()?);
                 inbox.set_link_state(LinkState::Connected);
                 let state = ChassisState::default();
-                Ok::<_, KmcError>((ChassisLink { link, reopen: options.reopen, inbox, stream, state }, ()))
+                Ok::<_, KmcError>((ChassisReceiver { link, reopen: options.reopen, inbox, stream, state }, ()))
             }
         })?;
         let (requests, requests_rx) = std_mpsc::channel();

@@ -124,7 +124,7 @@ impl Inbox {
 }
 
 /// The port as the receive loop sees it.
-pub(super) struct ChassisLink {
+pub(super) struct ChassisReceiver {
     pub(super) link: SerialLink<ChassisFrameDecoder>,
     pub(super) reopen: Option<Backoff>,
     pub(super) inbox: Arc<Inbox>,
@@ -132,7 +132,7 @@ pub(super) struct ChassisLink {
     pub(super) state: ChassisState,
 }
 
-impl Receive for ChassisLink {
+impl Receive for ChassisReceiver {
     type Item = ChassisFrame;
     type State = ChassisState;
 
@@ -176,7 +176,7 @@ impl Receive for ChassisLink {
     }
 }
 
-impl Drop for ChassisLink {
+impl Drop for ChassisReceiver {
     fn drop(&mut self) {
         // A writer the stream thread never took would keep the port open (and, exclusive, busy).
         robowire_rt::lock(&self.stream.writer).take();

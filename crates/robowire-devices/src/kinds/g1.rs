@@ -1,4 +1,4 @@
-//! A Unitree G1 through the `g1` facade: the joints its variant drives, by their URDF names; the
+//! A Unitree G1 through `unitree::g1`: the joints its variant drives, by their URDF names; the
 //! pelvis IMU; the battery from `rt/lf/bmsstate`; the HG LowState itself to pass through. It is
 //! commanded joint by joint, not by a velocity: it is not driven, and has no services here.
 
@@ -6,7 +6,7 @@ use serde_json::Value;
 use unitree::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS};
 
 use super::unitree::{imu, low_level_stats, lowstate_passthrough};
-use crate::link::{Describe, Link, Observations, floats};
+use crate::facade::{Describe, Facade, Observations, floats};
 use crate::observation::{BatteryReading, JointReadings};
 use crate::{DeviceError, Observation, OpenOptions};
 
@@ -125,7 +125,7 @@ impl Describe for G1 {
     }
 }
 
-impl Link for G1 {
+impl Facade for G1 {
     fn observe(&self) -> Option<Observation> {
         let state = self.latest()?.state;
         Some(observation(&state, self.options().variant_of(state.mode_machine), self.battery().as_ref()))
@@ -149,8 +149,8 @@ impl Link for G1 {
     }
 }
 
-/// A G1 on `interface`, through the `g1` facade.
-pub(crate) fn open(interface: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+/// A G1 on `interface`, through `unitree::g1`.
+pub(crate) fn open(interface: &str, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     Ok(Box::new(G1::open(client_options(Some(interface), options))?))
 }
 

@@ -6,7 +6,7 @@ use std::time::Duration;
 use kmc::{ChassisState, Device, Driver};
 use serde_json::{Value, json};
 
-use crate::link::{Describe, Link, Observations};
+use crate::facade::{Describe, Facade, Observations};
 use crate::observation::{BatteryReading, MotorReport, Odometry, yaw_quaternion};
 use crate::{DeviceError, Observation, OpenOptions};
 
@@ -137,7 +137,7 @@ impl Describe for Driver {
     }
 }
 
-impl Link for Driver {
+impl Facade for Driver {
     fn observe(&self) -> Option<Observation> {
         Some(observation(&self.latest()?.state))
     }
@@ -173,7 +173,7 @@ impl Link for Driver {
 }
 
 /// The KMC chassis's driver on the serial port `path`.
-pub(crate) fn open(path: &std::path::Path, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+pub(crate) fn open(path: &std::path::Path, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     Ok(Box::new(Driver::open(path, driver_options(options))?))
 }
 

@@ -12,11 +12,11 @@ pub(crate) mod unitree;
 #[cfg(feature = "zsl1")]
 pub(crate) mod zsl1;
 
-use crate::link::Link;
+use crate::facade::Facade;
 use crate::{DeviceAddress, DeviceError, OpenOptions};
 
 /// The client of the real device at `address` (a `sim:` address is [`crate::sim`]'s).
-pub(crate) fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+pub(crate) fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     Ok(match address {
         #[cfg(feature = "kmc")]
         DeviceAddress::Kmc(path) => kmc::open(path, options)?,

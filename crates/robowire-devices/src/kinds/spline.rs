@@ -7,7 +7,7 @@ use zsl::spline::SplineMonitor;
 use zsl::udp::Device;
 use zsl::{JointFlags, JointIndex, Leg, SplineStateBlock};
 
-use crate::link::{Describe, Link, Observations, floats};
+use crate::facade::{Describe, Facade, Observations, floats};
 use crate::observation::JointReadings;
 use crate::{DeviceError, Observation, OpenOptions};
 
@@ -81,7 +81,7 @@ impl Describe for SplineMonitor {
     }
 }
 
-impl Link for SplineMonitor {
+impl Facade for SplineMonitor {
     fn observations(&self) -> Observations {
         Observations::new(self.every_state(), observation)
     }
@@ -108,7 +108,7 @@ pub const SPLINE_LINK: &str = "spline/spline";
 pub const SPLINE_IMU_LINK: &str = "spline/imu";
 
 /// A monitor of the spline daemon's shared memory `name`.
-pub(crate) fn open(name: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+pub(crate) fn open(name: &str, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     Ok(Box::new(SplineMonitor::open(monitor_options(name, options))?))
 }
 

@@ -1,13 +1,13 @@
 //! A Unitree robot's low-level interface over DDS (Go2, HG): joints, IMU, battery and the
 //! LowState itself from `rt/lowstate`. It is commanded joint by joint, not by a velocity: it is
-//! not driven, and has no services here (releasing the sport mode is the `go2` facade's).
+//! not driven, and has no services here (releasing the sport mode is `unitree::LowLevel`'s).
 
 use robowire_core::cdr::CdrType;
 use serde_json::Value;
 use unitree::{Device, Go2, Hg, HgLowState, LowLevel, LowState, Robot};
 use unitree_proto::F32;
 
-use crate::link::{Describe, Link, Observations, floats};
+use crate::facade::{Describe, Facade, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Passthrough, wide, xyzw};
 use crate::{DeviceError, Observation, OpenOptions};
 
@@ -182,7 +182,7 @@ impl<R: Family> Describe for LowLevel<R> {
     }
 }
 
-impl<R: Family> Link for LowLevel<R> {
+impl<R: Family> Facade for LowLevel<R> {
     fn observe(&self) -> Option<Observation> {
         Some(observation::<R>(&self.latest()?.state))
     }
@@ -203,7 +203,7 @@ impl<R: Family> Link for LowLevel<R> {
 }
 
 /// A Unitree robot of family `R` on `interface`, through its low-level client.
-pub(crate) fn open<R: Family>(interface: &str, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+pub(crate) fn open<R: Family>(interface: &str, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     Ok(Box::new(LowLevel::<R>::open(low_level_options::<R>(Some(interface), options))?))
 }
 

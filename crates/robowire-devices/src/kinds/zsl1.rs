@@ -4,7 +4,7 @@
 use serde_json::Value;
 use zsl::udp::{Device, HighLevel, Model, RobotState};
 
-use crate::link::{Describe, Link, Observations, floats};
+use crate::facade::{Describe, Facade, Observations, floats};
 use crate::observation::{BatteryReading, ImuReading, JointReadings, Odometry, wide, xyzw};
 use crate::{DeviceError, Observation, OpenOptions};
 
@@ -139,7 +139,7 @@ impl Describe for HighLevel {
     }
 }
 
-impl Link for HighLevel {
+impl Facade for HighLevel {
     fn observe(&self) -> Option<Observation> {
         Some(observation(&(&self.latest()?.state).into(), self.options().model))
     }
@@ -187,7 +187,7 @@ impl Link for HighLevel {
 }
 
 /// A ZSL-1 (or ZSL-1W, by `model`) at `ip`, its state expected at `options.zsl_local`.
-pub(crate) fn open(ip: std::net::IpAddr, model: Model, options: &OpenOptions) -> Result<Box<dyn Link>, DeviceError> {
+pub(crate) fn open(ip: std::net::IpAddr, model: Model, options: &OpenOptions) -> Result<Box<dyn Facade>, DeviceError> {
     let client = zsl::udp::ClientOptions::high_level(options.zsl_local.ip(), options.zsl_local.port(), ip);
     Ok(Box::new(HighLevel::open(client_options(client, model, options))?))
 }

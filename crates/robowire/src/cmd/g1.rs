@@ -1,4 +1,4 @@
-//! `robowire g1 …`: a Unitree G1 humanoid over DDS through the `g1` facade.
+//! `robowire g1 …`: a Unitree G1 humanoid over DDS through `unitree::g1`.
 
 use std::process::ExitCode;
 use std::time::Duration;

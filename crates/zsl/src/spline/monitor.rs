@@ -46,12 +46,12 @@ impl SplineMonitorOptions {
 }
 
 /// The daemon's state as the receive loop reads it.
-struct SplineLink {
+struct SplineReceiver {
     client: SplineClient,
     poll: Duration,
 }
 
-impl Receive for SplineLink {
+impl Receive for SplineReceiver {
     type Item = SplineStateBlock;
     type State = SplineStateBlock;
 
@@ -104,7 +104,7 @@ impl SplineMonitor {
                     Some(tap) => client.with_tap(tap),
                     None => client,
                 };
-                Ok::<_, SplineError>((SplineLink { client, poll }, ()))
+                Ok::<_, SplineError>((SplineReceiver { client, poll }, ()))
             }
         })?;
         Ok(Self { options, receiving })

@@ -60,12 +60,12 @@ pub struct ClientStats {
 /// The receive side of the link, as robowire-rt's receive loop drives it (spec decisions 2, 3,
 /// 6): accepted states feed the watchdog, the stream's per-datagram rules and the user; a
 /// timeout stops the latched motion.
-struct StateLink<I: Wire> {
+struct StateReceiver<I: Wire> {
     receiver: UdpReceiver<Codec<I>>,
     shared: Arc<Shared<I>>,
 }
 
-impl<I: Wire> Receive for StateLink<I> {
+impl<I: Wire> Receive for StateReceiver<I> {
     type Item = StateReceived<I::State>;
     type State = I::State;
 
@@ -133,7 +133,7 @@ impl<I: Wire> Session<I> {
                 let local = link.local_addr().map_err(UdpError::from)?;
                 let stats = link.stats_handle();
                 let (sender, receiver) = link.into_split();
-                Ok::<_, ConnectError>((StateLink { receiver, shared }, (sender, local, stats)))
+                Ok::<_, ConnectError>((StateReceiver { receiver, shared }, (sender, local, stats)))
             }
         })?;
         let job = StreamJob::new(CommandStream::new(now, options.period), sender, shared.clone());

@@ -1,5 +1,5 @@
 //! What every device kind implements for [`AnyDevice`](crate::AnyDevice): one trait, one
-//! implementation per facade (`kmc.rs`, `zsl.rs`, `unitree.rs`).
+//! implementation per kind (`kinds/kmc.rs`, `zsl1.rs`, `spline.rs`, `unitree.rs`, `g1.rs`).
 
 use std::any::Any;
 use std::future::Future;
@@ -50,8 +50,8 @@ impl<D: robowire_rt::device::Device> Shape for D {
     }
 }
 
-/// A device's link, whatever its kind.
-pub(crate) trait Link: Describe + Shape + Send + Sync + 'static {
+/// A device's facade, whatever its kind: what [`AnyDevice`](crate::AnyDevice) calls.
+pub(crate) trait Facade: Describe + Shape + Send + Sync + 'static {
     /// Every state from now on, device-neutral.
     fn observations(&self) -> Observations;
     /// The latest state, device-neutral.
