@@ -1,7 +1,7 @@
 //! The same client for an HG robot (G1, H1-2): its LowCmd type on `rt/lowcmd`, its checks, and
 //! damping that keeps `mode_machine`, seen by a plain reader in another participant, where
-//! loopback carries multicast (`robowire_dds::netns`). There is no HG simulator: nothing
-//! answers, which is also the watchdog's case.
+//! loopback carries multicast (`robowire_dds::netns`). Nothing answers here (the G1 simulator
+//! is `g1_dds.rs`'s), which is also the watchdog's case.
 
 use std::time::Duration;
 
