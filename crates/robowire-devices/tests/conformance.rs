@@ -1,4 +1,4 @@
-//! One conformance suite for every `sim:` kind (issue 34): each property of the one device shape
+//! One conformance suite for every `sim:` kind: each property of the one device shape
 //! written once, over `robowire_devices::{open, AnyDevice, OpenOptions}`, and checked on every
 //! simulator. Each (kind, property) pair is a test named `<kind>::<property>`
 //! (`cargo test --test conformance zsl1w::` runs one kind, `::silence` one property); DDS kinds

@@ -1,4 +1,4 @@
-//! The ZSL-1 simulator under its old name, kept for one release (issue 34): everything of
+//! The ZSL-1 simulator under its old name, kept for one release: everything of
 //! [`zsl1`](crate::zsl1), and its types under their `Dog*` names. New code uses
 //! [`zsl1`](crate::zsl1); this module goes in the next release.
 

@@ -117,8 +117,8 @@ fn the_state_stream_keeps_its_ticks_while_the_api_is_hammered() {
     assert_eq!(last.battery_percent().ceil(), 50.0);
 }
 
-/// The module's old name and its `Dog*` types, kept as deprecated aliases for one release
-/// (issue 34): code written against them still builds and drives the same simulator.
+/// The module's old name and its `Dog*` types, kept as deprecated aliases for one release:
+/// code written against them still builds and drives the same simulator.
 #[tokio::test]
 #[allow(deprecated)]
 async fn the_old_dog_names_still_work() {

@@ -31,7 +31,7 @@ enum Command {
     /// Talk to a KMC wheeled chassis over a serial port.
     Kmc(cmd::kmc::KmcArgs),
     /// Drive a ZsiBot ZSL-1 / ZSL-1W over UDP (HighLevel: stand, walk, tricks, status).
-    // `dog`: its old name, kept for one release (issue 34).
+    // `dog`: its old name, kept for one release.
     #[command(alias = "dog")]
     Zsl1(cmd::zsl1::Zsl1Args),
     /// Drive a Unitree Go2's low-level interface over DDS (status, watch, release, stand, damp).

@@ -113,7 +113,7 @@ fn demo_drives_the_simulated_zsl1_and_checks_what_it_saw() {
 }
 
 /// `dog`, the old name of `robowire zsl1` and `robowire sim zsl1`, is still accepted for one
-/// release (issue 34): the same command, the same help.
+/// release: the same command, the same help.
 #[test]
 fn the_old_name_dog_is_an_alias_of_zsl1() {
     let help = |args: &[&str]| {

@@ -67,7 +67,7 @@ pub(crate) fn rows(criterion: &Path) -> anyhow::Result<Vec<Row>> {
             met: None,
         });
     }
-    // The CDR paths run on precomputed copy plans: within 2× of the struct-image paths (issue 14).
+    // The CDR paths run on precomputed copy plans: within 2× of the struct-image paths.
     for (bench, label, image, image_label) in [
         ("lowcmd_encode_xcdr1", "LowCmd encode XCDR1 (copy plan)", "lowcmd_encode_image", "image encode"),
         (

@@ -24,7 +24,7 @@ __all__ = ["Zsl1", "Chassis", "Spline", "Go2", "G1", "loopback_has_multicast", "
 
 
 def __getattr__(name: str):
-    # ``Dog``: the old name of ``Zsl1``, kept for one release (robowire issue 34).
+    # ``Dog``: the old name of ``Zsl1``, kept for one release.
     if name == "Dog":
         _warnings.warn(
             "robowire.sim.Dog is now robowire.sim.Zsl1; the old name goes in the next release",

@@ -15,7 +15,7 @@ pub(crate) enum SimCommand {
     /// The ZSL-1 spline daemon: a 1 kHz loop on /spline_shm and /imu_shm with a PD joint model.
     Spline(SplineSimArgs),
     /// A ZSL-1 / ZSL-1W on UDP: HighLevel on 43997, LowLevel on 43900, state at 500 Hz.
-    // `dog`: its old name, kept for one release (issue 34).
+    // `dog`: its old name, kept for one release.
     #[command(alias = "dog")]
     Zsl1(Zsl1SimArgs),
     /// A Unitree Go2 on DDS (rt/lowcmd, rt/lowstate at 500 Hz, motion_switcher and sport), booted

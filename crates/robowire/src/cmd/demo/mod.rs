@@ -82,7 +82,7 @@ enum Device {
     /// KMC wheeled chassis on a pseudo-terminal.
     Kmc,
     /// ZSL-1 on loopback UDP (the HighLevel client).
-    // `dog`: its old name, kept for one release (issue 34).
+    // `dog`: its old name, kept for one release.
     #[value(alias = "dog")]
     Zsl1,
     /// ZSL-1 spline daemon on shared memory (the 1 kHz low-level loop).

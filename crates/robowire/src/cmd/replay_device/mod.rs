@@ -247,7 +247,7 @@ mod tests {
 
     #[test]
     fn a_link_of_an_old_capture_is_found_under_its_new_name() {
-        // Before issue 34 the ZSL-1's links were recorded as `dog/…`.
+        // An older capture recorded the ZSL-1's links as `dog/…`.
         let state = robowire_sim::zsl1::Zsl1Model::new(zsl_proto::udp::Model::Zsl1).high_level_state().encode();
         let command = zsl_proto::udp::HighLevelCommand::stand_up().encode(zsl_proto::udp::Model::Zsl1);
         let frames = [
