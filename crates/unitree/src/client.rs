@@ -9,16 +9,17 @@ use std::time::Duration;
 use robowire_core::schedule::Watchdog;
 use robowire_core::timing::LatenessSummary;
 use robowire_dds::qos::Qos;
-use robowire_dds::{Participant, Reader, StatsHandle, TopicStats};
+use robowire_dds::{Participant, StatsHandle, TopicStats};
 use robowire_rt::Time;
-use robowire_rt::device::{Device, Receive, Received, Receiving};
+use robowire_rt::device::{Device, Receiving};
 use robowire_rt::runner::{Runner, RunnerOptions, Waker};
-use robowire_rt::stats::Counter;
 use unitree_proto::go2::MotorCmd;
 use unitree_proto::robot::{Go2, Robot};
 use unitree_proto::stream::{CommandStream, Motion, MotionState};
 use unitree_proto::{LowCmd, Message};
 
+use crate::following::Following;
+use crate::receive::{StateReceiver, TickCounters, Ticks};
 use crate::services::{ServiceHandle, Services};
 use crate::stream::{Handed, MotionStatus, StreamJob, StreamShared};
 use crate::{LowLevelOptions, UnitreeError};
@@ -74,42 +75,6 @@ pub struct LowLevelStats {
     pub send_lateness: LatenessSummary,
     /// Time between LowStates, µs.
     pub state_gap: LatenessSummary,
-}
-
-/// What the receive loop counts beyond the feed.
-#[derive(Debug, Default)]
-struct TickCounters {
-    lost_by_tick: Counter,
-    late_by_tick: Counter,
-}
-
-/// `rt/lowstate` as robowire-rt's receive loop drives it.
-struct StateReceiver<R: Robot> {
-    reader: Reader<R::State>,
-    ticks: Ticks,
-    counters: Arc<TickCounters>,
-}
-
-impl<R: Robot> Receive for StateReceiver<R>
-where
-    R::State: Send + Sync,
-{
-    type Item = R::State;
-    type State = R::State;
-
-    async fn receive(&mut self) -> Received<R::State> {
-        match self.reader.recv().await {
-            Ok(sample) => Received::Item(sample.value),
-            Err(_) => Received::Closed,
-        }
-    }
-
-    fn on_item(&mut self, _: Time, state: R::State) -> Option<R::State> {
-        let (lost, late) = self.ticks.on(R::tick(&state));
-        self.counters.lost_by_tick.add(lost);
-        self.counters.late_by_tick.add(late);
-        Some(state)
-    }
 }
 
 /// A Unitree robot's low-level interface (`R`: [`Go2`] or [`Hg`](crate::Hg)): the LowCmd stream
@@ -419,67 +384,6 @@ pub(crate) fn go2_command(joints: &[JointCommand; 12]) -> LowCmd {
     cmd
 }
 
-/// A motion the LowCmd stream follows ([`LowLevel::follow`]): where it is, and a wait for its
-/// end. Cheap to clone; dropping it changes nothing (the stream goes on following).
-#[derive(Debug, Clone)]
-pub struct Following {
-    status: Arc<MotionStatus>,
-    runtime: tokio::runtime::Handle,
-    period: Duration,
-}
-
-impl Following {
-    /// Where the motion is (after the client closed: [`MotionState::Damped`] unless it had
-    /// reached its end).
-    pub fn state(&self) -> MotionState {
-        self.status.state()
-    }
-
-    /// When its first step was due, on the monotonic clock (`robowire_rt::now`; `None` before
-    /// it went out). Its step at `elapsed` was due at `began + elapsed`.
-    pub fn began(&self) -> Option<Time> {
-        self.status.began()
-    }
-
-    /// Whether the stream is done stepping it: its end reached (its final command held), or it
-    /// ended before.
-    pub fn is_done(&self) -> bool {
-        !matches!(self.state(), MotionState::Pending | MotionState::Moving { .. }) || self.status.is_closed()
-    }
-
-    /// Waits until its last step went out (`Ok`: the stream holds its final command from then
-    /// on), or until it ended before: [`UnitreeError::MotionEnded`] (replaced, damped, a step
-    /// refused), [`UnitreeError::Closed`] (the client closed). Any executor: the wait runs on the
-    /// client's receive thread, which looks every stream period. The future borrows nothing.
-    pub fn wait(&self) -> impl Future<Output = Result<(), UnitreeError>> + Send + 'static {
-        let this = self.clone();
-        async move {
-            if let Some(end) = this.end() {
-                return end;
-            }
-            let runtime = this.runtime.clone();
-            crate::services::on_runtime(&runtime, async move {
-                loop {
-                    if let Some(end) = this.end() {
-                        return end;
-                    }
-                    tokio::time::sleep(this.period).await;
-                }
-            })
-            .await
-        }
-    }
-
-    fn end(&self) -> Option<Result<(), UnitreeError>> {
-        match self.state() {
-            MotionState::Reached => Some(Ok(())),
-            _ if self.status.is_closed() => Some(Err(UnitreeError::Closed)),
-            MotionState::Pending | MotionState::Moving { .. } => None,
-            ended => Some(Err(UnitreeError::MotionEnded(ended))),
-        }
-    }
-}
-
 impl<R: Robot> Drop for LowLevel<R> {
     fn drop(&mut self) {
         if let Some(stream) = self.stream.take()
@@ -491,43 +395,5 @@ impl<R: Robot> Drop for LowLevel<R> {
             }
             job.close_motions();
         }
-    }
-}
-
-/// Tick bookkeeping: the usual step is the smallest positive one seen.
-#[derive(Default)]
-struct Ticks {
-    last: Option<u32>,
-    step: Option<u32>,
-}
-
-impl Ticks {
-    /// `(lost, late)` implied by `tick`.
-    fn on(&mut self, tick: u32) -> (u64, u64) {
-        let Some(last) = self.last.replace(tick) else { return (0, 0) };
-        let delta = tick.wrapping_sub(last);
-        if delta == 0 || delta > u32::MAX / 2 {
-            return (0, 1);
-        }
-        let step = *self.step.get_or_insert(delta);
-        self.step = Some(step.min(delta));
-        let step = step.min(delta);
-        (u64::from(delta / step).saturating_sub(1), 0)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::Ticks;
-
-    #[test]
-    fn ticks_count_gaps_and_reorders() {
-        let mut t = Ticks::default();
-        assert_eq!(t.on(10), (0, 0));
-        assert_eq!(t.on(12), (0, 0));
-        assert_eq!(t.on(14), (0, 0));
-        assert_eq!(t.on(20), (2, 0), "16 and 18 missing");
-        assert_eq!(t.on(20), (0, 1), "not after the previous");
-        assert_eq!(t.on(22), (0, 0));
     }
 }

@@ -3,16 +3,19 @@
 
 mod client;
 mod error;
+mod following;
 pub mod g1;
 pub mod go2;
 pub mod hg;
 mod options;
+mod receive;
 pub mod services;
 mod stream;
 pub mod trajectory;
 
-pub use client::{Following, JointCommand, LowLevel, LowLevelStats};
+pub use client::{JointCommand, LowLevel, LowLevelStats};
 pub use error::UnitreeError;
+pub use following::Following;
 pub use options::{FIRST_STATE_TIMEOUT, LowLevelOptions, STATE_TIMEOUT};
 pub use robowire_core::schedule::Connection;
 pub use robowire_dds::ParticipantOptions;
