@@ -192,6 +192,8 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
 
         // 2. Release: before it the robot ignores LowCmds.
         let start = robot.joint_positions().context("no state")?;
+        // The LowCmd stream runs from this first command on: its rate is taken from here.
+        let streaming = Instant::now();
         robot.hold(&start)?;
         let ignored = until(Duration::from_secs(5), || sim.snapshot().lowcmd.ignored_mode > 0).await;
         let ignored = if ignored { sim.snapshot().lowcmd.ignored_mode } else { 0 };
@@ -297,7 +299,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         ];
         let elapsed = started.elapsed().as_secs_f64();
         report.rates_hz = vec![
-            ("LowCmd", low.commands_sent as f64 / elapsed),
+            ("LowCmd", low.commands_sent as f64 / streaming.elapsed().as_secs_f64()),
             ("LowState", low.lowstate.samples as f64 / elapsed),
         ];
         report.timings = vec![
