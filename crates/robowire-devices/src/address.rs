@@ -23,25 +23,9 @@ pub enum DeviceAddress {
     G1(String),
     /// `spline:/spline_shm`: a ZSL-1's spline daemon on shared memory, watched.
     Spline(String),
-    /// `sim:kmc|zsl1|zsl1w|go2|g1|spline`: an in-process simulator and a client of it.
-    Sim(SimKind),
-}
-
-/// The simulators an address can start.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum SimKind {
-    /// A KMC chassis on a pseudo-terminal.
-    Kmc,
-    /// A ZSL-1 on loopback UDP.
-    Zsl1,
-    /// A ZSL-1W on loopback UDP.
-    Zsl1w,
-    /// A Go2 on DDS.
-    Go2,
-    /// A 29-joint G1 on DDS.
-    G1,
-    /// The spline daemon on private shared memory.
-    Spline,
+    /// `sim:kmc|zsl1|zsl1w|go2|g1|spline`: an in-process simulator of that kind and a client of
+    /// it (every kind but `hg` has one: [`DeviceKind::simulated`]).
+    Sim(DeviceKind),
 }
 
 /// What kind of device an address names, whatever its link.
@@ -64,6 +48,14 @@ pub enum DeviceKind {
 }
 
 impl DeviceKind {
+    /// Every kind, in the order addresses list them.
+    pub const ALL: [Self; 7] = [Self::Kmc, Self::Zsl1, Self::Zsl1w, Self::Go2, Self::Hg, Self::G1, Self::Spline];
+
+    /// Whether `sim:` starts one (every kind but the HG family's generic client).
+    pub fn simulated(self) -> bool {
+        self != Self::Hg
+    }
+
     /// Its name in addresses: `kmc`, `zsl1`, `zsl1w`, `go2`, `hg`, `g1`, `spline`.
     pub fn name(self) -> &'static str {
         match self {
@@ -80,6 +72,9 @@ impl DeviceKind {
 
 /// The addresses every error message shows as examples.
 pub const ADDRESS_EXAMPLES: &str = "kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0, spline:/spline_shm, sim:kmc|zsl1|zsl1w|go2|g1|spline";
+
+/// The reason a `sim:` address of no simulated kind is refused.
+const NO_SUCH_SIMULATOR: &str = "no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)";
 
 /// Why an address was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -119,15 +114,11 @@ impl FromStr for DeviceAddress {
                 Ok(Self::Spline(rest.into()))
             }
             "spline" => Err(refuse("not a shared-memory object name (/spline_shm)")),
-            "sim" => Ok(Self::Sim(match rest {
-                "kmc" => SimKind::Kmc,
-                "zsl1" => SimKind::Zsl1,
-                "zsl1w" => SimKind::Zsl1w,
-                "go2" => SimKind::Go2,
-                "g1" => SimKind::G1,
-                "spline" => SimKind::Spline,
-                _ => return Err(refuse("no such simulator (kmc, zsl1, zsl1w, go2, g1, spline)")),
-            })),
+            "sim" => DeviceKind::ALL
+                .into_iter()
+                .find(|kind| kind.simulated() && kind.name() == rest)
+                .map(Self::Sim)
+                .ok_or_else(|| refuse(NO_SUCH_SIMULATOR)),
             _ => Err(refuse("unknown kind")),
         }
     }
@@ -143,21 +134,7 @@ impl fmt::Display for DeviceAddress {
             Self::Hg(interface) => write!(f, "hg:{interface}"),
             Self::G1(interface) => write!(f, "g1:{interface}"),
             Self::Spline(name) => write!(f, "spline:{name}"),
-            Self::Sim(kind) => write!(f, "sim:{}", kind.device().name()),
-        }
-    }
-}
-
-impl SimKind {
-    /// The device it simulates.
-    pub fn device(self) -> DeviceKind {
-        match self {
-            Self::Kmc => DeviceKind::Kmc,
-            Self::Zsl1 => DeviceKind::Zsl1,
-            Self::Zsl1w => DeviceKind::Zsl1w,
-            Self::Go2 => DeviceKind::Go2,
-            Self::G1 => DeviceKind::G1,
-            Self::Spline => DeviceKind::Spline,
+            Self::Sim(kind) => write!(f, "sim:{}", kind.name()),
         }
     }
 }
@@ -173,7 +150,7 @@ impl DeviceAddress {
             Self::Hg(_) => DeviceKind::Hg,
             Self::G1(_) => DeviceKind::G1,
             Self::Spline(_) => DeviceKind::Spline,
-            Self::Sim(sim) => sim.device(),
+            Self::Sim(kind) => *kind,
         }
     }
 
@@ -221,6 +198,9 @@ mod tests {
             DeviceAddress::Hg("eth0".into()),
             "h1: names the HG client"
         );
+        let simulated: Vec<_> = DeviceKind::ALL.into_iter().filter(|k| k.simulated()).map(DeviceKind::name).collect();
+        assert_eq!(NO_SUCH_SIMULATOR, format!("no such simulator ({})", simulated.join(", ")), "one list of kinds");
+        assert!("sim:hg".parse::<DeviceAddress>().is_err(), "the HG client has no simulator of its own");
         for (bad, reason) in [
             ("kmc", "no kind: write KIND:WHERE"),
             ("kmc:", "nothing after the kind"),

@@ -17,7 +17,7 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::time::Duration;
 
-pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind, SimKind};
+pub use address::{ADDRESS_EXAMPLES, AddressError, DeviceAddress, DeviceKind};
 pub use facade::{Describe, Observations, StateChanges};
 #[cfg(feature = "kmc")]
 pub use kinds::kmc::kmc_taps;
@@ -247,7 +247,7 @@ fn physics_possible(address: &DeviceAddress, options: &OpenOptions) -> Result<()
     if options.sim_physics.is_none() {
         return Ok(());
     }
-    if !matches!(address, DeviceAddress::Sim(SimKind::Go2 | SimKind::G1)) {
+    if !matches!(address, DeviceAddress::Sim(DeviceKind::Go2 | DeviceKind::G1)) {
         return Err(DeviceError::NoPhysics { address: address.clone() });
     }
     if !cfg!(feature = "mujoco") {
@@ -257,13 +257,13 @@ fn physics_possible(address: &DeviceAddress, options: &OpenOptions) -> Result<()
 }
 
 #[cfg(feature = "sim")]
-fn open_simulated(address: &DeviceAddress, kind: SimKind, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+fn open_simulated(address: &DeviceAddress, kind: DeviceKind, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
     let (simulator, facade) = sim::open(address, kind, options)?;
     Ok(AnyDevice { address: address.clone(), facade, simulator: Some(simulator) })
 }
 
 #[cfg(not(feature = "sim"))]
-fn open_simulated(address: &DeviceAddress, _: SimKind, _: &OpenOptions) -> Result<AnyDevice, DeviceError> {
+fn open_simulated(address: &DeviceAddress, _: DeviceKind, _: &OpenOptions) -> Result<AnyDevice, DeviceError> {
     Err(DeviceError::NoSimulators { address: address.clone() })
 }
 

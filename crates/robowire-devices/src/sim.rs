@@ -12,7 +12,7 @@ use robowire_sim::spline::{SplineSim, SplineSimConfig};
 use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
 
 use crate::facade::Facade;
-use crate::{DeviceAddress, DeviceError, OpenOptions, SimKind};
+use crate::{DeviceAddress, DeviceError, DeviceKind, OpenOptions};
 
 /// The simulator behind a `sim:` address, for what only a simulator does (faults, snapshots).
 #[derive(Debug)]
@@ -37,21 +37,21 @@ pub enum Simulator {
 
 pub(crate) fn open(
     address: &DeviceAddress,
-    kind: SimKind,
+    kind: DeviceKind,
     options: &OpenOptions,
 ) -> Result<(Simulator, Box<dyn Facade>), DeviceError> {
     let failed =
         |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator { address: address.clone(), source };
     Ok(match kind {
         #[cfg(feature = "kmc")]
-        SimKind::Kmc => {
+        DeviceKind::Kmc => {
             let sim = ChassisSim::spawn(ChassisSimConfig::default()).map_err(|e| failed(e.into()))?;
             let driver = kmc::Driver::open(sim.path(), crate::kinds::kmc::driver_options(options))?;
             (Simulator::Kmc(sim), Box::new(driver))
         }
         #[cfg(feature = "zsl1")]
-        SimKind::Zsl1 | SimKind::Zsl1w => {
-            let model = if kind == SimKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
+        DeviceKind::Zsl1 | DeviceKind::Zsl1w => {
+            let model = if kind == DeviceKind::Zsl1w { zsl::udp::Model::Zsl1W } else { zsl::udp::Model::Zsl1 };
             let sim =
                 Zsl1Sim::spawn(Zsl1SimConfig { model, ..Zsl1SimConfig::loopback() }).map_err(|e| failed(e.into()))?;
             let dog = sim.high_level_addr();
@@ -63,7 +63,7 @@ pub(crate) fn open(
             (Simulator::Zsl1(sim), Box::new(link))
         }
         #[cfg(feature = "zsl1")]
-        SimKind::Spline => {
+        DeviceKind::Spline => {
             static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
             let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let tag = format!("devices-{}-{n}", std::process::id());
@@ -75,7 +75,7 @@ pub(crate) fn open(
             (Simulator::Spline(sim), Box::new(monitor))
         }
         #[cfg(feature = "unitree")]
-        SimKind::Go2 => {
+        DeviceKind::Go2 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
             let client = crate::kinds::unitree::low_level_options::<unitree::Go2>(Some(interface), options);
             let sim = Go2Sim::spawn(Go2SimConfig {
@@ -89,7 +89,7 @@ pub(crate) fn open(
             (Simulator::Go2(sim), Box::new(client))
         }
         #[cfg(feature = "unitree")]
-        SimKind::G1 => {
+        DeviceKind::G1 => {
             let interface = options.sim_interface.as_deref().unwrap_or("lo");
             let client = crate::kinds::g1::client_options(Some(interface), options);
             let participant = client.low_level.participant.clone();
@@ -102,6 +102,10 @@ pub(crate) fn open(
             .map_err(|e| failed(e.into()))?;
             let client = unitree::g1::G1::open(client)?;
             (Simulator::G1(sim), Box::new(client))
+        }
+        // The HG family's generic client has no simulator of its own (`sim:g1` is the G1's).
+        DeviceKind::Hg => {
+            return Err(DeviceError::Unsupported { what: "a simulator of the HG client (sim:g1 is the G1's)" });
         }
         #[allow(unreachable_patterns)] // every kind built
         _ => return Err(crate::kinds::not_built(address)),

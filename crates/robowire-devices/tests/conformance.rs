@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 
 use robowire_dds::netns::with_loopback_multicast;
-use robowire_devices::{AnyDevice, Connection, DeviceAddress, Observation, OpenOptions, SimKind, Simulator, open};
+use robowire_devices::{AnyDevice, Connection, DeviceAddress, DeviceKind, Observation, OpenOptions, Simulator, open};
 use robowire_fixtures::wait::{one_at_a_time, runtime_two_workers, until_async};
 use robowire_sim::g1::G1Fault;
 use robowire_sim::go2::Go2Fault;
@@ -44,14 +44,14 @@ const FORWARD_MPS: f32 = 0.3;
 
 /// Runs `property` on `kind`, one test at a time (two simulators and their streams would make
 /// each other late on two cores), DDS kinds where loopback carries multicast.
-fn check<F: Future<Output = ()>>(kind: SimKind, property: fn(SimKind) -> F) {
+fn check<F: Future<Output = ()>>(kind: DeviceKind, property: fn(DeviceKind) -> F) {
     let _turn = one_at_a_time();
     let run = move || runtime_two_workers().block_on(property(kind));
     if DeviceAddress::Sim(kind).uses_dds() { with_loopback_multicast(run) } else { run() }
 }
 
 /// `sim:<kind>`, opened.
-fn open_sim(kind: SimKind, options: &OpenOptions) -> AnyDevice {
+fn open_sim(kind: DeviceKind, options: &OpenOptions) -> AnyDevice {
     let address = DeviceAddress::Sim(kind);
     open(&address, options).unwrap_or_else(|e| panic!("{address}: {}", robowire_devices::error_chain(&e)))
 }
@@ -63,9 +63,9 @@ async fn connection(events: &mut watch::Receiver<Connection>, want: Connection) 
 }
 
 /// A first state arrives; it observes something; the device reports itself connected.
-async fn first_state(kind: SimKind) {
+async fn first_state(kind: DeviceKind) {
     let device = open_sim(kind, &OpenOptions::default());
-    assert_eq!(device.kind(), kind.device());
+    assert_eq!(device.kind(), kind);
     assert!(device.wait_state(WAIT).await, "a first state");
     let seen = device.observe().expect("an observation once a state arrived");
     assert_ne!(seen, Observation::default(), "the state observes something");
@@ -76,7 +76,7 @@ async fn first_state(kind: SimKind) {
 
 /// Silenced by its own fault switch, the simulator is `Disconnected` after the state timeout;
 /// speaking again, it is `Connected` and its states flow.
-async fn silence(kind: SimKind) {
+async fn silence(kind: DeviceKind) {
     let device = open_sim(kind, &OpenOptions { state_timeout: Some(STATE_TIMEOUT), ..OpenOptions::default() });
     assert!(device.wait_state(WAIT).await, "a first state");
     let mut events = device.connection_events();
@@ -94,7 +94,7 @@ async fn silence(kind: SimKind) {
 /// After `close`, what the client held (a serial line, a UDP port, a DDS participant's domain,
 /// a shared-memory object) serves again: a client of the still running simulator by its real
 /// address gets states, or the port binds and the simulator's states reach it.
-async fn close_frees(kind: SimKind) {
+async fn close_frees(kind: DeviceKind) {
     let device = open_sim(kind, &OpenOptions::default());
     assert!(device.wait_state(WAIT).await, "a first state");
     let held = held(&device);
@@ -120,7 +120,7 @@ async fn close_frees(kind: SimKind) {
 /// Dropped after being commanded, a device's last command on its links commands no motion (the
 /// KMC's and the ZSL-1's stop bursts, a Unitree's damping); a monitor sends nothing, on drop
 /// neither.
-async fn drop_is_safe(kind: SimKind) {
+async fn drop_is_safe(kind: DeviceKind) {
     let mut recording = Recording::new();
     let device = open_sim(kind, &OpenOptions { record: Some(recording.links()), ..OpenOptions::default() });
     assert!(device.wait_state(WAIT).await, "a first state");
@@ -151,7 +151,7 @@ async fn drop_is_safe(kind: SimKind) {
 
 /// `stats_line` returns while the stream runs, called over and over from another thread; the
 /// states keep coming meanwhile.
-async fn stats_never_block(kind: SimKind) {
+async fn stats_never_block(kind: DeviceKind) {
     let device = Arc::new(open_sim(kind, &OpenOptions::default()));
     assert!(device.wait_state(WAIT).await, "a first state");
     let (stop, lines) = (Arc::new(AtomicBool::new(false)), Arc::new(AtomicU64::new(0)));
@@ -177,7 +177,7 @@ async fn stats_never_block(kind: SimKind) {
 
 /// Opened with a recorder, the device declares its links; once used, every one carries frames,
 /// and every frame reads by its link's description.
-async fn record_taps_every_link(kind: SimKind) {
+async fn record_taps_every_link(kind: DeviceKind) {
     let mut recording = Recording::new();
     let device = open_sim(kind, &OpenOptions { record: Some(recording.links()), ..OpenOptions::default() });
     let names = recording.names();
@@ -398,16 +398,16 @@ macro_rules! properties {
 macro_rules! kind {
     ($name:ident: $kind:expr) => {
         mod $name {
-            use robowire_devices::SimKind;
+            use robowire_devices::DeviceKind;
             properties!($kind;
                 first_state, silence, close_frees, drop_is_safe, stats_never_block, record_taps_every_link);
         }
     };
 }
 
-kind!(kmc: SimKind::Kmc);
-kind!(zsl1: SimKind::Zsl1);
-kind!(zsl1w: SimKind::Zsl1w);
-kind!(go2: SimKind::Go2);
-kind!(g1: SimKind::G1);
-kind!(spline: SimKind::Spline);
+kind!(kmc: DeviceKind::Kmc);
+kind!(zsl1: DeviceKind::Zsl1);
+kind!(zsl1w: DeviceKind::Zsl1w);
+kind!(go2: DeviceKind::Go2);
+kind!(g1: DeviceKind::G1);
+kind!(spline: DeviceKind::Spline);

@@ -14,4 +14,4 @@ pub use bridge::{BridgeOptions, BridgedDevice, namespaces, run};
 pub use error::BridgeError;
 pub use graph::{NODE_NAME, RosDistro, UnknownDistro};
 pub use report::{DeviceCounters, DeviceReport};
-pub use robowire_devices::{AddressError, DeviceAddress, SimKind, SimPhysics};
+pub use robowire_devices::{AddressError, DeviceAddress, DeviceKind, SimPhysics};

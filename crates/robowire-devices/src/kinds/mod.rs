@@ -38,13 +38,13 @@ pub(crate) fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<Box
 
 /// The error for an address whose kind this build leaves out.
 pub(crate) fn not_built(address: &DeviceAddress) -> DeviceError {
-    use crate::SimKind;
+    use crate::DeviceKind;
     let (kind, feature) = match address {
-        DeviceAddress::Kmc(_) | DeviceAddress::Sim(SimKind::Kmc) => ("KMC chassis", "kmc"),
+        DeviceAddress::Kmc(_) | DeviceAddress::Sim(DeviceKind::Kmc) => ("KMC chassis", "kmc"),
         DeviceAddress::Zsl1(_)
         | DeviceAddress::Zsl1w(_)
         | DeviceAddress::Spline(_)
-        | DeviceAddress::Sim(SimKind::Zsl1 | SimKind::Zsl1w | SimKind::Spline) => ("ZSL-1", "zsl1"),
+        | DeviceAddress::Sim(DeviceKind::Zsl1 | DeviceKind::Zsl1w | DeviceKind::Spline) => ("ZSL-1", "zsl1"),
         DeviceAddress::Go2(_) | DeviceAddress::Hg(_) | DeviceAddress::G1(_) | DeviceAddress::Sim(_) => {
             ("Unitree", "unitree")
         }

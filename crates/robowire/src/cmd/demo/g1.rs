@@ -43,7 +43,7 @@ pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
 /// `sim:g1`: the simulator and the client on DDS domain 0, interface lo.
 fn open(record: Option<&RecordLinks>) -> anyhow::Result<robowire_devices::AnyDevice> {
     let options = robowire_devices::OpenOptions { record: record.cloned(), ..robowire_devices::OpenOptions::default() };
-    super::open_simulated(robowire_devices::SimKind::G1, &options)
+    super::open_simulated(robowire_devices::DeviceKind::G1, &options)
 }
 
 /// A command that holds `q` with the ankles' pitch and roll given as A and B motor angles (AB

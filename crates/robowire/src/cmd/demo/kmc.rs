@@ -8,7 +8,7 @@ use anyhow::Context;
 use kmc::{ChassisFrame, Device, DriverOptions};
 use kmc_proto::{HostFrame, PcControl};
 use robowire_core::timing::LatenessRing;
-use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_devices::{DeviceKind, OpenOptions, Simulator};
 use robowire_sim::kmc::Fault;
 
 use super::{Check, DeviceReport, InjectedFault, Progress, Status};
@@ -37,7 +37,7 @@ pub(super) fn run(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
     out.line("== KMC chassis (UART on a pseudo-terminal) ==");
     // sim:kmc's driver: the defaults, with the battery and all-state polls.
     let device = super::open_simulated(
-        SimKind::Kmc,
+        DeviceKind::Kmc,
         &OpenOptions { kmc_polls: true, record: record.cloned(), ..OpenOptions::default() },
     )?;
     let (Some(Simulator::Kmc(sim)), Some(driver)) = (device.simulator(), device.kmc()) else {

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use robowire_core::timing::LatenessRing;
-use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_devices::{DeviceKind, OpenOptions, Simulator};
 use robowire_rt::stats::micros;
 use robowire_sim::go2::Go2Fault;
 use unitree::trajectory::{JointTrajectory, STAND_KD, STAND_KP, from_fn};
@@ -40,7 +40,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
     let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
     runtime.block_on(async {
         // sim:go2: the simulator and the client on DDS domain 0, interface lo.
-        let device = super::open_simulated(SimKind::Go2, &OpenOptions { record: record.cloned(), ..OpenOptions::default() })?;
+        let device = super::open_simulated(DeviceKind::Go2, &OpenOptions { record: record.cloned(), ..OpenOptions::default() })?;
         let (Some(Simulator::Go2(sim)), Some(robot)) = (device.simulator(), device.go2()) else {
             anyhow::bail!("sim:go2 opened something other than a simulated Go2");
         };

@@ -35,7 +35,7 @@ fn on_dds_loopback<T: Send>(out: &Output, scenario: impl FnOnce() -> anyhow::Res
 /// The simulated device at `sim:KIND`, opened by address as any app opens a device: its client
 /// and, still reachable for faults and snapshots, its simulator.
 fn open_simulated(
-    kind: robowire_devices::SimKind,
+    kind: robowire_devices::DeviceKind,
     options: &robowire_devices::OpenOptions,
 ) -> anyhow::Result<robowire_devices::AnyDevice> {
     let address = robowire_devices::DeviceAddress::Sim(kind);

@@ -6,7 +6,7 @@ use robowire_record::RecordLinks;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use robowire_devices::{OpenOptions, SimKind, Simulator};
+use robowire_devices::{DeviceKind, OpenOptions, Simulator};
 use robowire_sim::zsl1::{STANDING_HEIGHT_M, Zsl1Fault, Zsl1Sim};
 use zsl::udp::{Action, CallError, Connection, ControlMode, Device, HighLevel, Latched, ReturnCode};
 
@@ -125,7 +125,7 @@ async fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -
     // The vendor's 3 s watchdog, shortened so the silence fault fits in a short demo.
     let watchdog = Duration::from_millis(500);
     let device = super::open_simulated(
-        SimKind::Zsl1,
+        DeviceKind::Zsl1,
         &OpenOptions { state_timeout: Some(watchdog), record: record.cloned(), ..Default::default() },
     )?;
     let (Some(Simulator::Zsl1(sim)), Some(dog)) = (device.simulator(), device.zsl()) else {
