@@ -26,6 +26,7 @@ use std::time::Duration;
 
 use anyhow::bail;
 use kmc_proto::description::{CHASSIS, HOST};
+use robowire_devices::DeviceKind;
 use robowire_record::{Direction, RecordedFrame};
 use robowire_sim::replay::Pace;
 use unitree_proto::description::GO2_LOW_LEVEL;
@@ -35,33 +36,28 @@ use zsl_proto::udp::AnyDatagram;
 
 use crate::cmd::captures::same_link;
 
-/// A device robowire plays the side of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Device {
-    /// A ZSL-1 on UDP.
-    Zsl1,
-    /// A KMC chassis on a serial line.
-    KmcChassis,
-    /// A Go2's low-level link on DDS.
-    Go2,
-    /// The ZSL-1's spline daemon on shared memory.
-    Spline,
-}
-
 /// What `--as-device` plays, for the error that finds none.
 const PLAYABLE: &str = "ZSL-1 states (zsl1.high_level, zsl1.low_level), KMC chassis frames (kmc.host received, \
                         kmc.chassis sent), Go2 LowStates (unitree_go.low_level) and spline daemon states \
                         (zsl1.spline.client received, zsl1.spline.daemon sent)";
 
-impl Device {
+/// The device kind whose side robowire plays back from a link of `protocol`, and which frames
+/// of it that device sent.
+trait Player: Sized {
     /// The device whose side a link of `protocol` has.
+    fn of(protocol: &str) -> Option<Self>;
+    /// Whether `frame`, of a link of this device, is one the device sent.
+    fn sent(self, frame: &RecordedFrame) -> bool;
+}
+
+impl Player for DeviceKind {
     fn of(protocol: &str) -> Option<Self> {
         if [HIGH_LEVEL.name, LOW_LEVEL.name].contains(&protocol) {
             Some(Self::Zsl1)
         } else if [SPLINE_CLIENT.name, SPLINE_DAEMON.name].contains(&protocol) {
             Some(Self::Spline)
         } else if [HOST.name, CHASSIS.name].contains(&protocol) {
-            Some(Self::KmcChassis)
+            Some(Self::Kmc)
         } else if protocol == GO2_LOW_LEVEL.name {
             Some(Self::Go2)
         } else {
@@ -69,7 +65,6 @@ impl Device {
         }
     }
 
-    /// Whether `frame`, of a link of this device, is one the device sent.
     fn sent(self, frame: &RecordedFrame) -> bool {
         match self {
             Self::Zsl1 => matches!(
@@ -86,7 +81,7 @@ impl Device {
                     }
             }
             // The chassis' frames: what the host received, what the chassis sent.
-            Self::KmcChassis => {
+            Self::Kmc => {
                 frame.direction
                     == if frame.protocol.protocol() == HOST.name { Direction::Received } else { Direction::Sent }
             }
@@ -97,6 +92,8 @@ impl Device {
                 .get(..4)
                 .and_then(|h| CdrEncoding::from_header(h.try_into().ok()?))
                 .is_some_and(|encoding| frame.bytes.len() == LowState::cdr_len(encoding)),
+            // No player: `of` names none of these.
+            Self::Zsl1w | Self::Hg | Self::G1 => false,
         }
     }
 }
@@ -144,13 +141,14 @@ fn found(frames: &[RecordedFrame]) -> String {
 fn pick<'f>(
     frames: &'f [RecordedFrame],
     link: Option<&str>,
-) -> anyhow::Result<(String, Device, Vec<&'f RecordedFrame>)> {
-    let device_frames = |link: &str, device: Device| -> Vec<&RecordedFrame> {
+) -> anyhow::Result<(String, DeviceKind, Vec<&'f RecordedFrame>)> {
+    let device_frames = |link: &str, device: DeviceKind| -> Vec<&RecordedFrame> {
         frames.iter().filter(|f| f.link == link && device.sent(f)).collect()
     };
     let Some(link) = link else {
         // The link of the first device frame.
-        let first = frames.iter().find_map(|f| Device::of(f.protocol.protocol()).filter(|d| d.sent(f)).map(|d| (f, d)));
+        let first =
+            frames.iter().find_map(|f| DeviceKind::of(f.protocol.protocol()).filter(|d| d.sent(f)).map(|d| (f, d)));
         let Some((first, device)) = first else {
             bail!("no device frames to play: {}; --as-device plays {PLAYABLE}", found(frames));
         };
@@ -163,7 +161,7 @@ fn pick<'f>(
         bail!("no link {link:?}: {}", found(frames));
     };
     let (link, protocol) = (recorded.link.as_str(), recorded.protocol.protocol());
-    let Some(device) = Device::of(protocol) else {
+    let Some(device) = DeviceKind::of(protocol) else {
         bail!("link {link} is {protocol}, which has no device side to play; --as-device plays {PLAYABLE}");
     };
     let picked = device_frames(link, device);
@@ -182,10 +180,10 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
     let offsets: Vec<(Duration, Vec<u8>)> = picked.iter().map(|f| offset(f)).collect();
     let pace = target.speed.map_or(Pace::Fast, |speed| Pace::Recorded { speed });
     match device {
-        Device::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
-        Device::KmcChassis => serial::run(offsets, &link, pace),
-        Device::Go2 => dds::run(offsets, &link, target.dds, pace),
-        Device::Spline => {
+        DeviceKind::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
+        DeviceKind::Kmc => serial::run(offsets, &link, pace),
+        DeviceKind::Go2 => dds::run(offsets, &link, target.dds, pace),
+        DeviceKind::Spline => {
             // The device's IMU records (its `zsl1.imu` link beside), from the states' first on.
             let device = link.split('/').next().unwrap_or_default();
             let imu: Vec<(Duration, Vec<u8>)> = frames
@@ -196,6 +194,7 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
                 .collect();
             shm::run(offsets, imu, &link, target.shm, pace)
         }
+        other => bail!("no player for a {} link", other.name()),
     }
 }
 
@@ -234,14 +233,14 @@ mod tests {
         ];
         let picked =
             |link| pick(&frames, link).map(|(l, d, f)| (l, d, f.iter().map(|f| f.direction).collect::<Vec<_>>()));
-        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), Device::KmcChassis, vec![Direction::Sent]));
+        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), DeviceKind::Kmc, vec![Direction::Sent]));
         assert_eq!(
             picked(Some("kmc/serial")).unwrap(),
-            ("kmc/serial".into(), Device::KmcChassis, vec![Direction::Received])
+            ("kmc/serial".into(), DeviceKind::Kmc, vec![Direction::Received])
         );
         assert_eq!(
             picked(Some("go2/low_level")).unwrap(),
-            ("go2/low_level".into(), Device::Go2, vec![Direction::Sent])
+            ("go2/low_level".into(), DeviceKind::Go2, vec![Direction::Sent])
         );
     }
 
@@ -256,7 +255,7 @@ mod tests {
         ];
         for asked in ["zsl1/high_level", "dog/high_level"] {
             let (link, device, picked) = pick(&frames, Some(asked)).unwrap();
-            assert_eq!((link.as_str(), device, picked.len()), ("dog/high_level", Device::Zsl1, 1), "{asked}");
+            assert_eq!((link.as_str(), device, picked.len()), ("dog/high_level", DeviceKind::Zsl1, 1), "{asked}");
             assert_eq!(picked[0].direction, Direction::Received);
         }
         let error = pick(&frames, Some("zsl1/low_level")).unwrap_err().to_string();
