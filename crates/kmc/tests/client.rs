@@ -42,11 +42,9 @@ fn non_finite_arguments_send_nothing() {
     assert_eq!(client.client_mut().counters().bytes_written, 0);
     // A valid command after the refused ones: once it has arrived, anything sent before it has.
     client.send_pc_control(0.1, 0.0).unwrap();
-    let deadline = std::time::Instant::now() + Duration::from_secs(20);
-    while sim.stats().control_frames == 0 {
-        assert!(std::time::Instant::now() < deadline, "the sentinel never arrived");
-        std::thread::sleep(Duration::from_millis(1));
-    }
+    robowire_fixtures::wait::until(Duration::from_secs(20), "the sentinel at the chassis", || {
+        sim.stats().control_frames > 0
+    });
     assert_eq!((sim.stats().control_frames, sim.stats().af_writes), (1, 0), "only the sentinel was sent");
     assert_eq!(sim.state().commanded_velocity_mps, 0.1);
 }
