@@ -14,6 +14,9 @@
 //!
 //! Each sends every frame on robowire's runner at its due time: the recorded offset divided by
 //! a speed, or at once ([`Pace`]); what the client sends meanwhile is counted.
+//!
+//! Which recorded links can be played, as which device, and which of their frames the device
+//! sent: [`PLAYABLE`], keyed by the links' protocol (features `kmc`, `zsl`, `go2`).
 
 #[cfg(feature = "replay")]
 mod datagram;
@@ -23,6 +26,7 @@ mod dds;
 mod serial;
 #[cfg(feature = "zsl")]
 mod shm;
+mod table;
 
 use std::time::Duration;
 
@@ -37,6 +41,7 @@ pub use self::dds::{DdsReplay, DdsTopic};
 pub use self::serial::SerialReplay;
 #[cfg(feature = "zsl")]
 pub use self::shm::SplineReplay;
+pub use self::table::{PLAYABLE, Playable, Played, playable, playable_list};
 
 /// How fast to play.
 #[derive(Debug, Clone, Copy, PartialEq)]

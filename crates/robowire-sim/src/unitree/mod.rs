@@ -107,6 +107,7 @@ pub enum AdvanceError {
 
 /// What a simulated Unitree robot counts of its state stream and its services.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(not(feature = "g1"), allow(unreachable_pub, reason = "public as robowire_sim::g1::StreamCounters"))]
 pub struct StreamCounters {
     /// The `rt/lowstate` writer's counters.
     pub lowstate: TopicStats,

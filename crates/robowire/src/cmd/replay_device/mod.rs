@@ -2,17 +2,14 @@
 //! the same transport, so that a session seen once on a robot can be replayed on a desk. The
 //! link's protocol (from the capture's metadata) says which device and transport:
 //!
-//! - `zsl1.high_level`, `zsl1.low_level`: the ZSL-1's states on UDP (HighLevel on 43997,
-//!   LowLevel on 43900 of `--bind`), [`udp`].
-//! - `kmc.host` (its received frames) or `kmc.chassis` (its sent frames): the KMC chassis'
-//!   frames on a pseudo-terminal, [`serial`].
-//! - `unitree_go.low_level`: the Go2's `LowState_` payloads (either direction: the client
-//!   received them, a simulator sent them) on DDS `rt/lowstate`, [`dds`].
-//! - `zsl1.spline.client` (its received frames) or `zsl1.spline.daemon` (its sent frames): the
-//!   spline daemon's states on shared memory, with the IMU records of the device's `zsl1.imu`
-//!   link, [`shm`].
+//! - the ZSL-1's states on UDP (HighLevel on 43997, LowLevel on 43900 of `--bind`), [`udp`];
+//! - the KMC chassis' frames on a pseudo-terminal, [`serial`];
+//! - the Go2's `LowState_` payloads on DDS `rt/lowstate`, [`dds`];
+//! - the spline daemon's states on shared memory, with the IMU records of the device's
+//!   `zsl1.imu` link, [`shm`].
 //!
-//! This picks the device's frames out of the capture; `robowire_sim::replay` plays them.
+//! `robowire_sim::replay::PLAYABLE` says which protocols have a device side and which frames the
+//! device sent. This picks the device's frames out of the capture; `robowire_sim::replay` plays them.
 
 mod dds;
 mod serial;
@@ -25,78 +22,11 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::bail;
-use kmc_proto::description::{CHASSIS, HOST};
-use robowire_devices::DeviceKind;
-use robowire_record::{Direction, RecordedFrame};
-use robowire_sim::replay::Pace;
-use unitree_proto::description::GO2_LOW_LEVEL;
-use unitree_proto::{CdrEncoding, LowState, Message};
-use zsl_proto::description::{HIGH_LEVEL, IMU, LOW_LEVEL, SPLINE_CLIENT, SPLINE_DAEMON};
-use zsl_proto::udp::AnyDatagram;
+use robowire_record::RecordedFrame;
+use robowire_sim::replay::{Pace, Playable, Played, playable, playable_list};
+use zsl_proto::description::IMU;
 
 use crate::cmd::captures::same_link;
-
-/// What `--as-device` plays, for the error that finds none.
-const PLAYABLE: &str = "ZSL-1 states (zsl1.high_level, zsl1.low_level), KMC chassis frames (kmc.host received, \
-                        kmc.chassis sent), Go2 LowStates (unitree_go.low_level) and spline daemon states \
-                        (zsl1.spline.client received, zsl1.spline.daemon sent)";
-
-/// The device kind whose side robowire plays back from a link of `protocol`, and which frames
-/// of it that device sent.
-trait Player: Sized {
-    /// The device whose side a link of `protocol` has.
-    fn of(protocol: &str) -> Option<Self>;
-    /// Whether `frame`, of a link of this device, is one the device sent.
-    fn sent(self, frame: &RecordedFrame) -> bool;
-}
-
-impl Player for DeviceKind {
-    fn of(protocol: &str) -> Option<Self> {
-        if [HIGH_LEVEL.name, LOW_LEVEL.name].contains(&protocol) {
-            Some(Self::Zsl1)
-        } else if [SPLINE_CLIENT.name, SPLINE_DAEMON.name].contains(&protocol) {
-            Some(Self::Spline)
-        } else if [HOST.name, CHASSIS.name].contains(&protocol) {
-            Some(Self::Kmc)
-        } else if protocol == GO2_LOW_LEVEL.name {
-            Some(Self::Go2)
-        } else {
-            None
-        }
-    }
-
-    fn sent(self, frame: &RecordedFrame) -> bool {
-        match self {
-            Self::Zsl1 => matches!(
-                AnyDatagram::decode(&frame.bytes),
-                Ok(AnyDatagram::HighLevelState(_) | AnyDatagram::LowLevelState(_))
-            ),
-            // The daemon's states: what the controller received, what the daemon sent.
-            Self::Spline => {
-                frame.direction
-                    == if frame.protocol.protocol() == SPLINE_CLIENT.name {
-                        Direction::Received
-                    } else {
-                        Direction::Sent
-                    }
-            }
-            // The chassis' frames: what the host received, what the chassis sent.
-            Self::Kmc => {
-                frame.direction
-                    == if frame.protocol.protocol() == HOST.name { Direction::Received } else { Direction::Sent }
-            }
-            // A LowState_ by its length in the encoding its header names, as the link's
-            // description tells LowCmd_ and LowState_ apart (whatever its CRC).
-            Self::Go2 => frame
-                .bytes
-                .get(..4)
-                .and_then(|h| CdrEncoding::from_header(h.try_into().ok()?))
-                .is_some_and(|encoding| frame.bytes.len() == LowState::cdr_len(encoding)),
-            // No player: `of` names none of these.
-            Self::Zsl1w | Self::Hg | Self::G1 => false,
-        }
-    }
-}
 
 /// Where and how fast to play.
 #[derive(Debug)]
@@ -137,22 +67,28 @@ fn found(frames: &[RecordedFrame]) -> String {
     format!("the capture has {}", list.join(", "))
 }
 
-/// The device frames of `link` (or of the first link that has any), with the link and device.
+/// Whether `frame` is one its link's device sent, by the link's entry in `PLAYABLE`.
+fn device_sent(playable: &Playable, frame: &RecordedFrame) -> bool {
+    playable.device_sent(frame.direction, &frame.bytes)
+}
+
+/// The device frames of `link` (or of the first link that has any), with the link and what they
+/// are played as.
 fn pick<'f>(
     frames: &'f [RecordedFrame],
     link: Option<&str>,
-) -> anyhow::Result<(String, DeviceKind, Vec<&'f RecordedFrame>)> {
-    let device_frames = |link: &str, device: DeviceKind| -> Vec<&RecordedFrame> {
-        frames.iter().filter(|f| f.link == link && device.sent(f)).collect()
+) -> anyhow::Result<(String, Played, Vec<&'f RecordedFrame>)> {
+    let device_frames = |link: &str, playable: &Playable| -> Vec<&RecordedFrame> {
+        frames.iter().filter(|f| f.link == link && device_sent(playable, f)).collect()
     };
     let Some(link) = link else {
         // The link of the first device frame.
         let first =
-            frames.iter().find_map(|f| DeviceKind::of(f.protocol.protocol()).filter(|d| d.sent(f)).map(|d| (f, d)));
-        let Some((first, device)) = first else {
-            bail!("no device frames to play: {}; --as-device plays {PLAYABLE}", found(frames));
+            frames.iter().find_map(|f| playable(f.protocol.protocol()).filter(|p| device_sent(p, f)).map(|p| (f, p)));
+        let Some((first, playable)) = first else {
+            bail!("no device frames to play: {}; --as-device plays {}", found(frames), playable_list());
         };
-        return Ok((first.link.clone(), device, device_frames(&first.link, device)));
+        return Ok((first.link.clone(), playable.played, device_frames(&first.link, playable)));
     };
     // The link by its name in the capture, else under its old or new name (an old capture's
     // `dog/high_level` is `zsl1/high_level`).
@@ -161,14 +97,14 @@ fn pick<'f>(
         bail!("no link {link:?}: {}", found(frames));
     };
     let (link, protocol) = (recorded.link.as_str(), recorded.protocol.protocol());
-    let Some(device) = DeviceKind::of(protocol) else {
-        bail!("link {link} is {protocol}, which has no device side to play; --as-device plays {PLAYABLE}");
+    let Some(playable) = playable(protocol) else {
+        bail!("link {link} is {protocol}, which has no device side to play; --as-device plays {}", playable_list());
     };
-    let picked = device_frames(link, device);
+    let picked = device_frames(link, playable);
     if picked.is_empty() {
         bail!("link {link} ({protocol}) has no device frames: {}", found(frames));
     }
-    Ok((link.to_string(), device, picked))
+    Ok((link.to_string(), playable.played, picked))
 }
 
 /// Plays the device frames of `target.link` (default: the first link that has any) on the
@@ -180,10 +116,10 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
     let offsets: Vec<(Duration, Vec<u8>)> = picked.iter().map(|f| offset(f)).collect();
     let pace = target.speed.map_or(Pace::Fast, |speed| Pace::Recorded { speed });
     match device {
-        DeviceKind::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
-        DeviceKind::Kmc => serial::run(offsets, &link, pace),
-        DeviceKind::Go2 => dds::run(offsets, &link, target.dds, pace),
-        DeviceKind::Spline => {
+        Played::Zsl1 => udp::run(offsets, picked[0].protocol.protocol(), &link, target.bind, pace),
+        Played::Kmc => serial::run(offsets, &link, pace),
+        Played::Go2 => dds::run(offsets, &link, target.dds, pace),
+        Played::Spline => {
             // The device's IMU records (its `zsl1.imu` link beside), from the states' first on.
             let device = link.split('/').next().unwrap_or_default();
             let imu: Vec<(Duration, Vec<u8>)> = frames
@@ -194,14 +130,18 @@ pub(crate) fn run(frames: &[RecordedFrame], target: &Target<'_>) -> anyhow::Resu
                 .collect();
             shm::run(offsets, imu, &link, target.shm, pace)
         }
-        other => bail!("no player for a {} link", other.name()),
+        other => bail!("no player for {other:?} in this build"),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use unitree_proto::LowCmd;
+    use kmc_proto::description::{CHASSIS, HOST};
+    use robowire_record::Direction;
+    use unitree_proto::description::GO2_LOW_LEVEL;
+    use unitree_proto::{CdrEncoding, LowCmd, LowState, Message};
+    use zsl_proto::description::HIGH_LEVEL;
 
     fn frame(
         link: &str,
@@ -233,14 +173,11 @@ mod tests {
         ];
         let picked =
             |link| pick(&frames, link).map(|(l, d, f)| (l, d, f.iter().map(|f| f.direction).collect::<Vec<_>>()));
-        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), DeviceKind::Kmc, vec![Direction::Sent]));
-        assert_eq!(
-            picked(Some("kmc/serial")).unwrap(),
-            ("kmc/serial".into(), DeviceKind::Kmc, vec![Direction::Received])
-        );
+        assert_eq!(picked(None).unwrap(), ("kmc/chassis".into(), Played::Kmc, vec![Direction::Sent]));
+        assert_eq!(picked(Some("kmc/serial")).unwrap(), ("kmc/serial".into(), Played::Kmc, vec![Direction::Received]));
         assert_eq!(
             picked(Some("go2/low_level")).unwrap(),
-            ("go2/low_level".into(), DeviceKind::Go2, vec![Direction::Sent])
+            ("go2/low_level".into(), Played::Go2, vec![Direction::Sent])
         );
     }
 
@@ -255,7 +192,7 @@ mod tests {
         ];
         for asked in ["zsl1/high_level", "dog/high_level"] {
             let (link, device, picked) = pick(&frames, Some(asked)).unwrap();
-            assert_eq!((link.as_str(), device, picked.len()), ("dog/high_level", DeviceKind::Zsl1, 1), "{asked}");
+            assert_eq!((link.as_str(), device, picked.len()), ("dog/high_level", Played::Zsl1, 1), "{asked}");
             assert_eq!(picked[0].direction, Direction::Received);
         }
         let error = pick(&frames, Some("zsl1/low_level")).unwrap_err().to_string();
