@@ -43,6 +43,21 @@ pub fn peers_dir() -> PathBuf {
     )
 }
 
+/// Unitree's walking policies as ONNX with their deploy configs: `$ROBOWIRE_POLICIES`, else
+/// `../shared/policies` beside the workspace; an error when it has no `g1_walk.onnx`.
+pub fn policies_dir() -> Result<PathBuf, String> {
+    let dir =
+        std::env::var_os("ROBOWIRE_POLICIES").map_or_else(|| peers_dir().with_file_name("policies"), PathBuf::from);
+    if dir.join("g1_walk.onnx").is_file() {
+        Ok(dir)
+    } else {
+        Err(format!(
+            "no {}: Unitree's G1 walking policy as ONNX (set ROBOWIRE_POLICIES)",
+            dir.join("g1_walk.onnx").display()
+        ))
+    }
+}
+
 /// Where the environment lives: `$CARGO_TARGET_DIR` (or `target/`)`/interop/py310`.
 fn env_dir() -> PathBuf {
     let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| workspace().join("target"), PathBuf::from);

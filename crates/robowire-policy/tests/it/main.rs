@@ -1,0 +1,7 @@
+//! robowire-policy's integration tests: one binary.
+
+mod config;
+mod model;
+mod observation;
+mod onnx;
+mod shipped;
