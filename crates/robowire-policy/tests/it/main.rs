@@ -1,6 +1,7 @@
 //! robowire-policy's integration tests: one binary.
 
 mod config;
+mod control;
 mod model;
 mod observation;
 mod onnx;
