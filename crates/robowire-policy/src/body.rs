@@ -35,6 +35,9 @@ pub trait Body: Send + Sync + 'static {
     /// Its message family.
     const MSG_TYPE: MsgType;
 
+    /// Each joint's position range by slot, rad (a slot without a joint: `None`).
+    fn joint_range(motor: usize) -> Option<(f32, f32)>;
+
     /// The latest state: the IMU returned, each motor's angle and velocity written into `q_rad`
     /// and `dq_rad_s` (by slot); `None` before the first.
     fn sense(&self, q_rad: &mut [f32], dq_rad_s: &mut [f32]) -> Option<Reading>;
@@ -75,6 +78,10 @@ fn read<const N: usize>(q: &mut [f32], dq: &mut [f32], motors: [(f32, f32); N]) 
 impl Body for G1 {
     const MSG_TYPE: MsgType = MsgType::Hg;
 
+    fn joint_range(motor: usize) -> Option<(f32, f32)> {
+        unitree::g1::JOINT_LIMITS.get(motor).map(|l| (l.q_min, l.q_max))
+    }
+
     fn sense(&self, q: &mut [f32], dq: &mut [f32]) -> Option<Reading> {
         let latest = self.latest()?;
         let s = &latest.state;
@@ -110,6 +117,10 @@ impl Body for G1 {
 
 impl Body for LowLevel<Go2> {
     const MSG_TYPE: MsgType = MsgType::Go;
+
+    fn joint_range(motor: usize) -> Option<(f32, f32)> {
+        unitree::GO2_JOINT_LIMITS.get(motor).map(|l| (l.q_min, l.q_max))
+    }
 
     fn sense(&self, q: &mut [f32], dq: &mut [f32]) -> Option<Reading> {
         let latest = self.latest()?;

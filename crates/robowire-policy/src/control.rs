@@ -8,7 +8,9 @@
 //! - the policy gave an action that is not finite, or failed;
 //! - the observation could not be built (a motor missing from the state).
 //!
-//! Targets between ticks are the LowCmd stream's to hold.
+//! A policy's targets are clamped into each joint's range (the robot's hardware stops, the
+//! URDF's limits in training): the PD pushes toward the stop as it would toward the target
+//! beyond it. Targets between ticks are the LowCmd stream's to hold.
 
 use std::time::{Duration, Instant};
 
@@ -109,6 +111,8 @@ pub struct StepReport {
     pub command: [f32; 3],
     /// The inference's duration.
     pub inference: Duration,
+    /// Targets clamped into their joint's range so far.
+    pub clamped: u64,
 }
 
 /// The deploy sequence and the policy, on caller time.
@@ -122,6 +126,8 @@ pub struct Controller {
     /// Legs, then arm and waist: motor, pose, gains.
     held: Vec<MotorTarget>,
     targets: Vec<MotorTarget>,
+    /// Each target's joint range, rad (by target; unbounded without one).
+    ranges: Vec<(f32, f32)>,
     /// Where the joints were when the stand began.
     from_rad: Vec<f32>,
     phase: Phase,
@@ -131,8 +137,9 @@ pub struct Controller {
 }
 
 impl Controller {
-    /// A controller for `config` running `policy`, before its first tick.
-    pub fn new(config: &PolicyConfig, policy: OnnxPolicy) -> Self {
+    /// A controller for `config` running `policy`, before its first tick; each motor's range
+    /// from `range` (`None`: unbounded).
+    pub fn new(config: &PolicyConfig, policy: OnnxPolicy, range: impl Fn(usize) -> Option<(f32, f32)>) -> Self {
         let legs =
             config.leg_joint2motor_idx.iter().zip(&config.default_angles).zip(config.kps.iter().zip(&config.kds));
         let arms = config
@@ -148,6 +155,7 @@ impl Controller {
             max_tilt_rad: config.max_tilt_rad,
             action_scale: config.action_scale,
             default_angles: config.default_angles.clone(),
+            ranges: held.iter().map(|t| range(t.motor).unwrap_or((f32::NEG_INFINITY, f32::INFINITY))).collect(),
             from_rad: vec![0.0; held.len()],
             targets: held.clone(),
             held,
@@ -241,8 +249,12 @@ impl Controller {
         if let Some((joint, &value)) = action.iter().enumerate().find(|(_, a)| !a.is_finite()) {
             return Err(Fault::NotFinite { joint, value });
         }
-        for ((target, a), default) in self.targets.iter_mut().zip(action).zip(&self.default_angles) {
-            target.q_rad = a * self.action_scale + default;
+        for (((target, a), default), (min, max)) in
+            self.targets.iter_mut().zip(action).zip(&self.default_angles).zip(&self.ranges)
+        {
+            let q = a * self.action_scale + default;
+            target.q_rad = q.clamp(*min, *max);
+            self.report.clamped += u64::from(target.q_rad != q);
         }
         let report = &mut self.report;
         report.obs.clear();

@@ -100,6 +100,9 @@ pub enum StartError {
     /// No LowState within [`FIRST_STATE`].
     #[error("no LowState from the robot within {} s", FIRST_STATE.as_secs())]
     NoState,
+    /// The holder given holds no client of the config's robot.
+    #[error("the device is not a {0:?} robot")]
+    NoBody(crate::config::MsgType),
     /// The robot's controller would not let go.
     #[error("cannot release the robot's controller: {0}")]
     Release(String),
@@ -121,14 +124,19 @@ struct Shared {
 }
 
 /// A policy running on a robot.
-#[derive(Debug)]
-pub struct Running<B: Body> {
-    runner: Option<Runner<PolicyJob<B>>>,
+pub struct Running<H: Send + Sync + 'static, B: Body> {
+    runner: Option<Runner<PolicyJob<H, B>>>,
     waker: Waker,
     shared: Arc<Shared>,
 }
 
-impl<B: Body> Running<B> {
+impl<H: Send + Sync + 'static, B: Body> std::fmt::Debug for Running<H, B> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Running").field("phase", &self.phase()).finish_non_exhaustive()
+    }
+}
+
+impl<H: Send + Sync + 'static, B: Body> Running<H, B> {
     /// Damps the robot and ends the run at the next tick.
     pub fn stop(&self) {
         self.shared.stop.store(true, Ordering::Release);
@@ -155,7 +163,7 @@ impl<B: Body> Running<B> {
     }
 }
 
-impl<B: Body> Drop for Running<B> {
+impl<H: Send + Sync + 'static, B: Body> Drop for Running<H, B> {
     fn drop(&mut self) {
         self.stop();
         if let Some(runner) = self.runner.take() {
@@ -164,26 +172,34 @@ impl<B: Body> Drop for Running<B> {
     }
 }
 
-/// Starts `policy` on `body` for `config`: waits for the first LowState, releases the robot's
-/// controller (`options.release`), and runs the sequence on its own thread.
-pub async fn start<B: Body>(
-    body: Arc<B>,
+/// Starts `policy` for `config` on the robot's client that `body` finds in `holder` (`Some` for
+/// a client held as it is, `robowire_devices::AnyDevice::g1` for a device opened by address):
+/// waits for the first LowState, releases the robot's controller (`options.release`), and runs
+/// the sequence on its own thread. The holder is kept (and dropped) by the run.
+pub async fn start<H, B>(
+    holder: Arc<H>,
+    body: fn(&H) -> Option<&B>,
     config: &PolicyConfig,
     policy: OnnxPolicy,
     options: RunOptions,
-) -> Result<Running<B>, StartError> {
+) -> Result<Running<H, B>, StartError>
+where
+    H: Send + Sync + 'static,
+    B: Body,
+{
     if config.msg_type != B::MSG_TYPE {
         return Err(StartError::MsgType { config: config.msg_type, device: B::MSG_TYPE });
     }
+    let robot = body(&holder).ok_or(StartError::NoBody(B::MSG_TYPE))?;
     let velocity = match config.observation.contains(&Term::BaseLinVel) {
-        true => Some(BaseVelocity::read(&*body).map_err(StartError::SportState)?),
+        true => Some(BaseVelocity::read(robot).map_err(StartError::SportState)?),
         false => None,
     };
     let motors = config.msg_type.motors();
     let (mut q, mut dq) = (vec![0.0; motors], vec![0.0; motors]);
     let deadline = robowire_rt::now() + FIRST_STATE;
     let reading = loop {
-        if let Some(reading) = body.sense(&mut q, &mut dq).filter(|r| r.age <= STALE_STATE) {
+        if let Some(reading) = robot.sense(&mut q, &mut dq).filter(|r| r.age <= STALE_STATE) {
             break reading;
         }
         if robowire_rt::now() >= deadline {
@@ -192,9 +208,9 @@ pub async fn start<B: Body>(
         tokio::time::sleep(Duration::from_millis(10)).await;
     };
     if options.release {
-        body.release().await.map_err(StartError::Release)?;
+        robot.release().await.map_err(StartError::Release)?;
     }
-    let mut controller = Controller::new(config, policy);
+    let mut controller = Controller::new(config, policy, B::joint_range);
     let sensed = Sensed {
         quaternion_wxyz: reading.quaternion_wxyz,
         gyroscope_rad_s: reading.gyroscope_rad_s,
@@ -211,6 +227,7 @@ pub async fn start<B: Body>(
         report: Mutex::new(StepReport::default()),
     });
     let job = PolicyJob {
+        holder,
         body,
         controller,
         velocity,
@@ -229,8 +246,9 @@ pub async fn start<B: Body>(
 }
 
 /// The run on the runner's thread.
-struct PolicyJob<B: Body> {
-    body: Arc<B>,
+struct PolicyJob<H, B> {
+    holder: Arc<H>,
+    body: fn(&H) -> Option<&B>,
     controller: Controller,
     velocity: Option<Arc<BaseVelocity>>,
     command: Arc<CommandSlot>,
@@ -244,10 +262,12 @@ struct PolicyJob<B: Body> {
     done: bool,
 }
 
-impl<B: Body> PolicyJob<B> {
+impl<H: Send + Sync + 'static, B: Body> PolicyJob<H, B> {
     /// Damps the robot and ends the run with `why`.
     fn end(&mut self, why: Ended) {
-        self.body.damp();
+        if let Some(body) = (self.body)(&self.holder) {
+            body.damp();
+        }
         self.controller.stop();
         self.done = true;
         *robowire_rt::lock(&self.shared.phase) = Phase::Damped;
@@ -255,7 +275,7 @@ impl<B: Body> PolicyJob<B> {
     }
 }
 
-impl<B: Body> Job for PolicyJob<B> {
+impl<H: Send + Sync + 'static, B: Body> Job for PolicyJob<H, B> {
     fn next_run(&mut self) -> Option<Time> {
         (!self.done).then_some(self.next)
     }
@@ -276,7 +296,11 @@ impl<B: Body> Job for PolicyJob<B> {
         {
             return self.end(Ended::Duration);
         }
-        let reading = self.body.sense(&mut self.q, &mut self.dq);
+        let holder = self.holder.clone();
+        let Some(body) = (self.body)(&holder) else {
+            return self.end(Ended::Refused("the device no longer holds the robot's client".into()));
+        };
+        let reading = body.sense(&mut self.q, &mut self.dq);
         let base_velocity = self.velocity.as_ref().and_then(|v| v.latest(STALE_STATE));
         let sensed = reading.map(|r| {
             let sensed = Sensed {
@@ -290,7 +314,7 @@ impl<B: Body> Job for PolicyJob<B> {
         });
         let state = sensed.as_ref().map(|(s, age)| (s, *age));
         let outcome = match self.controller.tick(now, state, self.command.get()) {
-            Tick::Command(targets) => self.body.command(targets).err().map(Ended::Refused),
+            Tick::Command(targets) => body.command(targets).err().map(Ended::Refused),
             Tick::Damp(fault) => Some(Ended::Fault(fault)),
         };
         if let Some(why) = outcome {

@@ -69,6 +69,12 @@ pub(crate) trait Plant: Send + std::fmt::Debug {
     }
     /// Simulated time stepped so far, s.
     fn time_s(&self) -> f64;
+    /// Whether the base is held (Unitree's elastic band); `false` (the default): it is not.
+    fn held(&self) -> bool {
+        false
+    }
+    /// Lets the base go (a plant that holds none ignores it).
+    fn let_go(&mut self) {}
 }
 
 /// The Go2's 12 motors on the kinematic joint model: motor `m` is leg `m / 3`, joint `m % 3`.

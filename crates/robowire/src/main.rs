@@ -38,6 +38,9 @@ enum Command {
     Go2(cmd::go2::Go2Args),
     /// Drive a Unitree G1 humanoid's low-level interface over DDS (status, watch, release, damp, zero).
     G1(cmd::g1::G1Args),
+    /// Run a trained locomotion policy (ONNX, unitree_rl_gym's deploy config) on a Unitree robot or its physics simulator.
+    #[command(subcommand)]
+    Policy(cmd::policy::PolicyCommand),
     /// Inspect DDS: the topics on the network, the samples of one.
     Dds(cmd::dds::DdsCommandArgs),
     /// Every device as a ROS 2 node on the wire (cmd_vel, odom, tf, imu, joint_states, …), no ROS install needed.
@@ -68,6 +71,9 @@ fn main() -> ExitCode {
         Command::Demo(args) if args.runs_go2() => Some(robowire_dds::netns::for_this_process()),
         Command::Status(args) if args.device.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Watch(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
+        Command::Policy(cmd::policy::PolicyCommand::Run(args)) if args.simulates_dds() => {
+            Some(robowire_dds::netns::for_this_process())
+        }
         _ => None,
     };
     let result = match cli.command {
@@ -79,6 +85,7 @@ fn main() -> ExitCode {
         Command::Zsl1(args) => cmd::zsl1::run(args),
         Command::Go2(args) => cmd::go2::run(args),
         Command::G1(args) => cmd::g1::run(args),
+        Command::Policy(command) => cmd::policy::run(command, loopback),
         Command::Dds(args) => cmd::dds::run(args),
         Command::Ros2(args) => cmd::ros2::run(args),
         Command::Shm(command) => cmd::shm::run(&command),

@@ -22,7 +22,9 @@ fn controller() -> (Controller, PolicyConfig) {
         outputs: vec![("actions", vec![1, 12])],
     };
     let policy = OnnxPolicy::load(&model.write(), 47, 12).unwrap();
-    (Controller::new(&config, policy), config)
+    // Ankle rolls (slots 5 and 11) within ±0.1 rad.
+    let range = |motor: usize| [5, 11].contains(&motor).then_some((-0.1, 0.1));
+    (Controller::new(&config, policy, range), config)
 }
 
 const ZEROS: [f32; 35] = [0.0; 35];
@@ -67,11 +69,13 @@ fn stand_hold_then_walk_as_deploy_real() {
     assert_eq!(c.phase(), Phase::Walking);
     // sqrt(4 × 0.25) = 1 on every joint: target = 1 × 0.25 + default.
     let walking = targets(c.tick(at(STAND_S + HOLD_S + 0.02), Some((&sensed, FRESH)), [0.3, 0.0, 0.0]));
-    let expected: Vec<f32> = config.default_angles.iter().map(|d| 0.25 + d).collect();
+    // The ankle rolls' 0.25 clamped to their 0.1.
+    let expected: Vec<f32> =
+        config.default_angles.iter().enumerate().map(|(j, d)| if j % 6 == 5 { 0.1 } else { 0.25 + d }).collect();
     assert!(walking[..12].iter().zip(&expected).all(|(w, e)| (w - e).abs() < 1e-6), "{walking:?}");
     assert_eq!(&walking[12..], config.arm_waist_target.as_slice());
     let report = c.report();
-    assert_eq!((report.step, report.action[0], report.command), (1, 1.0, [0.3, 0.0, 0.0]));
+    assert_eq!((report.step, report.action[0], report.command, report.clamped), (1, 1.0, [0.3, 0.0, 0.0], 2));
     assert_eq!(report.obs[6], 0.6);
 }
 

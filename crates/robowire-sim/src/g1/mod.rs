@@ -68,7 +68,7 @@ pub use crate::unitree::{
     AdvanceError, BasePose, COMMAND_HOLD_S, Fault as G1Fault, MAX_SPEED, SimClock, SimError as G1SimError,
     StreamCounters,
 };
-pub use model::{CONTROLLER_GAINS, G1Body, JOINTS, STAND_POSE_RAD, SUPPLY_V, has_disabled_motor};
+pub use model::{CONTROLLER_GAINS, G1Body, JOINTS, LET_GO_AFTER_S, STAND_POSE_RAD, SUPPLY_V, has_disabled_motor};
 pub use services::HOLDING_ACTIONS;
 
 use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};

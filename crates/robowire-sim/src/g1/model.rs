@@ -90,6 +90,13 @@ const STOPS: [JointStops; JOINTS] = {
 #[cfg(feature = "mujoco")]
 const PELVIS_HEIGHT_M: f64 = 0.95;
 
+/// The leg joints: slots 0..12 (left hip pitch … right ankle roll).
+const LEG_SLOTS: usize = 12;
+
+/// How long a LowCmd stream drives every leg joint with stiffness before a held pelvis is let
+/// go, s.
+pub const LET_GO_AFTER_S: f32 = 3.5;
+
 /// [`STAND_POSE_RAD`], the slots `variant` does not drive at 0.
 fn start_pose(variant: G1Variant) -> [f32; JOINTS] {
     core::array::from_fn(|s| if variant.drives(s) { STAND_POSE_RAD[s] } else { 0.0 })
@@ -114,6 +121,8 @@ pub struct G1Body {
     /// Motors that failed: they report mode 0 and produce no torque.
     faulted: [bool; JOINTS],
     tick_ms: u32,
+    /// How long the LowCmds have driven every leg joint, while the pelvis is held, s.
+    driven_s: f32,
 }
 
 /// Whether a motor command sets any target, gain or torque.
@@ -144,7 +153,11 @@ impl G1Body {
     }
 
     /// As [`G1Body::new`], in MuJoCo: robowire's model of the G1 or the user's MJCF of
-    /// `options` (hanging, its pelvis held, when `options.hanging`).
+    /// `options`. Hanging (`options.hanging`): its pelvis held where it starts for good. Free:
+    /// it settles on the floor, standing, and its pelvis is held there as on Unitree's elastic
+    /// band until a LowCmd stream has driven every leg joint with stiffness for
+    /// [`LET_GO_AFTER_S`]; then it is let go (a real G1 hangs on its gantry until its controller
+    /// runs).
     #[cfg(feature = "mujoco")]
     pub fn physics(
         variant: G1Variant,
@@ -163,6 +176,7 @@ impl G1Body {
         let mut physics = crate::physics::Physics::load(&rig, options)?;
         if !options.hanging {
             physics.settle(0.5);
+            physics.hold_base();
         }
         Ok(Self::on(Box::new(physics), variant, mode_machine))
     }
@@ -181,7 +195,24 @@ impl G1Body {
             arm_weight: 0.0,
             faulted: [false; JOINTS],
             tick_ms: 0,
+            driven_s: 0.0,
         }
+    }
+
+    /// Whether the pelvis is held (a free body not yet let go).
+    pub fn held(&self) -> bool {
+        self.plant.held()
+    }
+
+    /// Whether the latest LowCmd, fresh, drives every leg joint (slots 0..12) with stiffness.
+    fn drives_legs(&self) -> bool {
+        let fresh = self.lowcmd.as_ref().filter(|_| !self.controller && self.lowcmd_age_s <= COMMAND_HOLD_S);
+        fresh.is_some_and(|cmd| {
+            cmd.motor_cmd[..LEG_SLOTS]
+                .iter()
+                .enumerate()
+                .all(|(s, m)| !self.faulted[s] && m.mode == 1 && m.kp.get() > 0.0)
+        })
     }
 
     /// Which G1 this is.
@@ -335,6 +366,12 @@ impl G1Body {
         self.arm_sdk_age_s += dt_s;
         if self.arm_sdk_age_s > COMMAND_HOLD_S {
             self.arm_weight = (self.arm_weight - ARM_SDK_WEIGHT_RATE_PER_S * dt_s).max(0.0);
+        }
+        if self.plant.held() {
+            self.driven_s = if self.drives_legs() { self.driven_s + dt_s } else { 0.0 };
+            if self.driven_s >= LET_GO_AFTER_S {
+                self.plant.let_go();
+            }
         }
         let targets = self.targets();
         self.plant.step(dt_s, &targets);

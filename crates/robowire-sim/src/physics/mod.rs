@@ -12,6 +12,7 @@
 //! A foot's force is the sum of the normal forces of the contacts on the foot motor's body and
 //! the bodies below it.
 
+mod band;
 mod rig;
 
 use std::path::{Path, PathBuf};
@@ -109,6 +110,8 @@ pub struct Physics {
     carry_s: f64,
     /// Time stepped since the robot was placed (its settling not counted), s.
     time_s: f64,
+    /// The base held until [`Plant::let_go`].
+    band: Option<band::Band>,
 }
 
 impl std::fmt::Debug for Physics {
@@ -206,6 +209,7 @@ impl Physics {
             foot_force_n: [0.0; 4],
             carry_s: 0.0,
             time_s: 0.0,
+            band: None,
         })
     }
 
@@ -231,6 +235,19 @@ impl Physics {
         self.data.forward();
     }
 
+    /// Holds the base where it is, as on Unitree's elastic band, until [`Plant::let_go`].
+    pub fn hold_base(&mut self) {
+        let model = self.data.model();
+        let base = model.jnt_bodyid()[0] as usize;
+        let mass = model.body_subtreemass().get(base).copied().unwrap_or(30.0);
+        let base_kg = model.body_mass().get(base).copied().unwrap_or(1.0);
+        let inertia = model.body_inertia().get(base).map_or(0.01, |i| i.iter().copied().fold(f64::MAX, f64::min));
+        let qpos = self.data.qpos();
+        let mut pose = [0.0; 7];
+        pose.copy_from_slice(&qpos[self.base_qpos..self.base_qpos + 7]);
+        self.band = Some(band::Band::at(pose, mass, base_kg, inertia, STEP_S));
+    }
+
     /// One 1 ms step, motor `m` commanded `targets[m]`.
     fn step_once(&mut self, targets: &[PdTarget]) {
         let (qpos, qvel) = (self.data.qpos(), self.data.qvel());
@@ -242,7 +259,15 @@ impl Physics {
             let torque = if torque.is_finite() { torque.clamp(-m.tau_max_nm, m.tau_max_nm) } else { 0.0 };
             self.tau_nm[slot] = torque as f32;
         }
+        let held = self.band.as_ref().map(|band| {
+            let (p, v) = (self.base_qpos, self.base_dof);
+            let qpos: [f64; 7] = core::array::from_fn(|i| qpos[p + i]);
+            let qvel: [f64; 6] = core::array::from_fn(|i| qvel[v + i]);
+            band.forces(&qpos, &qvel)
+        });
+        let base_dof = self.base_dof;
         let applied = self.data.qfrc_applied_mut();
+        applied[base_dof..base_dof + 6].copy_from_slice(&held.unwrap_or([0.0; 6]));
         for (motor, tau) in self.motors.iter().zip(&self.tau_nm) {
             if let Some(m) = motor {
                 applied[m.dof] = f64::from(*tau);
@@ -339,6 +364,14 @@ impl Plant for Physics {
 
     fn time_s(&self) -> f64 {
         self.time_s
+    }
+
+    fn held(&self) -> bool {
+        self.band.is_some()
+    }
+
+    fn let_go(&mut self) {
+        self.band = None;
     }
 }
 

@@ -13,6 +13,13 @@ pub(crate) struct DeviceArgs {
     /// The device: kmc:/dev/ttyUSB0, zsl1:192.168.234.1, zsl1w:IP, go2:eth0, hg:eth0, g1:eth0,
     /// spline:/spline_shm, or sim:kmc|zsl1|zsl1w|go2|spline for a simulator started here.
     address: DeviceAddress,
+    #[command(flatten)]
+    reach: ReachArgs,
+}
+
+/// How to reach a device given by address.
+#[derive(Debug, Args)]
+pub(crate) struct ReachArgs {
     /// DDS domain (go2:, hg:, g1:, sim:go2).
     #[arg(long, default_value_t = 0)]
     domain: u16,
@@ -29,7 +36,7 @@ pub(crate) struct DeviceArgs {
     record: crate::cmd::record::RecordArgs,
     /// sim:go2's and sim:g1's body: --physics [--model MJCF] [--free-base].
     #[command(flatten)]
-    body: crate::cmd::sim_body::SimPhysicsArgs,
+    pub(crate) body: crate::cmd::sim_body::SimPhysicsArgs,
 }
 
 #[derive(Debug, Args)]
@@ -54,9 +61,22 @@ impl DeviceArgs {
         command: &str,
         run: impl FnOnce(AnyDevice) -> F,
     ) -> anyhow::Result<ExitCode> {
-        let recorder = self.record.start(&format!("{command} {}", self.address))?;
+        self.reach.recording(&self.address, command, run)
+    }
+}
+
+impl ReachArgs {
+    /// [`DeviceArgs::recording`] for the device at `address`.
+    pub(crate) fn recording<F: Future<Output = anyhow::Result<AnyDevice>>>(
+        &self,
+        address: &DeviceAddress,
+        command: &str,
+        run: impl FnOnce(AnyDevice) -> F,
+    ) -> anyhow::Result<ExitCode> {
+        let recorder = self.record.start(&format!("{command} {address}"))?;
         let ran = runtime()?.block_on(async {
-            let device = run(self.open(recorder.as_ref().map(robowire_record::Recorder::links)).await?).await?;
+            let device =
+                run(self.open(address, recorder.as_ref().map(robowire_record::Recorder::links)).await?).await?;
             eprintln!("{}", device.stats_line());
             device.close().context("closing the device")
         });
@@ -65,9 +85,9 @@ impl DeviceArgs {
         ran.map(|()| ExitCode::SUCCESS)
     }
 
-    /// Opens the device, its links recorded with `record` if given, and waits for its first
-    /// state.
-    async fn open(&self, record: Option<RecordLinks>) -> anyhow::Result<AnyDevice> {
+    /// Opens the device at `address`, its links recorded with `record` if given, and waits for
+    /// its first state.
+    async fn open(&self, address: &DeviceAddress, record: Option<RecordLinks>) -> anyhow::Result<AnyDevice> {
         let timeout = crate::cmd::seconds("--connect-timeout-s", self.connect_timeout_s)?;
         let options = OpenOptions {
             domain: self.domain,
@@ -76,7 +96,6 @@ impl DeviceArgs {
             sim_physics: self.body.options(),
             ..OpenOptions::default()
         };
-        let address = &self.address;
         let device = robowire_devices::open(address, &options).with_context(|| format!("opening {address}"))?;
         if !device.wait_state(timeout).await {
             anyhow::bail!("no state from {address} within {:.1} s: {}", timeout.as_secs_f64(), what_to_check(address));

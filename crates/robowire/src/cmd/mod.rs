@@ -12,6 +12,7 @@ pub(crate) mod go2;
 pub(crate) mod kmc;
 pub(crate) mod live;
 pub(crate) mod plot;
+pub(crate) mod policy;
 pub(crate) mod record;
 pub(crate) mod replay_device;
 pub(crate) mod ros2;

@@ -32,6 +32,16 @@ pub(crate) struct SimPhysicsArgs {
 }
 
 impl SimPhysicsArgs {
+    /// Whether `--physics` was given.
+    pub(crate) fn physics(&self) -> bool {
+        self.body.physics
+    }
+
+    /// The base free on the floor, whatever `--free-base` said.
+    pub(crate) fn free_the_base(&mut self) {
+        self.free_base = true;
+    }
+
     /// What `robowire_devices::open` is asked for: `None`, the kinematic body.
     pub(crate) fn options(&self) -> Option<robowire_devices::SimPhysics> {
         self.body.physics.then(|| robowire_devices::SimPhysics {

@@ -1,0 +1,173 @@
+//! `robowire policy run CONFIG.yaml --device ADDRESS`: a trained locomotion policy (ONNX, with
+//! unitree_rl_gym's deploy config) on a G1 or a Go2, or on their physics simulators, through
+//! `robowire_policy`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use clap::{Args, Subcommand};
+use robowire_devices::{AnyDevice, DeviceAddress, DeviceKind};
+use robowire_policy::control::{HOLD_S, STAND_S};
+use robowire_policy::{Body, CommandSlot, Ended, MsgType, OnnxPolicy, Phase, PolicyConfig, RunOptions, Running};
+
+use crate::cmd::device::ReachArgs;
+
+#[derive(Debug, Subcommand)]
+pub(crate) enum PolicyCommand {
+    /// Run a policy: wait for the robot's state, release its controller, move to the default
+    /// pose in 2 s, hold it 1 s, then run the policy every control_dt until --duration or
+    /// Ctrl-C. A stale state (100 ms), a tilt past max_tilt_rad, an action that is not finite or
+    /// a command the robot's limits refuse damp the robot at once.
+    Run(RunArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RunArgs {
+    /// The deploy config: unitree_rl_gym's deploy_real/configs/*.yaml, policy_path an ONNX file
+    /// relative to it.
+    config: PathBuf,
+    /// The robot: g1:IFACE, go2:IFACE, or sim:g1 / sim:go2 with --physics (started here, its base
+    /// free on the floor).
+    #[arg(long)]
+    device: DeviceAddress,
+    /// The velocity asked: vx m/s, vy m/s, wz rad/s (clamped to the config's max_cmd).
+    #[arg(long, value_name = "VX,VY,WZ", default_value = "0,0,0", value_parser = parse_command)]
+    cmd: [f32; 3],
+    /// Seconds the policy runs once it took over (default: until Ctrl-C).
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// Run the policy from the first tick: no move to the default pose, no hold.
+    #[arg(long)]
+    no_stand: bool,
+    #[command(flatten)]
+    reach: ReachArgs,
+}
+
+impl RunArgs {
+    /// A simulator on DDS: it and the policy's client meet on loopback, which needs multicast.
+    pub(crate) fn simulates_dds(&self) -> bool {
+        self.device.is_simulated() && self.device.uses_dds()
+    }
+}
+
+fn parse_command(text: &str) -> Result<[f32; 3], String> {
+    let values: Vec<f32> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().map_err(|e| format!("{v:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match <[f32; 3]>::try_from(values) {
+        Ok(command) if command.iter().all(|v| v.is_finite()) => Ok(command),
+        Ok(command) => Err(format!("{command:?}: every value must be finite")),
+        Err(values) => Err(format!("three values VX,VY,WZ, found {}", values.len())),
+    }
+}
+
+pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::Loopback>) -> anyhow::Result<ExitCode> {
+    let PolicyCommand::Run(mut args) = command;
+    let config = PolicyConfig::load(&args.config).map_err(anyhow::Error::msg)?;
+    let msg_type = robot_of(&args.device, args.reach.body.physics())?;
+    if config.msg_type != msg_type {
+        bail!(
+            "msg_type: {} is a config for {:?} robots, {} is {:?}",
+            args.config.display(),
+            config.msg_type,
+            args.device,
+            msg_type
+        );
+    }
+    let duration = args.duration.map(|s| crate::cmd::seconds("--duration", s)).transpose()?;
+    let policy =
+        OnnxPolicy::load(&config.policy_path, config.num_obs, config.num_actions).map_err(anyhow::Error::msg)?;
+    // A policy walks a simulated robot on the floor.
+    args.reach.body.free_the_base();
+    let options = RunOptions { command: CommandSlot::new(args.cmd), duration, stand: !args.no_stand, release: true };
+    let mut ended = None;
+    let code = crate::cmd::device::on_loopback(loopback, || {
+        args.reach.recording(&args.device, "robowire policy run", |device| async {
+            let device = Arc::new(device);
+            let end = match msg_type {
+                MsgType::Hg => walk(device.clone(), AnyDevice::g1, &config, policy, options).await?,
+                MsgType::Go => walk(device.clone(), AnyDevice::go2, &config, policy, options).await?,
+            };
+            ended = Some(end);
+            Arc::try_unwrap(device).map_err(|_| anyhow::anyhow!("the policy's thread still holds the device"))
+        })
+    })?;
+    Ok(match ended {
+        Some(Ended::Duration | Ended::Stopped) => code,
+        _ => ExitCode::FAILURE,
+    })
+}
+
+/// Which message family the robot at `address` speaks, or why a policy cannot drive it.
+fn robot_of(address: &DeviceAddress, physics: bool) -> anyhow::Result<MsgType> {
+    let msg_type = match address {
+        DeviceAddress::G1(_) | DeviceAddress::Sim(DeviceKind::G1) => MsgType::Hg,
+        DeviceAddress::Go2(_) | DeviceAddress::Sim(DeviceKind::Go2) => MsgType::Go,
+        DeviceAddress::Hg(_) => {
+            bail!("{address}: a policy drives a G1 as g1:IFACE (hg:/h1: robots are not supported yet)")
+        }
+        other => {
+            bail!("{other}: a policy drives a Unitree robot: g1:IFACE, go2:IFACE, sim:g1 or sim:go2 with --physics")
+        }
+    };
+    if address.is_simulated() && !physics {
+        bail!(
+            "{address} is the kinematic simulator: its joints follow the commands and nothing walks; \
+             add --physics (a build with --features mujoco)"
+        );
+    }
+    Ok(msg_type)
+}
+
+/// Runs the policy on the robot `body` finds in `device` until it ends or Ctrl-C, a line each
+/// second.
+async fn walk<B: Body>(
+    device: Arc<AnyDevice>,
+    body: fn(&AnyDevice) -> Option<&B>,
+    config: &PolicyConfig,
+    policy: OnnxPolicy,
+    options: RunOptions,
+) -> anyhow::Result<Ended> {
+    let command = options.command.get();
+    let running = robowire_policy::start(device, body, config, policy, options).await.context("starting the policy")?;
+    eprintln!(
+        "policy {} every {} ms: standing {STAND_S} s, holding {HOLD_S} s, then walking at ({}, {}, {})",
+        config.policy_path.display(),
+        (config.control_dt * 1e3).round(),
+        command[0],
+        command[1],
+        command[2],
+    );
+    let ended = until_ended(&running).await;
+    drop(running);
+    eprintln!("ended: {ended}; the robot was damped");
+    Ok(ended)
+}
+
+async fn until_ended<H: Send + Sync + 'static, B: Body>(running: &Running<H, B>) -> Ended {
+    let ended = running.ended();
+    tokio::pin!(ended);
+    let ctrl_c = tokio::signal::ctrl_c();
+    tokio::pin!(ctrl_c);
+    let mut every = tokio::time::interval(Duration::from_secs(1));
+    loop {
+        tokio::select! {
+            end = &mut ended => return end,
+            _ = &mut ctrl_c => running.stop(),
+            _ = every.tick() => {
+                let step = running.last_step();
+                match running.phase() {
+                    Phase::Walking => eprintln!(
+                        "walking: step {}, command ({:.2}, {:.2}, {:.2}), inference {} µs",
+                        step.step, step.command[0], step.command[1], step.command[2], step.inference.as_micros()
+                    ),
+                    phase => eprintln!("{phase:?}"),
+                }
+            }
+        }
+    }
+}

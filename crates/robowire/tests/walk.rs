@@ -1,0 +1,107 @@
+//! Unitree's G1 walking policy (`../shared/policies`: its ONNX and its own deploy config) on the
+//! physics G1 (feature `mujoco`): `robowire sim g1 --physics --free-base` in one process,
+//! `robowire policy run g1_walk.yaml --device g1:lo` in another, and the pelvis watched on
+//! `rt/sportmodestate` by a participant of the test's own. Where loopback carries multicast
+//! (`robowire_dds::netns`).
+
+mod support;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use robowire_dds::qos::Qos;
+use robowire_dds::{Participant, ParticipantOptions};
+use robowire_fixtures::{interop, peers};
+use support::{Running, robowire};
+use unitree_proto::sport_state::SportModeState;
+
+/// The pelvis as `rt/sportmodestate` said: x, y, z (m) and yaw (rad), in order.
+#[derive(Default)]
+struct Track(Mutex<Vec<[f32; 4]>>);
+
+/// Watches `rt/sportmodestate` on `lo` until `done`.
+fn watch(done: Arc<AtomicBool>) -> (Arc<Track>, std::thread::JoinHandle<()>) {
+    let track = Arc::new(Track::default());
+    let thread = std::thread::spawn({
+        let track = track.clone();
+        move || {
+            let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+            runtime.block_on(async {
+                let options = ParticipantOptions { interface: Some("lo".into()), ..ParticipantOptions::default() };
+                let participant = Participant::new(options).unwrap();
+                let mut reader = participant.reader::<SportModeState>("rt/sportmodestate", Qos::READER).unwrap();
+                while !done.load(Ordering::Acquire) {
+                    if let Ok(Ok(sample)) = tokio::time::timeout(Duration::from_millis(100), reader.recv()).await {
+                        let s = sample.value;
+                        let [x, y, z] = s.position.map(|v| v.get());
+                        track.0.lock().unwrap().push([x, y, z, s.imu_state.rpy[2].get()]);
+                    }
+                }
+            });
+        }
+    });
+    (track, thread)
+}
+
+/// Runs the policy at `cmd` for 10 s on a free physics G1; the pelvis's track.
+fn walk(cmd: &str) -> Vec<[f32; 4]> {
+    let Some(dir) = interop::require(peers::policies_dir()) else { return Vec::new() };
+    let track = Arc::new(Mutex::new(Vec::new()));
+    robowire_dds::netns::with_loopback_multicast(|| {
+        let sim =
+            Running::start(&["sim", "g1", "--physics", "--free-base", "--interface", "lo", "--report-every-s", "0"]);
+        assert!(sim.first_line.starts_with("g1 domain 0 lo"), "{}", sim.first_line);
+        let done = Arc::new(AtomicBool::new(false));
+        let (seen, watcher) = watch(done.clone());
+        let out = robowire()
+            .args(["policy", "run"])
+            .arg(dir.join("g1_walk.yaml"))
+            .args(["--device", "g1:lo", "--cmd", cmd, "--duration", "10"])
+            .output()
+            .unwrap();
+        done.store(true, Ordering::Release);
+        watcher.join().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        eprintln!("{stderr}");
+        assert!(out.status.success() && stderr.contains("ended: the duration ran out"), "{stderr}");
+        *track.lock().unwrap() = std::mem::take(&mut *seen.0.lock().unwrap());
+        drop(sim);
+    });
+    let track = std::mem::take(&mut *track.lock().unwrap());
+    track
+}
+
+/// The lowest pelvis on the track, m.
+fn lowest(track: &[[f32; 4]]) -> f32 {
+    track.iter().map(|p| p[2]).fold(f32::MAX, f32::min)
+}
+
+#[test]
+fn unitrees_g1_policy_walks_the_physics_g1_forward() {
+    let track = walk("0.5,0,0");
+    let (Some(first), Some(last)) = (track.first(), track.last()) else { return };
+    let forward = last[0] - first[0];
+    eprintln!("{} states: from {first:?} to {last:?}, lowest {:.3} m", track.len(), lowest(&track));
+    assert!(track.len() > 1000, "rt/sportmodestate through the run: {}", track.len());
+    assert!(forward >= 2.0, "walked {forward:.2} m forward in 10 s at 0.5 m/s");
+    assert!(lowest(&track) >= 0.5, "the pelvis stayed above 0.5 m: {:.3}", lowest(&track));
+}
+
+#[test]
+fn unitrees_g1_policy_turns_the_physics_g1_in_place() {
+    let track = walk("0,0,0.5");
+    let (Some(first), Some(last)) = (track.first(), track.last()) else { return };
+    // The yaw unwrapped along the track.
+    let turned: f32 = track
+        .windows(2)
+        .map(|w| {
+            let d = w[1][3] - w[0][3];
+            (d + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+        })
+        .sum();
+    let moved = ((last[0] - first[0]).powi(2) + (last[1] - first[1]).powi(2)).sqrt();
+    eprintln!("turned {turned:.2} rad, moved {moved:.2} m, lowest {:.3} m", lowest(&track));
+    assert!(turned >= 2.0, "turned {turned:.2} rad in 10 s at 0.5 rad/s");
+    assert!(lowest(&track) >= 0.5, "the pelvis stayed above 0.5 m: {:.3}", lowest(&track));
+}
