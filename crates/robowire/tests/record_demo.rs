@@ -1,6 +1,6 @@
 //! The demo's capture (`robowire demo --record`: every simulated device in one file) read back by
 //! an independent reader, the `mcap` Python package with Unitree's IDL classes
-//! (`tests/record_interop/read_capture.py`): every channel has a schema, every JSON message
+//! (`robowire-record/tests/interop/read_capture.py`): every channel has a schema, every JSON message
 //! parses, every Unitree `cdr` message deserialises with Unitree's class and carries Unitree's CRC
 //! (but the bit flips the demo injects), log times are monotonic per channel, and the counts are
 //! the demo's own. Then `robowire plot` draws it, and refuses a truncated copy.
@@ -38,7 +38,7 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
         device["counters"][name].as_u64().unwrap_or_else(|| panic!("{name} of {device}"))
     };
 
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../robowire-record/tests/interop/read_capture.py");
     let read = Command::new(&python).arg(script).arg(&capture).output().unwrap();
     assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
     let seen: Value = serde_json::from_slice(&read.stdout).unwrap();

@@ -20,7 +20,7 @@ fn temp(name: &str) -> PathBuf {
 
 /// What `read_capture.py` makes of `capture`.
 fn read_with_python(python: &Path, capture: &Path) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../robowire-record/tests/interop/read_capture.py");
     let read = Command::new(python).arg(script).arg(capture).output().unwrap();
     assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
     serde_json::from_slice(&read.stdout).unwrap()
