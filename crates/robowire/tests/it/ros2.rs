@@ -5,15 +5,14 @@
 //! CycloneDDS, ros2-client and robowire's own DDS) is tested in-process with its crate,
 //! `robowire-ros2` (`tests/it/`).
 
-mod support;
-
 use std::io::{BufRead, BufReader, Read};
 use std::process::{Child, Stdio};
 use std::sync::{Arc, Mutex};
 
 use robowire_dds::netns::with_loopback_multicast;
 use serde_json::Value;
-use support::robowire;
+
+use crate::support::robowire;
 
 /// `robowire ros2 ARGS`, started and waited for (its "ready" line), and its log since.
 struct Bridge(Child, Arc<Mutex<String>>);

@@ -4,12 +4,11 @@
 //! `robowire replay --as-device` plays a recorded walk to a live client. (The recorder's captures
 //! read by an independent reader, the `mcap` Python package: robowire-record's tests.)
 
-mod support;
-
 use std::process::Stdio;
 
 use serde_json::Value;
-use support::{Running, robowire};
+
+use crate::support::{Running, robowire};
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("robowire-record-{}-{name}", std::process::id()))
