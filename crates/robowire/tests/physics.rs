@@ -9,6 +9,7 @@
 //! robot, a user's model) are robowire-sim's `tests/physics.rs`; `sim:go2` and `sim:g1` with
 //! physics by address, robowire-devices' `tests/physics.rs`.
 
+#[path = "it/support.rs"]
 mod support;
 
 use serde_json::Value;

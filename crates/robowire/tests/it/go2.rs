@@ -3,13 +3,12 @@
 //! `robowire go2 …` against the same simulator. Each where loopback carries multicast
 //! (`robowire_dds::netns`).
 
-mod support;
-
 use std::io::{BufRead, BufReader};
 use std::process::Stdio;
 
 use robowire_dds::netns::with_loopback_multicast;
-use support::{Running, robowire, start_example, with_unitree_examples};
+
+use crate::support::{Running, robowire, start_example, with_unitree_examples};
 
 /// `robowire sim go2 --interface lo`, started and waited for.
 fn start_sim() -> Running {

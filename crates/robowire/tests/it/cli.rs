@@ -1,17 +1,12 @@
 //! The `robowire` binary as users script it.
 
-mod support;
-
 use std::process::Output;
-use std::sync::Mutex;
 
-use support::{Running, robowire};
+use crate::support::{Running, one_demo_at_a_time, robowire};
 
-/// `robowire demo …`, one at a time: its scenarios are paced by the wall clock (a phase of
-/// motion lasts so long), and two at once on two cores starve each other's streams.
+/// `robowire demo …`, one at a time ([`one_demo_at_a_time`]).
 fn demo(args: &[&str]) -> Output {
-    static TURN: Mutex<()> = Mutex::new(());
-    let _turn = robowire_rt::lock(&TURN);
+    let _turn = one_demo_at_a_time();
     robowire().arg("demo").args(args).output().unwrap()
 }
 

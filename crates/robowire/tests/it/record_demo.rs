@@ -1,17 +1,13 @@
 //! The demo's capture (`robowire demo --record`: every simulated device in one file) read back by
 //! an independent reader, the `mcap` Python package with Unitree's IDL classes
-//! (`tests/record_interop/read_capture.py`): every channel has a schema, every JSON message
+//! (`robowire-record/tests/interop/read_capture.py`): every channel has a schema, every JSON message
 //! parses, every Unitree `cdr` message deserialises with Unitree's class and carries Unitree's CRC
 //! (but the bit flips the demo injects), log times are monotonic per channel, and the counts are
 //! the demo's own. Then `robowire plot` draws it, and refuses a truncated copy.
 
-mod support;
-
-use std::path::Path;
-use std::process::Command;
-
 use serde_json::Value;
-use support::robowire;
+
+use crate::support::{one_demo_at_a_time, read_capture, robowire};
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("robowire-record-demo-{}-{name}", std::process::id()))
@@ -28,7 +24,9 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
         return;
     };
     let capture = temp("demo.mcap");
+    let turn = one_demo_at_a_time();
     let demo = robowire().args(["demo", "--duration", "1", "--json", "--record"]).arg(&capture).output().unwrap();
+    drop(turn);
     let stderr = String::from_utf8_lossy(&demo.stderr);
     assert!(demo.status.success(), "{stderr}");
     assert!(stderr.contains(" 0 dropped") && stderr.contains(" 0 without JSON"), "{stderr}");
@@ -38,10 +36,7 @@ fn the_demo_capture_reads_back_with_the_demo_counts() {
         device["counters"][name].as_u64().unwrap_or_else(|| panic!("{name} of {device}"))
     };
 
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
-    let read = Command::new(&python).arg(script).arg(&capture).output().unwrap();
-    assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
-    let seen: Value = serde_json::from_slice(&read.stdout).unwrap();
+    let seen = read_capture(&python, &capture);
     let channels = seen["channels"].as_object().unwrap();
     for (topic, c) in channels {
         assert!(c["schema"].is_string() && c["schema_encoding"].is_string(), "{topic} has a schema: {c}");

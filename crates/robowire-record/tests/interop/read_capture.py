@@ -1,5 +1,6 @@
 """Reads a robowire capture with the `mcap` Python package, an MCAP reader independent of
-robowire's, and prints what it found as one JSON line.
+robowire's, and prints what it found as one JSON line (for robowire-record's tests, and the
+`robowire` crate's tests of the captures its commands' `--record` makes).
 
     python read_capture.py FILE.mcap
 

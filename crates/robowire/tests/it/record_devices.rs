@@ -4,32 +4,23 @@
 //! then read back by the `mcap` Python package (where its environment is: every JSON message
 //! parses, log times are monotonic per channel, every channel has messages).
 
-mod support;
-
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use robowire_core::Direction;
 use robowire_core::json::{LinkDescription, SKIPPED_BYTES};
 use serde_json::Value;
-use support::{Running, robowire};
+
+use crate::support::{Running, one_demo_at_a_time, read_capture, robowire};
 
 fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("robowire-record-devices-{}-{name}", std::process::id()))
 }
 
-/// What `read_capture.py` makes of `capture`.
-fn read_with_python(python: &Path, capture: &Path) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
-    let read = Command::new(python).arg(script).arg(capture).output().unwrap();
-    assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
-    serde_json::from_slice(&read.stdout).unwrap()
-}
-
 /// The channels of `capture` as the `mcap` package reads them: each has messages, monotonic
 /// log times, and every JSON message parses. The topics, sorted.
 fn check_with_python(python: &Path, capture: &Path) -> Vec<String> {
-    let seen = read_with_python(python, capture);
+    let seen = read_capture(python, capture);
     let channels = seen["channels"].as_object().unwrap();
     for (topic, c) in channels {
         assert!(c["count"].as_u64().unwrap() > 0, "{topic}");
@@ -116,8 +107,10 @@ fn both_ends_of_a_kmc_line_record_the_same_frames() {
 #[test]
 fn the_spline_demo_records_its_client_and_imu_reader() {
     let capture = temp("spline.mcap");
+    let turn = one_demo_at_a_time();
     let demo =
         robowire().args(["demo", "--only", "spline", "--duration", "1", "--record"]).arg(&capture).output().unwrap();
+    drop(turn);
     let log = String::from_utf8_lossy(&demo.stderr).to_string();
     assert!(demo.status.success(), "{}{log}", String::from_utf8_lossy(&demo.stdout));
     assert!(log.contains("record:") && log.contains(" 0 dropped"), "{log}");

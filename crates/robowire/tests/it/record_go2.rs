@@ -4,14 +4,12 @@
 //! with `unitree_sdk2py`'s classes and carries the CRC Unitree's `crc.py` computes; the counts
 //! equal what the programs counted. Where loopback carries multicast (`robowire_dds::netns`).
 
-mod support;
-
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use robowire_dds::netns::with_loopback_multicast;
-use serde_json::Value;
-use support::{Running, robowire};
+
+use crate::support::{Running, read_capture, robowire};
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("robowire-record-go2-{}-{name}", std::process::id()))
@@ -20,14 +18,6 @@ fn temp(name: &str) -> std::path::PathBuf {
 /// The number after `label` in `line` (`lowcmd sent 1234 …`).
 fn count_after(line: &str, label: &str) -> u64 {
     line.split(label).nth(1).and_then(|rest| rest.split_whitespace().next()).and_then(|n| n.parse().ok()).unwrap_or(0)
-}
-
-/// What `read_capture.py` makes of `capture`.
-fn read_with_python(python: &Path, capture: &Path) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record_interop/read_capture.py");
-    let read = Command::new(python).arg(script).arg(capture).output().unwrap();
-    assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
-    serde_json::from_slice(&read.stdout).unwrap()
 }
 
 #[test]
@@ -62,7 +52,7 @@ fn check_go2_session(python: &Path) {
     assert!(client_stderr.contains("record:") && client_stderr.contains(" 0 dropped"), "{client_stderr}");
     let stats_line = client_stderr.lines().find(|l| l.starts_with("lowcmd sent")).unwrap_or_default();
 
-    let client = read_with_python(python, &client_capture);
+    let client = read_capture(python, &client_capture);
     assert_eq!(client["unitree_types"], true, "Unitree's IDL classes imported");
     let channels = client["channels"].as_object().unwrap();
     let expected = [
@@ -97,7 +87,7 @@ fn check_go2_session(python: &Path) {
     assert!(received >= count_after(stats_line, "lowstate received "), "{received}: {stats_line}");
 
     // The simulator's side: what it took and wrote.
-    let sim = read_with_python(python, &sim_capture);
+    let sim = read_capture(python, &sim_capture);
     let channels = sim["channels"].as_object().unwrap();
     let lowcmds = &channels["/go2/low_level/received"];
     assert_eq!(lowcmds["schema"], "unitree_go::msg::dds_::LowCmd_");

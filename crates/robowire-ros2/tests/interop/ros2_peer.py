@@ -1,5 +1,6 @@
-"""A ROS 2 peer on CycloneDDS (no ROS install): drives `robowire ros2` the way a ROS 2 node on
-rmw_cyclonedds would, and prints what it saw as one JSON line.
+"""A ROS 2 peer on CycloneDDS (no ROS install): drives the bridge (robowire-ros2, the library
+behind `robowire ros2`) the way a ROS 2 node on rmw_cyclonedds would, and prints what it saw as
+one JSON line.
 
     python ros2_peer.py SCENARIO NAMESPACE
 

@@ -4,15 +4,14 @@
 //! `rt/lowstate` sample, the joints by phase). Each where loopback carries multicast
 //! (`robowire_dds::netns`).
 
-mod support;
-
 use std::io::BufReader;
 use std::path::Path;
 use std::process::{Child, Stdio};
 
 use robowire_dds::netns::with_loopback_multicast;
 use serde_json::Value;
-use support::{Running, robowire, start_example, with_unitree_examples};
+
+use crate::support::{Running, robowire, start_example, with_unitree_examples};
 
 /// The stand pose of the simulator's controller, by slot (unitree_rl_gym's default angles).
 const STAND: [f64; 12] = [-0.1, 0.0, 0.0, 0.3, -0.2, 0.0, -0.1, 0.0, 0.0, 0.3, -0.2, 0.0];
@@ -26,7 +25,7 @@ fn start_sim() -> Running {
 
 /// The observer on `lo` in `mode`, once it saw a first state.
 fn start_observer(python: &Path, mode: &str) -> (Child, BufReader<std::process::ChildStdout>) {
-    support::start_observer(python, "tests/g1_interop/observe_lowstate.py", &["lo", mode])
+    crate::support::start_observer(python, "tests/g1_interop/observe_lowstate.py", &["lo", mode])
 }
 
 fn f64s(value: &Value) -> Vec<f64> {
@@ -52,7 +51,7 @@ fn unitree_g1_low_level_example_runs_unchanged_against_the_simulator() {
         let mut example = start_example(python, &examples.join("low_level"), "g1_low_level_example.py");
         // The observer ends once the example's third (AB) stage swung the ankle; the example
         // itself never ends.
-        let seen = support::observer_summary(observer, observed);
+        let seen = crate::support::observer_summary(observer, observed);
         let _ = example.kill();
         let out = example.wait_with_output().unwrap();
         let context = format!("{seen}\nexample: {}", String::from_utf8_lossy(&out.stderr));
@@ -119,7 +118,7 @@ fn unitree_g1_arm_sdk_example_lifts_the_arms_on_the_simulator() {
         let stdout = String::from_utf8_lossy(&out.stdout);
         assert!(stdout.contains("Done!"), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
         drop(observer.stdin.take());
-        let seen = support::observer_summary(observer, observed);
+        let seen = crate::support::observer_summary(observer, observed);
         assert_eq!((seen["timed_out"].as_bool(), seen["bad_crc"].as_u64()), (Some(false), Some(0)), "{seen}");
         // Stage 2: the left shoulder roll and both elbows to π/2, the right shoulder roll to −π/2.
         let all = &seen["all"];

@@ -3,13 +3,12 @@
 //! addresses; physics asked of a device without a simulated body. (The Go2 on DDS is in
 //! `tests/go2.rs`, in a private network.)
 
-mod support;
-
 use std::process::Stdio;
 
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig};
 use serde_json::Value;
-use support::{Running, robowire};
+
+use crate::support::{Running, robowire};
 
 /// `robowire status ARGS --json`: its JSON.
 fn status_json(args: &[&str]) -> Value {

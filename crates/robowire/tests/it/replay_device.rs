@@ -4,8 +4,6 @@
 //! recorded states, in order; and what it cannot play is a clear error (exit code 1), never a
 //! panic.
 
-mod support;
-
 use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::Duration;
@@ -13,7 +11,8 @@ use std::time::Duration;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_fixtures::wait::runtime;
 use robowire_record::{Direction, RecordedFrame};
-use support::{Running, robowire};
+
+use crate::support::{Running, one_demo_at_a_time, robowire};
 
 /// Generous: a state not seen within this is a failure, not slowness.
 const WAIT: Duration = Duration::from_secs(30);
@@ -22,14 +21,9 @@ fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("robowire-replay-device-{}-{name}", std::process::id()))
 }
 
-/// One demo at a time: this file's tests run in parallel, and three demos at once on a 2-core
-/// machine starve the spline daemon's 1 kHz loop (the demo's PD loop then stops at its stall
-/// bound).
-static DEMO: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
 /// `robowire demo --only DEVICE --duration 1 --record CAPTURE`, and the capture's frames.
 fn record_demo(device: &str, capture: &Path) -> Vec<RecordedFrame> {
-    let one_at_a_time = DEMO.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let one_at_a_time = one_demo_at_a_time();
     let demo =
         robowire().args(["demo", "--only", device, "--duration", "1", "--record"]).arg(capture).output().unwrap();
     drop(one_at_a_time);

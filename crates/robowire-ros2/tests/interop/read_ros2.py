@@ -1,7 +1,7 @@
-"""Reads a ROS 2 capture of `robowire ros2 --record` with two ROS 2 readers independent of
-robowire's: `rosbags` (as a rosbag2 MCAP file) and `mcap-ros2-support` (the `mcap` package's ROS 2
-decoder), each decoding every message with the `ros2msg` definition in the file, and prints what
-they found as one JSON line.
+"""Reads a ROS 2 capture of the bridge (`BridgeOptions::record`; `robowire ros2 --record`) with
+two ROS 2 readers independent of robowire's: `rosbags` (as a rosbag2 MCAP file) and
+`mcap-ros2-support` (the `mcap` package's ROS 2 decoder), each decoding every message with the
+`ros2msg` definition in the file, and prints what they found as one JSON line.
 
     python read_ros2.py FILE.mcap
 

@@ -1,11 +1,9 @@
 //! `robowire sim zsl1` and `robowire zsl1 …` as separate processes on loopback, the way a user
 //! scripts them; and `dog`, their old name, still accepted for one release.
 
-mod support;
-
 use std::process::Output;
 
-use support::{Running, robowire};
+use crate::support::{Running, one_demo_at_a_time, robowire};
 
 /// Starts `robowire sim zsl1` on free ports; returns it and its HighLevel port.
 fn sim(extra: &[&str]) -> (Running, String) {
@@ -105,7 +103,9 @@ fn a_taken_local_port_names_the_address_and_lists_host_addresses() {
 
 #[test]
 fn demo_drives_the_simulated_zsl1_and_checks_what_it_saw() {
+    let turn = one_demo_at_a_time();
     let out = robowire().args(["demo", "--only", "zsl1"]).output().unwrap();
+    drop(turn);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("zsl1: walks a square and returns to the start"), "{stdout}");

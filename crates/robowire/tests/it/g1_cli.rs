@@ -2,13 +2,12 @@
 //! `robowire sim g1 --interface lo`, each where loopback carries multicast
 //! (`robowire_dds::netns`): what the commands print, and what the simulator says it received.
 
-mod support;
-
 use std::io::{BufRead, BufReader};
 use std::process::{Output, Stdio};
 
 use robowire_dds::netns::with_loopback_multicast;
-use support::{Running, robowire};
+
+use crate::support::{Running, robowire};
 
 /// `robowire sim g1 --interface lo ARGS`, started and waited for.
 fn start_sim(args: &[&str]) -> Running {

@@ -2,11 +2,9 @@
 //! an unreadable capture, a wrong interface name — exits non-zero with one line that says what
 //! to do, and never panics.
 
-mod support;
-
 use std::net::UdpSocket;
 
-use support::robowire;
+use crate::support::robowire;
 
 /// One case: the arguments, and words the error line must contain (what to do about it).
 struct Case {

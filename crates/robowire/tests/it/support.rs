@@ -1,10 +1,31 @@
-//! What the CLI's integration tests share: the binary under test, and a `robowire` process (a
-//! simulator, a replay) that ends with its test.
+//! What the CLI's integration tests share: the binary under test, a `robowire` process (a
+//! simulator, a replay) that ends with its test, one demo at a time, the peers' scripts.
 
-#![allow(dead_code, reason = "each test binary uses part of it")]
+#![allow(dead_code, reason = "`tests/it` and `tests/physics.rs` each use part of it")]
 
 use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
 use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
+use std::sync::MutexGuard;
+
+use serde_json::Value;
+
+/// One `robowire demo` of this binary at a time while the guard lives: a demo's scenarios are
+/// paced by the wall clock (a phase of motion lasts so long), and two at once on two cores starve
+/// each other's streams (the spline daemon's 1 kHz loop first: the demo's PD loop then stops at
+/// its stall bound).
+pub(crate) fn one_demo_at_a_time() -> MutexGuard<'static, ()> {
+    robowire_fixtures::wait::one_at_a_time()
+}
+
+/// What the `mcap` Python package (with `python`, the peers' environment) reads in `capture`:
+/// robowire-record's independent reader, `robowire-record/tests/interop/read_capture.py`.
+pub(crate) fn read_capture(python: &Path, capture: &Path) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../robowire-record/tests/interop/read_capture.py");
+    let read = Command::new(python).arg(script).arg(capture).output().unwrap();
+    assert!(read.status.success(), "{}", String::from_utf8_lossy(&read.stderr));
+    serde_json::from_slice(&read.stdout).unwrap()
+}
 
 /// Runs `test` with the peers' Python and the directory `examples` gives (one of
 /// `robowire_fixtures::peers`' Unitree example directories), in a network namespace where
@@ -12,7 +33,7 @@ use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
 /// they are missing (`robowire_fixtures::interop::require`).
 pub(crate) fn with_unitree_examples(
     examples: fn() -> Result<std::path::PathBuf, String>,
-    test: impl FnOnce(&std::path::Path, &std::path::Path) + Send,
+    test: impl FnOnce(&Path, &Path) + Send,
 ) {
     let Some(python) = robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python()) else {
         return;
@@ -23,7 +44,7 @@ pub(crate) fn with_unitree_examples(
 
 /// Unitree's Python example `name` in `dir` with `python`, its Enter prompt answered, on `lo`
 /// (domain 0); stdout and stderr piped.
-pub(crate) fn start_example(python: &std::path::Path, dir: &std::path::Path, name: &str) -> Child {
+pub(crate) fn start_example(python: &Path, dir: &Path, name: &str) -> Child {
     use std::io::Write;
     let mut example = Command::new(python)
         .arg(name)
@@ -41,8 +62,8 @@ pub(crate) fn start_example(python: &std::path::Path, dir: &std::path::Path, nam
 
 /// An observer script (`script`, relative to this crate) on Unitree's SDK with `python` and
 /// `args`, once it printed `ready` (its stdin piped: some end when it closes).
-pub(crate) fn start_observer(python: &std::path::Path, script: &str, args: &[&str]) -> (Child, BufReader<ChildStdout>) {
-    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
+pub(crate) fn start_observer(python: &Path, script: &str, args: &[&str]) -> (Child, BufReader<ChildStdout>) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
     let mut child = Command::new(python)
         .arg(script)
         .args(args)
@@ -64,7 +85,7 @@ pub(crate) fn start_observer(python: &std::path::Path, script: &str, args: &[&st
 }
 
 /// An observer's summary (its last line, one JSON object) once it ended.
-pub(crate) fn observer_summary(mut observer: Child, mut stdout: BufReader<ChildStdout>) -> serde_json::Value {
+pub(crate) fn observer_summary(mut observer: Child, mut stdout: BufReader<ChildStdout>) -> Value {
     let mut out = String::new();
     stdout.read_to_string(&mut out).unwrap();
     let status = observer.wait().unwrap();
