@@ -5,7 +5,7 @@
 //!
 //! Two binaries stay apart: `tests/dds_flood` (it floods every DDS port of the programs it starts
 //! and measures their memory; run alone, it shares the two cores with no other test) and
-//! `tests/physics.rs` (built only with the feature `mujoco`, by `cargo xtask mujoco`'s runs).
+//! `tests/physics/` (built only with the feature `mujoco`, by `cargo xtask mujoco`'s runs).
 
 mod support;
 
@@ -17,6 +17,7 @@ mod g1;
 mod g1_cli;
 mod go2;
 mod lowlevel;
+mod policy;
 mod record;
 mod record_demo;
 mod record_devices;

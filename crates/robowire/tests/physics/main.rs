@@ -7,10 +7,12 @@
 //! multicast (`robowire_dds::netns`). `robowire status sim:go2 --physics` reads a LowState of
 //! the body in MuJoCo. The sans-IO physics checks (a tenth of the gains, the damped and silent
 //! robot, a user's model) are robowire-sim's `tests/physics.rs`; `sim:go2` and `sim:g1` with
-//! physics by address, robowire-devices' `tests/physics.rs`.
+//! physics by address, robowire-devices' `tests/physics.rs`. Unitree's G1 walking policy on the
+//! free physics G1: [`walk`].
 
-#[path = "it/support.rs"]
+#[path = "../it/support.rs"]
 mod support;
+mod walk;
 
 use serde_json::Value;
 use support::{Running, observer_summary, robowire, start_example, start_observer, with_unitree_examples};

@@ -4,16 +4,14 @@
 //! `rt/sportmodestate` by a participant of the test's own. Where loopback carries multicast
 //! (`robowire_dds::netns`).
 
-mod support;
-
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use crate::support::{Running, robowire};
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_fixtures::{interop, peers};
-use support::{Running, robowire};
 use unitree_proto::sport_state::SportModeState;
 
 /// The pelvis as `rt/sportmodestate` said: x, y, z (m) and yaw (rad), in order.
@@ -68,8 +66,7 @@ fn walk(cmd: &str) -> Vec<[f32; 4]> {
         *track.lock().unwrap() = std::mem::take(&mut *seen.0.lock().unwrap());
         drop(sim);
     });
-    let track = std::mem::take(&mut *track.lock().unwrap());
-    track
+    std::mem::take(&mut *track.lock().unwrap())
 }
 
 /// The lowest pelvis on the track, m.

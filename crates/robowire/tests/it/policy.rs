@@ -3,9 +3,7 @@
 //! whose sizes disagree, a model that is not there. The walks themselves (MuJoCo) are
 //! `tests/walk.rs`.
 
-mod support;
-
-use support::robowire;
+use crate::support::robowire;
 
 /// Unitree's G1 deploy config with its fields unchanged, beside a model path that does not exist.
 const G1_YAML: &str = "control_dt: 0.02\nmsg_type: \"hg\"\nimu_type: \"pelvis\"\nlowcmd_topic: \"rt/lowcmd\"\n\
