@@ -7,6 +7,10 @@
 //! coarse phase ends within the kernel's wake-up latency instead of the default 50 µs slack;
 //! the spin absorbs that latency. Optional `SCHED_FIFO` priority, CPU pinning and `mlockall`.
 //!
+//! A runner started with [`Runner::spawn_polling`] also runs its job as soon as one of the job's
+//! file descriptors (a socket) has something to read: it waits in `poll(2)` instead of parking,
+//! so that a datagram is handled on the runner's thread without a hand-over to it.
+//!
 //! ```
 //! use std::time::Duration;
 //! use robowire_core::schedule::{Periodic, Time};
@@ -31,6 +35,12 @@
 //! # Ok::<(), robowire_rt::RtError>(())
 //! ```
 
+mod poll;
+#[cfg(test)]
+mod tests;
+
+use std::os::fd::OwnedFd;
+use std::os::unix::net::UnixDatagram;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::{JoinHandle, Thread};
@@ -39,6 +49,7 @@ use std::time::Duration;
 use robowire_core::schedule::Time;
 
 use crate::{Placement, RtError, now};
+use poll::Readable;
 
 /// Periodic work for a [`Runner`].
 pub trait Job: Send + 'static {
@@ -47,7 +58,8 @@ pub trait Job: Send + 'static {
     fn next_run(&mut self) -> Option<Time>;
 
     /// Does what is due at `now`. Called at (just after) the deadline, or earlier when a
-    /// [`Waker`] woke the thread.
+    /// [`Waker`] woke the thread or, on a [`Runner::spawn_polling`] runner, when one of its file
+    /// descriptors has something to read.
     fn run(&mut self, now: Time);
 }
 
@@ -84,6 +96,20 @@ impl RunnerOptions {
 struct Control {
     stop: AtomicBool,
     woken: AtomicBool,
+    /// A polling runner's end of its wake socket pair: a datagram sent on it ends the thread's
+    /// `poll(2)`.
+    wake: Option<UnixDatagram>,
+}
+
+impl Control {
+    /// Ends the thread's wait, parked or polling.
+    fn notify(&self, thread: &Thread) {
+        thread.unpark();
+        if let Some(wake) = &self.wake {
+            // Non-blocking: a full socket already holds a wake-up.
+            let _ = wake.send(&[1]);
+        }
+    }
 }
 
 /// Wakes a runner's thread early: its job runs at once (to send a stop, say). Cheap to clone,
@@ -98,7 +124,7 @@ impl Waker {
     /// The job runs as soon as the thread is scheduled.
     pub fn wake(&self) {
         self.control.woken.store(true, Ordering::Release);
-        self.thread.unpark();
+        self.control.notify(&self.thread);
     }
 }
 
@@ -117,8 +143,31 @@ impl<J: Job> std::fmt::Debug for Runner<J> {
 impl<J: Job> Runner<J> {
     /// Starts the thread: placement first (an error there is returned, and the thread ends),
     /// then the loop.
-    pub fn spawn(options: RunnerOptions, mut job: J) -> Result<Self, RtError> {
-        let control = Arc::new(Control::default());
+    pub fn spawn(options: RunnerOptions, job: J) -> Result<Self, RtError> {
+        Self::start(options, job, Control::default(), None)
+    }
+
+    /// Starts the thread as [`spawn`](Self::spawn) does; the job also runs as soon as one of
+    /// `readable` has something to read (or an error to report). The thread waits in `poll(2)`
+    /// on them until [`RunnerOptions::spin`] before the deadline, then spins with a non-blocking
+    /// look at them. The job reads them without blocking; what it leaves unread runs it again at
+    /// once.
+    pub fn spawn_polling(options: RunnerOptions, job: J, readable: Vec<OwnedFd>) -> Result<Self, RtError> {
+        let wake_error = |source| RtError::Wake { name: options.name.clone(), source };
+        let (wake, woken) = UnixDatagram::pair().map_err(wake_error)?;
+        wake.set_nonblocking(true).map_err(wake_error)?;
+        woken.set_nonblocking(true).map_err(wake_error)?;
+        let control = Control { wake: Some(wake), ..Control::default() };
+        Self::start(options, job, control, Some(Readable::new(woken, readable)))
+    }
+
+    fn start(
+        options: RunnerOptions,
+        mut job: J,
+        control: Control,
+        readable: Option<Readable>,
+    ) -> Result<Self, RtError> {
+        let control = Arc::new(control);
         let (placed_tx, placed) = std::sync::mpsc::sync_channel(1);
         let name = options.name.clone();
         let thread = std::thread::Builder::new()
@@ -130,7 +179,10 @@ impl<J: Job> Runner<J> {
                     let ok = placement.is_ok();
                     let _ = placed_tx.send(placement);
                     if ok {
-                        run(&mut job, &control, options.spin);
+                        match readable {
+                            None => run(&mut job, &control, |deadline| wait_until(deadline, options.spin, &control)),
+                            Some(readable) => readable.run(&mut job, &control, options.spin),
+                        }
                     }
                     job
                 }
@@ -167,7 +219,7 @@ impl<J: Job> Runner<J> {
 
     fn request_stop(&self) {
         self.waker.control.stop.store(true, Ordering::Release);
-        self.waker.thread.unpark();
+        self.waker.control.notify(&self.waker.thread);
     }
 }
 
@@ -184,10 +236,11 @@ fn options_name<T>(thread: &JoinHandle<T>) -> String {
     thread.thread().name().unwrap_or_default().to_string()
 }
 
-fn run<J: Job>(job: &mut J, control: &Control, spin: Duration) {
+/// The loop: `wait` until each deadline (or less), then the job.
+fn run<J: Job>(job: &mut J, control: &Control, mut wait: impl FnMut(Time)) {
     while !control.stop.load(Ordering::Acquire) {
         let Some(deadline) = job.next_run() else { return };
-        wait_until(deadline, spin, control);
+        wait(deadline);
         if control.stop.load(Ordering::Acquire) {
             return;
         }

@@ -24,6 +24,15 @@ pub enum RtError {
         #[source]
         source: io::Error,
     },
+    /// The socket pair that wakes a polling runner's thread could not be made.
+    #[error("cannot make the wake-up socket of thread {name}")]
+    Wake {
+        /// The thread's name.
+        name: String,
+        /// What the system said.
+        #[source]
+        source: io::Error,
+    },
     /// `mlockall` failed.
     #[error("cannot lock the process's memory (needs CAP_IPC_LOCK or a memlock limit)")]
     LockMemory(#[source] io::Error),

@@ -134,3 +134,43 @@ async fn the_old_dog_names_still_work() {
     let robot: DogModel = snapshot.robot;
     assert_eq!(robot.faults().error_word, Some(ReturnCode::MotorFault));
 }
+
+/// The state stream reads both ports itself: every command and every bad datagram is counted,
+/// on each port, and the LowLevel port answers a changed command too.
+#[tokio::test]
+async fn commands_and_junk_on_both_ports_are_counted() {
+    use robowire_fixtures::wait::until_async;
+    use zsl_proto::udp::{LowLevelCommand, LowLevelState, MotorCommand};
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
+    let mut high = client(&sim).await;
+    for _ in 0..5 {
+        high.send(&HighLevelCommand::default()).await.unwrap();
+    }
+    let junk = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    junk.send_to(&[0xEE; 7], sim.high_level_addr()).unwrap();
+    junk.send_to(&[0xEE; 7], sim.low_level_addr()).unwrap();
+
+    let codec = ClientCodec::<LowLevelCommand, LowLevelState>::new(Model::Zsl1, StateDecoding::Strict);
+    let mut low =
+        UdpLink::bind("127.0.0.1:0".parse().unwrap(), Peer::AnyPortOf(sim.low_level_addr()), codec).await.unwrap();
+    let hold = LowLevelCommand::new(MotorCommand::pd_hold([[0.0; 4], [0.8; 4], [-1.5; 4]], [80.0; 3], [1.0; 3]));
+    low.send(&hold).await.unwrap();
+    let answer = tokio::time::timeout(WATCHDOG, low.recv()).await.expect("a LowLevel state in time");
+    assert!(answer.is_ok(), "{answer:?}");
+
+    let counted = || {
+        let s = sim.snapshot();
+        (s.high_level.commands, s.high_level.invalid, s.low_level.commands, s.low_level.invalid) == (5, 1, 1, 1)
+    };
+    until_async(WATCHDOG, "5 + 1 commands and 2 junk datagrams counted", counted).await;
+    assert_eq!(sim.snapshot().low_level.client, low.local_addr().ok(), "the LowLevel port learned whom to answer");
+}
+
+#[tokio::test]
+async fn a_taken_port_is_a_bind_error_inside_a_task_too() {
+    let sim = Zsl1Sim::spawn(Zsl1SimConfig::loopback()).unwrap();
+    let taken = Zsl1SimConfig { high_level_port: sim.high_level_addr().port(), ..Zsl1SimConfig::loopback() };
+    let error = Zsl1Sim::spawn(taken).unwrap_err();
+    assert_eq!(error.kind(), std::io::ErrorKind::AddrInUse, "{error}");
+    assert!(error.to_string().contains("cannot bind"), "{error}");
+}

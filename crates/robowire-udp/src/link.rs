@@ -1,5 +1,7 @@
 //! A socket, a peer and a codec: typed datagrams both ways.
 
+mod receiver;
+
 use std::fmt;
 use std::io;
 use std::net::SocketAddr;
@@ -12,6 +14,7 @@ use tokio::net::UdpSocket;
 
 use crate::stats::{Counters, StatsHandle};
 use crate::{LinkStats, UdpError, host_ipv4_addresses};
+pub use receiver::UdpReceiver;
 
 /// Whom a link talks to, and whom it accepts datagrams from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,6 +117,24 @@ impl<C: DatagramCodec + Clone> UdpLink<C> {
     /// Binds `local` (no `SO_REUSEADDR`: a second client on the same port fails, as with the
     /// vendor SDKs) and talks to `peer`. Must be called inside a tokio runtime.
     pub async fn bind(local: SocketAddr, peer: Peer, codec: C) -> Result<Self, UdpError<C::Error>> {
+        Self::bind_registered(local, peer, codec)
+    }
+
+    /// [`bind`](Self::bind) from any thread, inside a runtime or not: the socket is registered
+    /// with `runtime`, whose reactor serves the async calls. Links used only through the `_now`
+    /// calls need no more of it than that it outlives them.
+    pub fn bind_in(
+        runtime: &tokio::runtime::Handle,
+        local: SocketAddr,
+        peer: Peer,
+        codec: C,
+    ) -> Result<Self, UdpError<C::Error>> {
+        let _context = runtime.enter();
+        Self::bind_registered(local, peer, codec)
+    }
+
+    /// Binds with the socket registered with the runtime of the calling context.
+    fn bind_registered(local: SocketAddr, peer: Peer, codec: C) -> Result<Self, UdpError<C::Error>> {
         let bind_error = |source| UdpError::Bind { addr: local, source, host_ipv4: host_ipv4_addresses() };
         let std_socket = std::net::UdpSocket::bind(local).map_err(bind_error)?;
         std_socket.set_nonblocking(true)?;
@@ -139,6 +160,7 @@ impl<C: DatagramCodec + Clone> UdpLink<C> {
             destination,
             codec,
             buf: vec![0; C::MAX_DATAGRAM_LEN + 1].into_boxed_slice(),
+            control: nix::cmsg_space!(nix::sys::time::TimeSpec).into_boxed_slice(),
             counters,
             tap: None,
         };
@@ -282,160 +304,6 @@ impl<C: DatagramCodec> UdpSender<C> {
     /// The counters now.
     pub fn stats(&self) -> LinkStats {
         self.counters.snapshot()
-    }
-}
-
-/// The receiving half.
-pub struct UdpReceiver<C> {
-    socket: Arc<UdpSocket>,
-    peer: Peer,
-    destination: Destination,
-    codec: C,
-    buf: Box<[u8]>,
-    counters: Arc<Counters>,
-    tap: Option<Tap>,
-}
-
-impl<C> fmt::Debug for UdpReceiver<C> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("UdpReceiver").field("peer", &self.peer).finish_non_exhaustive()
-    }
-}
-
-impl<C: DatagramCodec> UdpReceiver<C> {
-    /// The next datagram from the peer, decoded. Datagrams the [`Peer`] does not accept are
-    /// dropped and counted; one that does not decode is counted and returned as
-    /// [`UdpError::Decode`], a socket error is counted and returned as [`UdpError::Io`] (the
-    /// link stays usable after both).
-    ///
-    /// Cancel-safe: if the future is dropped before it completes, no datagram is lost.
-    pub async fn recv(&mut self) -> Result<C::Incoming, UdpError<C::Error>> {
-        self.recv_from().await.map(|(message, _)| message)
-    }
-
-    /// [`recv`](Self::recv), with the datagram's source.
-    pub async fn recv_from(&mut self) -> Result<(C::Incoming, SocketAddr), UdpError<C::Error>> {
-        loop {
-            let (len, from) = match self.socket.recv_from(&mut self.buf).await {
-                Ok(received) => received,
-                Err(e) => {
-                    Counters::bump(&self.counters.receive_errors);
-                    return Err(e.into());
-                }
-            };
-            if let Some(result) = self.accept(len, from) {
-                return result.map(|message| (message, from));
-            }
-        }
-    }
-
-    /// Asks the kernel to stamp each datagram with its arrival time (`SO_TIMESTAMPNS`), for
-    /// [`recv_stamped`](Self::recv_stamped): arrival as the network stack saw it, whatever the
-    /// receiving thread's scheduling.
-    pub fn enable_arrival_stamps(&self) -> io::Result<()> {
-        nix::sys::socket::setsockopt(&*self.socket, nix::sys::socket::sockopt::ReceiveTimestampns, &true)
-            .map_err(io::Error::from)
-    }
-
-    /// [`recv_from`](Self::recv_from) with the kernel's arrival stamp (`CLOCK_REALTIME`, since the
-    /// Unix epoch), if [`enable_arrival_stamps`](Self::enable_arrival_stamps) was called.
-    pub async fn recv_stamped(
-        &mut self,
-    ) -> Result<(C::Incoming, SocketAddr, Option<std::time::Duration>), UdpError<C::Error>> {
-        use nix::sys::socket::{ControlMessageOwned, MsgFlags, SockaddrStorage, recvmsg};
-        use std::os::fd::AsRawFd;
-        loop {
-            let socket = self.socket.clone();
-            let buf = &mut self.buf;
-            let received = socket
-                .async_io(tokio::io::Interest::READABLE, || {
-                    let mut cmsg = nix::cmsg_space!(nix::sys::time::TimeSpec);
-                    let mut iov = [io::IoSliceMut::new(buf)];
-                    let msg =
-                        recvmsg::<SockaddrStorage>(socket.as_raw_fd(), &mut iov, Some(&mut cmsg), MsgFlags::empty())
-                            .map_err(io::Error::from)?;
-                    let stamp = msg.cmsgs().ok().and_then(|mut c| {
-                        c.find_map(|m| match m {
-                            ControlMessageOwned::ScmTimestampns(ts) => Some(std::time::Duration::new(
-                                u64::try_from(ts.tv_sec()).unwrap_or(0),
-                                u32::try_from(ts.tv_nsec()).unwrap_or(0),
-                            )),
-                            _ => None,
-                        })
-                    });
-                    let from = msg.address.and_then(|a: SockaddrStorage| {
-                        a.as_sockaddr_in()
-                            .map(|v4| SocketAddr::from((v4.ip(), v4.port())))
-                            .or_else(|| a.as_sockaddr_in6().map(|v6| SocketAddr::from((v6.ip(), v6.port()))))
-                    });
-                    Ok((msg.bytes, from, stamp))
-                })
-                .await;
-            let (len, from, stamp) = match received {
-                Ok((len, Some(from), stamp)) => (len, from, stamp),
-                Ok((_, None, _)) => continue,
-                Err(e) => {
-                    Counters::bump(&self.counters.receive_errors);
-                    return Err(e.into());
-                }
-            };
-            if let Some(result) = self.accept(len, from) {
-                return result.map(|message| (message, from, stamp));
-            }
-        }
-    }
-
-    /// A datagram of `len` bytes (in `buf`) from `from`: `None` if the peer filter drops it (counted),
-    /// else the decoded message or the decode error (counted).
-    fn accept(&mut self, len: usize, from: SocketAddr) -> Option<Result<C::Incoming, UdpError<C::Error>>> {
-        if !self.peer.accepts(from) {
-            Counters::bump(&self.counters.foreign_dropped);
-            return None;
-        }
-        Counters::bump(&self.counters.received);
-        if let Some(tap) = &self.tap {
-            tap.record(Direction::Received, &self.buf[..len]);
-        }
-        Some(match self.codec.decode(&self.buf[..len]) {
-            Ok(message) => {
-                if self.peer.learns() {
-                    // Only when it changed: the sender's read never retries on a steady peer.
-                    if destination(&self.destination) != Some(from) {
-                        self.destination.write(robowire_rt::now(), &address_words(from));
-                    }
-                }
-                Ok(message)
-            }
-            Err(e) => {
-                Counters::bump(&self.counters.decode_errors);
-                Err(UdpError::Decode(e))
-            }
-        })
-    }
-
-    /// The address the socket is bound to.
-    pub fn local_addr(&self) -> io::Result<SocketAddr> {
-        self.socket.local_addr()
-    }
-
-    /// Whom this half accepts datagrams from.
-    pub fn peer(&self) -> Peer {
-        self.peer
-    }
-
-    /// The counters now.
-    pub fn stats(&self) -> LinkStats {
-        self.counters.snapshot()
-    }
-
-    /// Hands every datagram accepted from the peer from now on to `tap` (`None`: stop).
-    pub fn set_tap(&mut self, tap: Option<Tap>) {
-        self.tap = tap;
-    }
-
-    /// The codec, for codecs that keep state (to reset it after a timeout, say).
-    pub fn codec_mut(&mut self) -> &mut C {
-        &mut self.codec
     }
 }
 

@@ -184,3 +184,43 @@ async fn arrival_stamps_are_the_network_stacks_times() {
     assert!(gap >= Duration::from_millis(19), "stamped when they arrived, not when read: {gap:?}");
     assert_eq!(receiver.stats().received, before + 2);
 }
+
+/// Waits (at most 2 s per look) on the receiver's socket, as a stream thread does, and returns
+/// the next datagram the peer filter lets through.
+fn next_now(receiver: &mut robowire_udp::UdpReceiver<Word>) -> Result<u32, UdpError<BadLength>> {
+    use rustix::event::{PollFd, PollFlags, Timespec, poll};
+    loop {
+        let mut fds = [PollFd::new(receiver, PollFlags::IN)];
+        let timeout = Timespec { tv_sec: 2, tv_nsec: 0 };
+        assert_eq!(poll(&mut fds, Some(&timeout)).unwrap(), 1, "a datagram within 2 s");
+        if let Some(received) = receiver.recv_stamped_now().transpose() {
+            return received.map(|(message, _, _)| message);
+        }
+    }
+}
+
+#[test]
+fn a_thread_outside_the_runtime_waits_on_the_socket_and_receives_now() {
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_io().build().unwrap();
+    let robot = peer();
+    let peer_filter = Peer::AnyPortOf(robot.local_addr().unwrap());
+    let link = UdpLink::bind_in(runtime.handle(), "127.0.0.1:0".parse().unwrap(), peer_filter, Word).unwrap();
+    let (mut sender, mut receiver) = link.into_split();
+    let to = receiver.local_addr().unwrap();
+    assert!(matches!(receiver.recv_stamped_now(), Ok(None)), "nothing waiting: no wait, no error");
+
+    robot.send_to(&[1, 2, 3], to).unwrap();
+    assert!(matches!(next_now(&mut receiver), Err(UdpError::Decode(BadLength(3)))));
+    let spoofer = UdpSocket::bind("127.0.0.2:0").expect("127.0.0.2 is loopback on Linux");
+    spoofer.send_to(&1u32.to_le_bytes(), to).unwrap();
+    robot.send_to(&2u32.to_le_bytes(), to).unwrap();
+    assert_eq!(next_now(&mut receiver).unwrap(), 2, "the spoofed 1 is dropped");
+    assert!(matches!(receiver.recv_stamped_now(), Ok(None)));
+
+    sender.send_now(&3).unwrap();
+    let mut buf = [0u8; 8];
+    let (n, from) = robot.recv_from(&mut buf).unwrap();
+    assert_eq!((&buf[..n], from), (&3u32.to_le_bytes()[..], to));
+    let stats = receiver.stats();
+    assert_eq!((stats.received, stats.decode_errors, stats.foreign_dropped, stats.sent), (2, 1, 1, 1));
+}

@@ -1,35 +1,32 @@
 //! [`Zsl1Sim`]: the [`Zsl1Model`] on the two UDP ports of the ZSL-1, through `robowire-udp`'s
 //! device side and the ZSL-1 codecs, so that the transport is exercised from both ends.
 //!
-//! The robot lives on its state stream (robowire's runner): it sends state to each client every
-//! `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted) and
-//! answers a command that changes something at once. A thread runs a small tokio runtime that
-//! receives commands on both ports and hands them over in a lock-free queue, waking the stream
-//! for a command that differs from the one before. The handle's requests and snapshots go
-//! through the crate's `handover` module: the stream takes no lock.
+//! The robot lives on its state stream (robowire's polling runner): it sends state to each client
+//! every `state_period` on absolute deadlines (a late tick is sent once, the missed slots counted)
+//! and, between deadlines, waits on both ports' sockets itself: a command is read, applied and,
+//! if it changes something, answered at once on the same thread. The handle's requests and
+//! snapshots go through the crate's `handover` module: the stream takes no lock.
 
 mod stream;
 
 use std::io;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::os::fd::AsFd;
 use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
-use crossbeam_queue::ArrayQueue;
 use robowire_core::DatagramCodec;
 use robowire_core::schedule::Periodic;
 use robowire_core::timing::LatenessSummary;
 use robowire_rt::runner::{Runner, RunnerOptions, Waker};
 use robowire_rt::stats::{Counter, SharedLateness};
-use robowire_udp::{Peer, UdpError, UdpLink, UdpReceiver, UdpSender};
-use tokio::sync::watch;
+use robowire_udp::{Peer, UdpError, UdpLink, UdpSender};
 use zsl_proto::codec::{HighLevelDogCodec, LowLevelDogCodec};
-use zsl_proto::udp::{HIGH_LEVEL_PORT, HighLevelCommand, LOW_LEVEL_PORT, LowLevelCommand, Model};
+use zsl_proto::udp::{HIGH_LEVEL_PORT, LOW_LEVEL_PORT, Model};
 
 use super::model::{Faults, Zsl1Fault, Zsl1Model};
 use crate::handover::{Published, Requests, StreamStats};
-use stream::{Receive, StateStream};
+use stream::{Port, StateStream};
 
 /// Simulator settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,9 +81,6 @@ pub struct PortStats {
     pub commands: u64,
     /// Datagrams that failed strict decoding (counted, ignored).
     pub invalid: u64,
-    /// Valid commands dropped because the state stream had not taken the ones before them (it
-    /// stalled for longer than its hand-over holds).
-    pub dropped: u64,
     /// State datagrams sent.
     pub states_sent: u64,
     /// Junk datagrams sent (garbage fault).
@@ -115,17 +109,6 @@ pub struct Zsl1Snapshot {
     pub state_lateness: LatenessSummary,
 }
 
-/// A valid command, as the receive task hands it to the state stream.
-#[derive(Debug, Clone, Copy)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "the queue's slots are allocated once; a boxed command would be freed on the stream thread"
-)]
-enum Command {
-    High(HighLevelCommand, Model),
-    Low(LowLevelCommand),
-}
-
 /// What the API asks of the state stream.
 #[derive(Debug, Clone, Copy)]
 enum Request {
@@ -134,13 +117,11 @@ enum Request {
     SetBatteryPercent(f32),
 }
 
-/// The counters of one port, each written by one thread (the receive task: commands, invalid,
-/// dropped, jitter; the state stream: states and garbage sent).
+/// The counters of one port, written by the state stream, read by the handle.
 #[derive(Debug, Default)]
 struct PortCounters {
     commands: Counter,
     invalid: Counter,
-    dropped: Counter,
     states_sent: Counter,
     garbage_sent: Counter,
     jitter: SharedLateness<4096>,
@@ -151,7 +132,6 @@ impl PortCounters {
         PortStats {
             commands: self.commands.get(),
             invalid: self.invalid.get(),
-            dropped: self.dropped.get(),
             states_sent: self.states_sent.get(),
             garbage_sent: self.garbage_sent.get(),
             client,
@@ -168,12 +148,9 @@ struct View {
     low_level_client: Option<SocketAddr>,
 }
 
-/// What the state stream shares with the receive task and the handle, none of it a lock the
-/// stream takes.
+/// What the state stream shares with the handle, none of it a lock the stream takes.
 #[derive(Debug)]
 struct Handover {
-    /// Commands in arrival order: each may change what the robot does.
-    commands: ArrayQueue<Command>,
     requests: Requests<Request>,
     view: Published<View>,
     stream: StreamStats<4096>,
@@ -181,9 +158,6 @@ struct Handover {
     low_level: PortCounters,
 }
 
-/// Commands the receive task may hand over before the stream takes them: a second of both
-/// ports at 500 Hz.
-const COMMANDS: usize = 1024;
 /// Requests the stream has not taken yet (the API waits for each).
 const REQUESTS: usize = 16;
 
@@ -207,13 +181,13 @@ fn send_state<C: DatagramCodec>(
     }
 }
 
-/// The robot on two UDP ports, on its own threads; stopped on drop.
+/// The robot on two UDP ports, on its own thread; stopped on drop.
 pub struct Zsl1Sim {
     handover: Arc<Handover>,
     stream: Option<Runner<StateStream>>,
     waker: Waker,
-    stop_receiving: watch::Sender<bool>,
-    receiver: Option<JoinHandle<()>>,
+    /// Dropped after the stream, which owns the sockets.
+    _reactor: Reactor,
     high_level_addr: SocketAddr,
     low_level_addr: SocketAddr,
 }
@@ -227,11 +201,24 @@ impl std::fmt::Debug for Zsl1Sim {
     }
 }
 
-type Senders = (UdpSender<HighLevelDogCodec>, UdpSender<LowLevelDogCodec>);
-type Receivers = (UdpReceiver<HighLevelDogCodec>, UdpReceiver<LowLevelDogCodec>);
+/// The runtime the sockets are registered with; nothing runs on it (the stream reads and sends
+/// without it). Shut down without waiting, so that a simulator can be dropped inside an async
+/// task.
+struct Reactor(Option<tokio::runtime::Runtime>);
 
-/// Binds both ports inside `runtime`.
-fn bind(runtime: &tokio::runtime::Runtime, config: &Zsl1SimConfig) -> io::Result<(Senders, Receivers)> {
+impl Drop for Reactor {
+    fn drop(&mut self) {
+        if let Some(runtime) = self.0.take() {
+            runtime.shutdown_background();
+        }
+    }
+}
+
+/// Binds both ports, registered with `runtime`.
+fn bind(
+    runtime: &tokio::runtime::Handle,
+    config: &Zsl1SimConfig,
+) -> io::Result<(UdpLink<HighLevelDogCodec>, UdpLink<LowLevelDogCodec>)> {
     let reply = Peer::Any { reply_to: config.client };
     let bind_error = |port: u16, e: UdpError<zsl_proto::udp::DatagramError>| {
         let kind = match &e {
@@ -240,21 +227,14 @@ fn bind(runtime: &tokio::runtime::Runtime, config: &Zsl1SimConfig) -> io::Result
         };
         io::Error::new(kind, format!("ZSL-1 simulator cannot bind {}:{port}: {}", config.bind, error_chain(&e)))
     };
-    runtime.block_on(async {
-        let mut high =
-            UdpLink::bind(SocketAddr::new(config.bind, config.high_level_port), reply, HighLevelDogCodec::default())
-                .await
-                .map_err(|e| bind_error(config.high_level_port, e))?;
-        let mut low =
-            UdpLink::bind(SocketAddr::new(config.bind, config.low_level_port), reply, LowLevelDogCodec::default())
-                .await
-                .map_err(|e| bind_error(config.low_level_port, e))?;
-        high.set_tap(config.high_level_tap.clone());
-        low.set_tap(config.low_level_tap.clone());
-        let (high_tx, high_rx) = high.into_split();
-        let (low_tx, low_rx) = low.into_split();
-        Ok(((high_tx, low_tx), (high_rx, low_rx)))
-    })
+    let at = |port| SocketAddr::new(config.bind, port);
+    let mut high = UdpLink::bind_in(runtime, at(config.high_level_port), reply, HighLevelDogCodec::default())
+        .map_err(|e| bind_error(config.high_level_port, e))?;
+    let mut low = UdpLink::bind_in(runtime, at(config.low_level_port), reply, LowLevelDogCodec::default())
+        .map_err(|e| bind_error(config.low_level_port, e))?;
+    high.set_tap(config.high_level_tap.clone());
+    low.set_tap(config.low_level_tap.clone());
+    Ok((high, low))
 }
 
 fn error_chain(e: &dyn std::error::Error) -> String {
@@ -270,68 +250,35 @@ fn error_chain(e: &dyn std::error::Error) -> String {
 impl Zsl1Sim {
     /// Binds both ports and starts the robot lying down.
     pub fn spawn(config: Zsl1SimConfig) -> io::Result<Self> {
-        let (started_tx, started) = std::sync::mpsc::sync_channel(1);
-        let (waker_tx, waker_rx) = std::sync::mpsc::sync_channel::<Waker>(1);
-        let (stop_receiving, mut stop_rx) = watch::channel(false);
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_io().build()?;
+        let bound = bind(runtime.handle(), &config);
+        let reactor = Reactor(Some(runtime));
+        let (high, low) = bound?;
+        let (high_level_addr, low_level_addr) = (high.local_addr()?, low.local_addr()?);
+        let (high, low) = (Port::new(high), Port::new(low));
+        let readable = vec![high.receiver.as_fd().try_clone_to_owned()?, low.receiver.as_fd().try_clone_to_owned()?];
         let robot = Zsl1Model::new(config.model);
         let handover = Arc::new(Handover {
-            commands: ArrayQueue::new(COMMANDS),
             requests: Requests::new(REQUESTS),
             view: Published::new(&View { robot: robot.clone(), high_level_client: None, low_level_client: None }),
             stream: StreamStats::default(),
             high_level: PortCounters::default(),
             low_level: PortCounters::default(),
         });
-        let receiver = std::thread::Builder::new().name("zsl1-sim-rx".into()).spawn({
-            let (config, handover) = (config.clone(), handover.clone());
-            move || {
-                let setup = || -> io::Result<_> {
-                    if let Some(cpu) = config.cpu {
-                        robowire_rt::pin_current_thread(cpu)
-                            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
-                    }
-                    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
-                    let (senders, receivers) = bind(&runtime, &config)?;
-                    Ok((runtime, senders, receivers))
-                };
-                let (runtime, senders, (high, low)) = match setup() {
-                    Ok(ok) => ok,
-                    Err(e) => {
-                        let _ = started_tx.send(Err(e));
-                        return;
-                    }
-                };
-                let _ = started_tx.send(Ok(senders));
-                // The stream's waker, once it runs (none: it did not start).
-                let Ok(waker) = waker_rx.recv() else { return };
-                let receive = Receive { handover: &handover, waker, period: config.state_period };
-                runtime.block_on(receive.run(high, low, &mut stop_rx));
-            }
-        })?;
-        let (high, low) = started.recv().map_err(|_| io::Error::other("the ZSL-1 simulator thread died"))??;
-        let (high_level_addr, low_level_addr) = (high.local_addr()?, low.local_addr()?);
         let job = StateStream {
             robot,
             high,
             low,
             handover: handover.clone(),
             grid: Periodic::new(robowire_rt::now(), config.state_period),
+            period: config.state_period,
             last_step: None,
         };
         let placement = robowire_rt::Placement { cpu: config.cpu, ..Default::default() };
-        let stream = Runner::spawn(RunnerOptions::placed("zsl1-sim-state", placement), job)
+        let stream = Runner::spawn_polling(RunnerOptions::placed("zsl1-sim-state", placement), job, readable)
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, error_chain(&e)))?;
         let waker = stream.waker();
-        let _ = waker_tx.send(waker.clone());
-        Ok(Self {
-            handover,
-            stream: Some(stream),
-            waker,
-            stop_receiving,
-            receiver: Some(receiver),
-            high_level_addr,
-            low_level_addr,
-        })
+        Ok(Self { handover, stream: Some(stream), waker, _reactor: reactor, high_level_addr, low_level_addr })
     }
 
     /// Where HighLevel commands go.
@@ -384,10 +331,6 @@ impl Drop for Zsl1Sim {
     fn drop(&mut self) {
         if let Some(stream) = self.stream.take() {
             stream.stop();
-        }
-        let _ = self.stop_receiving.send(true);
-        if let Some(receiver) = self.receiver.take() {
-            let _ = receiver.join();
         }
     }
 }
