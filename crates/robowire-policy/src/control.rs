@@ -8,9 +8,9 @@
 //! - the policy gave an action that is not finite, or failed;
 //! - the observation could not be built (a motor missing from the state).
 //!
-//! A policy's targets are clamped into each joint's range (the robot's hardware stops, the
-//! URDF's limits in training): the PD pushes toward the stop as it would toward the target
-//! beyond it. Targets between ticks are the LowCmd stream's to hold.
+//! Every target is clamped into its joint's range (the robot's hardware stops, the URDF's limits
+//! in training): the PD pushes toward the stop as it would toward the target beyond it (a joint
+//! resting just past its stop, a policy's target beyond it). Targets between ticks are the LowCmd stream's to hold.
 
 use std::time::{Duration, Instant};
 
@@ -111,7 +111,7 @@ pub struct StepReport {
     pub command: [f32; 3],
     /// The inference's duration.
     pub inference: Duration,
-    /// Targets clamped into their joint's range so far.
+    /// Targets clamped into their joint's range so far (every phase).
     pub clamped: u64,
 }
 
@@ -196,7 +196,14 @@ impl Controller {
     /// the velocity asked (vx m/s, vy m/s, wz rad/s).
     pub fn tick(&mut self, now: Time, state: Option<(&Sensed<'_>, Duration)>, command: [f32; 3]) -> Tick<'_> {
         match self.decide(now, state, command) {
-            Ok(()) => Tick::Command(&self.targets),
+            Ok(()) => {
+                for (target, (min, max)) in self.targets.iter_mut().zip(&self.ranges) {
+                    let q = target.q_rad;
+                    target.q_rad = q.clamp(*min, *max);
+                    self.report.clamped += u64::from(target.q_rad != q);
+                }
+                Tick::Command(&self.targets)
+            }
             Err(fault) => {
                 self.phase = Phase::Damped;
                 Tick::Damp(fault)
@@ -249,12 +256,8 @@ impl Controller {
         if let Some((joint, &value)) = action.iter().enumerate().find(|(_, a)| !a.is_finite()) {
             return Err(Fault::NotFinite { joint, value });
         }
-        for (((target, a), default), (min, max)) in
-            self.targets.iter_mut().zip(action).zip(&self.default_angles).zip(&self.ranges)
-        {
-            let q = a * self.action_scale + default;
-            target.q_rad = q.clamp(*min, *max);
-            self.report.clamped += u64::from(target.q_rad != q);
+        for ((target, a), default) in self.targets.iter_mut().zip(action).zip(&self.default_angles) {
+            target.q_rad = a * self.action_scale + default;
         }
         let report = &mut self.report;
         report.obs.clear();

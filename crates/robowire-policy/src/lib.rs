@@ -15,6 +15,9 @@ pub mod control;
 pub mod model;
 pub mod observation;
 pub mod run;
+#[cfg(feature = "test-support")]
+#[doc(hidden)]
+pub mod tiny;
 
 pub use body::Body;
 pub use config::{ConfigError, ImuType, MsgType, PolicyConfig};

@@ -7,7 +7,7 @@ use robowire_policy::control::{HOLD_S, STAND_S};
 use robowire_policy::{Controller, Fault, OnnxPolicy, Phase, PolicyConfig, Sensed, Tick};
 
 use crate::config::G1_YAML;
-use crate::onnx::Model;
+use robowire_policy::tiny::Model;
 
 /// actions = sqrt(obs[0]) on each of the 12 joints: obs[0] is the gyroscope's x × 0.25, so a
 /// negative rate makes every action NaN.

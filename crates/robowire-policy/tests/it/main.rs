@@ -4,5 +4,4 @@ mod config;
 mod control;
 mod model;
 mod observation;
-mod onnx;
 mod shipped;

@@ -2,7 +2,7 @@
 
 use robowire_policy::{ModelError, OnnxPolicy};
 
-use crate::onnx::{Model, linear, summing};
+use robowire_policy::tiny::{Model, linear, summing};
 
 const W: [f32; 6] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
 

@@ -1,7 +1,9 @@
 //! Unitree's G1 walking policy (`../shared/policies`: its ONNX and its own deploy config) on the
 //! physics G1 (feature `mujoco`): `robowire sim g1 --physics --free-base` in one process,
 //! `robowire policy run g1_walk.yaml --device g1:lo` in another, and the pelvis watched on
-//! `rt/sportmodestate` by a participant of the test's own. Where loopback carries multicast
+//! `rt/sportmodestate` by a participant of the test's own. A Go2 config (its observation starting
+//! with the base's velocity from `rt/sportmodestate`) with a model that holds the default pose, on
+//! `sim:go2 --physics` started by `policy run` itself. Where loopback carries multicast
 //! (`robowire_dds::netns`).
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -101,4 +103,32 @@ fn unitrees_g1_policy_turns_the_physics_g1_in_place() {
     eprintln!("turned {turned:.2} rad, moved {moved:.2} m, lowest {:.3} m", lowest(&track));
     assert!(turned >= 2.0, "turned {turned:.2} rad in 10 s at 0.5 rad/s");
     assert!(lowest(&track) >= 0.5, "the pelvis stayed above 0.5 m: {:.3}", lowest(&track));
+}
+
+/// unitree_rl_gym's Go2 deploy values; the observation starts with the base's velocity.
+const GO2_YAML: &str = "control_dt: 0.02\nmsg_type: go\npolicy_path: zeros.onnx\n\
+leg_joint2motor_idx: [3, 4, 5, 0, 1, 2, 9, 10, 11, 6, 7, 8]\nkps: [20, 20, 20, 20, 20, 20, 20, 20, 20, 20, 20, 20]\n\
+kds: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]\n\
+default_angles: [0.1, 0.8, -1.5, -0.1, 0.8, -1.5, 0.1, 1.0, -1.5, -0.1, 1.0, -1.5]\n\
+lin_vel_scale: 2.0\nang_vel_scale: 0.25\ndof_pos_scale: 1.0\ndof_vel_scale: 0.05\naction_scale: 0.25\n\
+cmd_scale: [2.0, 2.0, 0.25]\nnum_actions: 12\nnum_obs: 48\nmax_cmd: [1.0, 0.5, 1.0]\n\
+observation: [base_lin_vel, base_ang_vel, projected_gravity, command, joint_pos, joint_vel, last_action]\n";
+
+#[test]
+fn a_go2_policy_stands_the_physics_go2_on_its_default_pose() {
+    let dir = std::env::temp_dir().join(format!("robowire-go2-policy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = robowire_policy::tiny::matmul(48, 12, vec![0.0; 48 * 12]).write();
+    std::fs::copy(model, dir.join("zeros.onnx")).unwrap();
+    std::fs::write(dir.join("go2.yaml"), GO2_YAML).unwrap();
+    // `policy run` finds multicast on loopback for its simulator itself.
+    let out = robowire()
+        .args(["policy", "run"])
+        .arg(dir.join("go2.yaml"))
+        .args(["--device", "sim:go2", "--physics", "--cmd", "0.5,0,0", "--duration", "2"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stderr.contains("ended: the duration ran out"), "{stderr}");
+    assert!(stderr.contains("walking: step"), "the policy ran: {stderr}");
 }

@@ -1,4 +1,5 @@
-//! Tiny ONNX models the tests make themselves (protobuf through tract's own ONNX types).
+//! Tiny ONNX models that tests make themselves (protobuf through tract's own ONNX types), for
+//! the tests of this crate and of the apps above it (feature `test-support`). Not public API.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -39,17 +40,22 @@ fn node(op: &str, inputs: &[&str], outputs: &[&str]) -> pb::NodeProto {
     }
 }
 
-/// A model: its inputs, a constant weight `w` of `dims`, nodes, outputs.
-pub(crate) struct Model {
-    pub(crate) inputs: Vec<(&'static str, Vec<i64>)>,
-    pub(crate) weight: (Vec<i64>, Vec<f32>),
-    pub(crate) nodes: Vec<(&'static str, Vec<&'static str>, Vec<&'static str>)>,
-    pub(crate) outputs: Vec<(&'static str, Vec<i64>)>,
+/// A model: its inputs, a constant weight `w` of `dims`, nodes (operator, inputs, outputs), outputs.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Each input's name and shape.
+    pub inputs: Vec<(&'static str, Vec<i64>)>,
+    /// The constant `w`: its shape and values.
+    pub weight: (Vec<i64>, Vec<f32>),
+    /// Each node: its operator, inputs and outputs.
+    pub nodes: Vec<(&'static str, Vec<&'static str>, Vec<&'static str>)>,
+    /// Each output's name and shape.
+    pub outputs: Vec<(&'static str, Vec<i64>)>,
 }
 
 impl Model {
     /// Written to a file of its own; its path.
-    pub(crate) fn write(&self) -> PathBuf {
+    pub fn write(&self) -> PathBuf {
         static NEXT: AtomicU32 = AtomicU32::new(0);
         let graph = pb::GraphProto {
             name: "tiny".into(),
@@ -76,23 +82,28 @@ impl Model {
             std::process::id(),
             NEXT.fetch_add(1, Ordering::Relaxed)
         ));
-        std::fs::write(&path, model.encode_to_vec()).unwrap();
+        std::fs::write(&path, model.encode_to_vec()).expect("writing a model to the temporary directory");
         path
     }
 }
 
 /// actions [1, 2] = obs [1, 3] · w [3, 2]: no state.
-pub(crate) fn linear(w: [f32; 6]) -> Model {
+pub fn linear(w: [f32; 6]) -> Model {
+    matmul(3, 2, w.to_vec())
+}
+
+/// actions [1, `actions`] = obs [1, `obs`] · w, `w` row-major [`obs`, `actions`].
+pub fn matmul(obs: i64, actions: i64, w: Vec<f32>) -> Model {
     Model {
-        inputs: vec![("obs", vec![1, 3])],
-        weight: (vec![3, 2], w.to_vec()),
+        inputs: vec![("obs", vec![1, obs])],
+        weight: (vec![obs, actions], w),
         nodes: vec![("MatMul", vec!["obs", "w"], vec!["actions"])],
-        outputs: vec![("actions", vec![1, 2])],
+        outputs: vec![("actions", vec![1, actions])],
     }
 }
 
 /// actions = obs · w + h_in, h_out = actions: the actions add up over the steps.
-pub(crate) fn summing(w: [f32; 6]) -> Model {
+pub fn summing(w: [f32; 6]) -> Model {
     Model {
         inputs: vec![("obs", vec![1, 3]), ("h_in", vec![1, 2])],
         weight: (vec![3, 2], w.to_vec()),
