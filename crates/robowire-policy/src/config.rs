@@ -19,6 +19,15 @@ pub enum MsgType {
     Go,
 }
 
+impl std::fmt::Display for MsgType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MsgType::Hg => "hg (G1, H1-2)",
+            MsgType::Go => "go (Go2)",
+        })
+    }
+}
+
 impl MsgType {
     /// The motors of its LowCmd.
     pub fn motors(self) -> usize {

@@ -8,6 +8,24 @@
 //! - [`control`]: `deploy_real.py`'s sequence and safety as a sans-IO machine on caller time;
 //! - [`run`]: that sequence on a robot ([`body`]: the G1 and the Go2 through their facades), on
 //!   robowire's runner.
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use robowire_policy::{CommandSlot, OnnxPolicy, PolicyConfig, RunOptions};
+//! use unitree::g1::{G1, G1Options};
+//!
+//! # async fn walk() -> Result<(), Box<dyn std::error::Error>> {
+//! let config = PolicyConfig::load("g1_walk.yaml".as_ref())?;
+//! let policy = OnnxPolicy::load(&config.policy_path, config.num_obs, config.num_actions)?;
+//! let robot = Arc::new(G1::open(G1Options::on(Some("eth0"), 0))?);
+//! let command = CommandSlot::new([0.3, 0.0, 0.0]);
+//! let options = RunOptions { command: command.clone(), ..RunOptions::default() };
+//! // Stand 2 s, hold 1 s, then the policy every control_dt; any fault damps the robot.
+//! let running = robowire_policy::start(robot, |g1| Some(g1), &config, policy, options).await?;
+//! command.set([0.0, 0.0, 0.3]); // turn, from the next step on
+//! println!("ended: {}", running.ended().await);
+//! # Ok(()) }
+//! ```
 
 pub mod body;
 pub mod config;

@@ -90,7 +90,7 @@ pub enum Ended {
 #[non_exhaustive]
 pub enum StartError {
     /// The config is for the other message family.
-    #[error("msg_type: the config is for {config:?} robots, the device is {device:?}")]
+    #[error("msg_type: the config is for {config} robots, the device speaks {device}")]
     MsgType {
         /// The config's.
         config: crate::config::MsgType,
@@ -101,7 +101,7 @@ pub enum StartError {
     #[error("no LowState from the robot within {} s", FIRST_STATE.as_secs())]
     NoState,
     /// The holder given holds no client of the config's robot.
-    #[error("the device is not a {0:?} robot")]
+    #[error("the device is not an {0} robot")]
     NoBody(crate::config::MsgType),
     /// The robot's controller would not let go.
     #[error("cannot release the robot's controller: {0}")]

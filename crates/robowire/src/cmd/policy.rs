@@ -71,11 +71,10 @@ pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::
     let msg_type = robot_of(&args.device, args.reach.body.physics())?;
     if config.msg_type != msg_type {
         bail!(
-            "msg_type: {} is a config for {:?} robots, {} is {:?}",
+            "msg_type: {} is a config for {} robots, {} speaks {msg_type}",
             args.config.display(),
             config.msg_type,
             args.device,
-            msg_type
         );
     }
     let duration = args.duration.map(|s| crate::cmd::seconds("--duration", s)).transpose()?;
