@@ -7,7 +7,8 @@
 //! - [`model`]: the ONNX model, checked at load, recurrent state fed back;
 //! - [`control`]: `deploy_real.py`'s sequence and safety as a sans-IO machine on caller time;
 //! - [`run`]: that sequence on a robot ([`body`]: the G1 and the Go2 through their facades), on
-//!   robowire's runner.
+//!   robowire's runner;
+//! - [`record`]: each policy step as a frame of a capture's `policy` channel.
 //!
 //! ```no_run
 //! use std::sync::Arc;
@@ -32,6 +33,7 @@ pub mod config;
 pub mod control;
 pub mod model;
 pub mod observation;
+pub mod record;
 pub mod run;
 #[cfg(feature = "test-support")]
 #[doc(hidden)]

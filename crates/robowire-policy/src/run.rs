@@ -59,11 +59,14 @@ pub struct RunOptions {
     /// Release the robot's controller first (motion_switcher). `false` for a robot already
     /// released.
     pub release: bool,
+    /// Where each policy step goes, as a frame of [`crate::record::POLICY`] (sent): a link of a
+    /// capture. A copy into the tap's ring: no allocation, no lock.
+    pub tap: Option<robowire_tap::Tap>,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
-        Self { command: CommandSlot::new([0.0; 3]), duration: None, stand: true, release: true }
+        Self { command: CommandSlot::new([0.0; 3]), duration: None, stand: true, release: true, tap: None }
     }
 }
 
@@ -240,6 +243,8 @@ where
         dq,
         shared: shared.clone(),
         done: false,
+        tap: options.tap,
+        frame: Vec::with_capacity(64 + 4 * (config.num_obs + config.num_actions)),
     };
     let runner = Runner::spawn(RunnerOptions::named("policy"), job)?;
     Ok(Running { waker: runner.waker(), runner: Some(runner), shared })
@@ -260,6 +265,9 @@ struct PolicyJob<H, B> {
     dq: Vec<f32>,
     shared: Arc<Shared>,
     done: bool,
+    tap: Option<robowire_tap::Tap>,
+    /// The last step's frame for the tap.
+    frame: Vec<u8>,
 }
 
 impl<H: Send + Sync + 'static, B: Body> PolicyJob<H, B> {
@@ -323,8 +331,15 @@ impl<H: Send + Sync + 'static, B: Body> Job for PolicyJob<H, B> {
         let phase = self.controller.phase();
         if phase == Phase::Walking {
             self.walking_since.get_or_insert(now);
-            if let Ok(mut report) = self.shared.report.try_lock() {
-                report.clone_from(self.controller.report());
+            let report = self.controller.report();
+            if let Some(tap) = &self.tap
+                && report.step > 0
+            {
+                crate::record::encode(report, &mut self.frame);
+                tap.record(robowire_core::Direction::Sent, &self.frame);
+            }
+            if let Ok(mut shared) = self.shared.report.try_lock() {
+                shared.clone_from(report);
             }
         }
         *robowire_rt::lock(&self.shared.phase) = phase;

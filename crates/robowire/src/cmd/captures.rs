@@ -12,7 +12,7 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
         &kmc_proto::description::DESCRIPTIONS,
         &unitree_proto::description::DESCRIPTIONS,
         &ros2_proto::description::DESCRIPTIONS,
-        &[&robowire_core::json::SKIPPED_BYTES],
+        &[&robowire_core::json::SKIPPED_BYTES, &robowire_policy::record::POLICY],
     ]
     .concat()
 }

@@ -73,10 +73,21 @@ impl ReachArgs {
         command: &str,
         run: impl FnOnce(AnyDevice) -> F,
     ) -> anyhow::Result<ExitCode> {
+        self.recording_with_links(address, command, |device, _| run(device))
+    }
+
+    /// As [`recording`](Self::recording), `run` also given the capture's links (`--record`) for
+    /// links of its own.
+    pub(crate) fn recording_with_links<F: Future<Output = anyhow::Result<AnyDevice>>>(
+        &self,
+        address: &DeviceAddress,
+        command: &str,
+        run: impl FnOnce(AnyDevice, Option<RecordLinks>) -> F,
+    ) -> anyhow::Result<ExitCode> {
         let recorder = self.record.start(&format!("{command} {address}"))?;
+        let links = || recorder.as_ref().map(robowire_record::Recorder::links);
         let ran = runtime()?.block_on(async {
-            let device =
-                run(self.open(address, recorder.as_ref().map(robowire_record::Recorder::links)).await?).await?;
+            let device = run(self.open(address, links()).await?, links()).await?;
             eprintln!("{}", device.stats_line());
             device.close().context("closing the device")
         });

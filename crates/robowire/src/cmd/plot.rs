@@ -34,8 +34,12 @@ pub(crate) struct PlotArgs {
 
 /// What each codec plots of its links.
 fn link_plots() -> Vec<&'static LinkPlots> {
-    let lists: [&'static [LinkPlots]; 3] =
-        [&kmc_proto::description::PLOTS, &zsl_proto::description::PLOTS, &unitree_proto::description::PLOTS];
+    let lists: [&'static [LinkPlots]; 4] = [
+        &kmc_proto::description::PLOTS,
+        &zsl_proto::description::PLOTS,
+        &unitree_proto::description::PLOTS,
+        &robowire_policy::record::PLOTS,
+    ];
     lists.into_iter().flatten().collect()
 }
 

@@ -11,6 +11,7 @@ use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use robowire_devices::{AnyDevice, DeviceAddress, DeviceKind};
 use robowire_policy::control::{HOLD_S, STAND_S};
+use robowire_policy::record::POLICY;
 use robowire_policy::{Body, CommandSlot, Ended, MsgType, OnnxPolicy, Phase, PolicyConfig, RunOptions, Running};
 
 use crate::cmd::device::ReachArgs;
@@ -82,10 +83,13 @@ pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::
         OnnxPolicy::load(&config.policy_path, config.num_obs, config.num_actions).map_err(anyhow::Error::msg)?;
     // A policy walks a simulated robot on the floor.
     args.reach.body.free_the_base();
-    let options = RunOptions { command: CommandSlot::new(args.cmd), duration, stand: !args.no_stand, release: true };
+    let mut options =
+        RunOptions { command: CommandSlot::new(args.cmd), duration, stand: !args.no_stand, ..RunOptions::default() };
     let mut ended = None;
     let code = crate::cmd::device::on_loopback(loopback, || {
-        args.reach.recording(&args.device, "robowire policy run", |device| async {
+        args.reach.recording_with_links(&args.device, "robowire policy run", |device, links| async {
+            // The policy's steps beside the device's links (`g1/policy`, `go2/policy`).
+            options.tap = links.map(|links| links.link(&format!("{}/policy", device.kind().name()), &POLICY));
             let device = Arc::new(device);
             let end = match msg_type {
                 MsgType::Hg => walk(device.clone(), AnyDevice::g1, &config, policy, options).await?,

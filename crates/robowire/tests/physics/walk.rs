@@ -125,10 +125,21 @@ fn a_go2_policy_stands_the_physics_go2_on_its_default_pose() {
     let out = robowire()
         .args(["policy", "run"])
         .arg(dir.join("go2.yaml"))
-        .args(["--device", "sim:go2", "--physics", "--cmd", "0.5,0,0", "--duration", "2"])
+        .args(["--device", "sim:go2", "--physics", "--cmd", "0.5,0,0", "--duration", "2", "--record"])
+        .arg(dir.join("go2.mcap"))
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && stderr.contains("ended: the duration ran out"), "{stderr}");
     assert!(stderr.contains("walking: step"), "the policy ran: {stderr}");
+    // The capture: the Go2's LowCmds and LowStates, and the policy's steps at 50 Hz.
+    let decoded = robowire().args(["decode", "--mcap"]).arg(dir.join("go2.mcap")).output().unwrap();
+    let summary = String::from_utf8_lossy(&decoded.stdout);
+    let count = |channel: &str| -> u64 {
+        let line = summary.lines().find(|l| l.starts_with(channel)).unwrap_or_else(|| panic!("{channel}: {summary}"));
+        line.split_whitespace().nth(2).and_then(|n| n.parse().ok()).unwrap_or(0)
+    };
+    assert!(count("/go2/low_level/sent ") > 1000 && count("/go2/low_level/received ") > 1000, "{summary}");
+    let steps = count("/go2/policy/sent/robowire.PolicyStep ");
+    assert!((50..=110).contains(&steps), "2 s of steps at 50 Hz (fewer if ticks were missed): {steps}\n{summary}");
 }
