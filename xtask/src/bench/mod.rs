@@ -32,6 +32,7 @@ pub(crate) const BENCHES: &[(&str, &str)] = &[
     ("robowire-ros2", "cmd_vel"),
     ("robowire-record", "record"),
     ("robowire", "recorded"),
+    ("robowire-policy", "inference"),
 ];
 
 /// One row of the table.
@@ -77,6 +78,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
     let ros2_meta_path = target.join("bench-meta-ros2.json");
     let record_meta_path = target.join("bench-meta-record.json");
     let recorded_meta_path = target.join("bench-meta-recorded.json");
+    let policy_meta_path = target.join("bench-meta-policy.json");
     let times: &[&str] = if quick {
         &["--warm-up-time", "0.5", "--measurement-time", "1"]
     } else {
@@ -107,6 +109,7 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
             .env("ROBOWIRE_BENCH_META_ROS2", &ros2_meta_path)
             .env("ROBOWIRE_BENCH_META_RECORD", &record_meta_path)
             .env("ROBOWIRE_BENCH_META_RECORDED", &recorded_meta_path)
+            .env("ROBOWIRE_BENCH_META_POLICY", &policy_meta_path)
             .envs(quick.then_some(("ROBOWIRE_BENCH_QUICK", "1")))
             .current_dir(&root)
             .status()
@@ -185,6 +188,10 @@ pub fn run(quick: bool) -> anyhow::Result<Vec<Row>> {
         None => None,
     };
     rows.extend(apps::physics_rows(physics.as_ref(), &dds)?);
+    // Unitree's G1 policy only where `../shared/policies` is.
+    let policy: Option<Value> =
+        std::fs::read_to_string(&policy_meta_path).ok().map(|t| serde_json::from_str(&t)).transpose()?;
+    rows.extend(apps::policy_rows(policy.as_ref())?);
 
     let markdown = report::to_markdown(&rows);
     println!("\n{markdown}");
