@@ -1,10 +1,12 @@
 //! The simulated bodies in MuJoCo (feature `mujoco`), without I/O: robowire's Go2 stands under
 //! the gains of Unitree's stand example and not under a tenth of them, sinks when damped, lies
 //! down again; robowire's G1, hanging, reaches the zero posture under Unitree's example gains;
-//! a user's MJCF without a motor's joint is refused by name. Each in simulated time (2 ms
+//! a user's MJCF without a motor's joint is refused by name; the free G1 stands on its band until
+//! a LowCmd stream drives its legs for `LET_GO_AFTER_S`, then it is let go and, under passive
+//! joints, falls. Each in simulated time (2 ms
 //! steps, as the state stream gives them), so the same on any machine.
 
-use robowire_sim::g1::{G1Body, JOINTS as G1_JOINTS};
+use robowire_sim::g1::{G1Body, JOINTS as G1_JOINTS, LET_GO_AFTER_S};
 use robowire_sim::go2::{Go2Body, JOINTS, LYING_POSE_RAD};
 use robowire_sim::physics::{PhysicsError, PhysicsOptions};
 use unitree_proto::g1::{self, G1Variant};
@@ -142,6 +144,35 @@ fn g1_zero_posture(waist_pitch_gain: f32) -> ([f32; G1_JOINTS], f32) {
         body.step(DT_S);
     }
     (body.joint_positions(), body.sport_state().unwrap().body_height.get())
+}
+
+#[test]
+fn the_free_g1_stands_on_its_band_until_a_lowcmd_stream_drives_its_legs() {
+    let variant = G1Variant::Dof29;
+    let mut body = G1Body::physics(variant, 5, &PhysicsOptions::default()).expect("robowire's G1 loads");
+    let pelvis = |body: &G1Body| body.sport_state().unwrap().position[2].get();
+    // Settled on the floor, standing, held: its controller's stand and 3 s of nothing after it.
+    body.set_controller(false);
+    for _ in 0..1500 {
+        body.step(DT_S);
+    }
+    assert!(body.held() && pelvis(&body) > 0.7, "held standing: {}", pelvis(&body));
+    // A stream holding the stand pose with stiffness on every leg joint lets it go after
+    // LET_GO_AFTER_S, not before.
+    let hold = g1::hold(&body.joint_positions(), 5, variant);
+    let ticks = (LET_GO_AFTER_S / DT_S).round() as u32;
+    for tick in 0..ticks + 2 {
+        // Held through the time (to a step: the time is summed in f32).
+        assert!(body.held() || tick >= ticks - 1, "let go at tick {tick} of {ticks}");
+        body.command(&hold);
+        body.step(DT_S);
+    }
+    assert!(!body.held(), "let go after {ticks} ticks");
+    // Let go and left passive (no LowCmd), it falls.
+    for _ in 0..1500 {
+        body.step(DT_S);
+    }
+    assert!(pelvis(&body) < 0.5, "fallen: {}", pelvis(&body));
 }
 
 #[test]

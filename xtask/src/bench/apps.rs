@@ -224,6 +224,29 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// The G1 walking policy's inference beside a matrix product of the same weights, p50 and p99.
+pub(crate) fn policy_rows(policy: Option<&Value>) -> anyhow::Result<Vec<Row>> {
+    let Some(policy) = policy else { return Ok(Vec::new()) };
+    let ns = |model: &str, pct: &str| {
+        policy[model][format!("{pct}_ns")].as_f64().with_context(|| format!("policy meta {model}.{pct}_ns"))
+    };
+    let shape = format!("{}×{}", policy["matmul"]["rows"], policy["matmul"]["columns"]);
+    ["p50", "p99"]
+        .into_iter()
+        .map(|pct| {
+            let (model, plain) = (ns("g1", pct)?, ns("matmul", pct)?);
+            Ok(Row {
+                path: format!("Unitree's G1 walking policy, one step on tract (LSTM 47 → 64, 64 → 32 → 12), {pct}"),
+                figure: format!("{:.1} µs", model / 1e3),
+                baseline: format!("tract MatMul of the same weights (1×47 · {shape}): {:.1} µs", plain / 1e3),
+                ratio: format!("{:.2}×", model / plain),
+                target: "–".into(),
+                met: None,
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use serde_json::json;
@@ -253,27 +276,4 @@ mod tests {
         assert_eq!(rows[8].met, Some(true));
         assert!(record_rows(&record, &recorded).is_err(), "the two benches' figures apart");
     }
-}
-
-/// The G1 walking policy's inference beside a matrix product of the same weights, p50 and p99.
-pub(crate) fn policy_rows(policy: Option<&Value>) -> anyhow::Result<Vec<Row>> {
-    let Some(policy) = policy else { return Ok(Vec::new()) };
-    let ns = |model: &str, pct: &str| {
-        policy[model][format!("{pct}_ns")].as_f64().with_context(|| format!("policy meta {model}.{pct}_ns"))
-    };
-    let shape = format!("{}×{}", policy["matmul"]["rows"], policy["matmul"]["columns"]);
-    ["p50", "p99"]
-        .into_iter()
-        .map(|pct| {
-            let (model, plain) = (ns("g1", pct)?, ns("matmul", pct)?);
-            Ok(Row {
-                path: format!("Unitree's G1 walking policy, one step on tract (LSTM 47 → 64, 64 → 32 → 12), {pct}"),
-                figure: format!("{:.1} µs", model / 1e3),
-                baseline: format!("tract MatMul of the same weights (1×47 · {shape}): {:.1} µs", plain / 1e3),
-                ratio: format!("{:.2}×", model / plain),
-                target: "–".into(),
-                met: None,
-            })
-        })
-        .collect()
 }

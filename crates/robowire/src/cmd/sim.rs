@@ -66,8 +66,10 @@ pub(crate) struct G1SimArgs {
     record: crate::cmd::record::RecordArgs,
     #[command(flatten)]
     body: crate::cmd::sim_body::BodyArgs,
-    /// With --physics: the pelvis free on the floor (default: held where it starts, hanging as
-    /// on Unitree's elastic band; the G1's balance controller is not simulated).
+    /// With --physics: the G1 on the floor, its pelvis held there as on Unitree's elastic band
+    /// until a LowCmd stream has driven every leg joint with stiffness for 3.5 s, then let go
+    /// (default: hanging where it starts, for good; the G1's balance controller is not
+    /// simulated).
     #[arg(long, requires = "physics")]
     free_base: bool,
 }
