@@ -64,16 +64,14 @@ def tilt_rad(device):
     return 2.0 * math.asin(min(1.0, math.hypot(x, y)))
 
 
-def test_the_physics_g1_by_address_hangs_unless_its_base_is_free(dds):
+def test_the_physics_g1_by_address_hangs_or_stands_on_its_band(dds):
     physics_go2(13).close()  # skips without physics
     with robowire.open("sim:g1", domain=13, physics=True) as g1:
         assert tilt_rad(g1) < 0.1, "hanging by its pelvis"
+    # Free: on the floor, held on its band until a LowCmd stream drives its legs (robowire-sim's
+    # tests/physics.rs lets it go).
     with robowire.open("sim:g1", domain=13, physics=True, free_base=True) as g1:
-        deadline = time.monotonic() + 10.0  # a failure bound: it falls in about a second
-        tilt = tilt_rad(g1)
-        while tilt < 0.8 and time.monotonic() < deadline:
-            tilt = tilt_rad(g1)
-        assert tilt > 0.8, f"free, without a balance controller, it falls: {tilt} rad"
+        assert tilt_rad(g1) < 0.1, "standing on its band"
 
 
 def test_a_model_needs_physics(dds):

@@ -21,7 +21,8 @@ def open(
     """kmc:PATH, zsl1:IP, zsl1w:IP, go2:IFACE, hg:IFACE, sim:kmc|zsl1|zsl1w|go2; a bad address raises ArgumentError.
     record: a path (a capture of its own, finished by close()) or a Recorder. physics: sim:go2's or sim:g1's body in
     MuJoCo (a wheel built with the `mujoco` feature, else robowire.Error; ArgumentError for any other address), the G1
-    hanging by its pelvis unless free_base; model: a user's MJCF instead of robowire's model."""
+    hanging by its pelvis unless free_base (then on the floor, held on a band until a LowCmd stream has driven its
+    legs for 3.5 s); model: a user's MJCF instead of robowire's model."""
 
 class Device:
     """A device opened by robowire.open(address)."""

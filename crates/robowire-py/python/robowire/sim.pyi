@@ -134,7 +134,7 @@ class G1(_UnitreeSimulator):
     ) -> None:
         """mode_machine None: the variant's (5 for 29 dof, 4 for 23); record: g1/low_level and g1/api, the robot's side;
         physics: the body in MuJoCo (a wheel built with the `mujoco` feature), its pelvis held (hanging) unless
-        free_base; model: a user's MJCF instead of robowire's model of the G1."""
+        free_base (then on the floor, held on a band until a LowCmd stream has driven its legs for 3.5 s); model: a user's MJCF instead of robowire's model of the G1."""
     @property
     def variant(self) -> Literal["29dof", "23dof", "29dof_waist_locked", "dual_arm"]: ...
     @property
