@@ -7,7 +7,7 @@ use serde::Deserialize;
 use unitree_proto::go2::MOTOR_COUNT;
 use unitree_proto::hg::HG_MOTOR_COUNT;
 
-use crate::observation::Term;
+use crate::term::Term;
 
 /// The LowCmd/LowState family a config drives (`msg_type`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

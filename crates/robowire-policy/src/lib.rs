@@ -35,6 +35,7 @@ pub mod model;
 pub mod observation;
 pub mod record;
 pub mod run;
+mod term;
 #[cfg(feature = "test-support")]
 #[doc(hidden)]
 pub mod tiny;
