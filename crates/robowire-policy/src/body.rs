@@ -48,6 +48,9 @@ pub trait Body: Send + Sync + 'static {
     /// Damping from the next LowCmd on.
     fn damp(&self);
 
+    /// Waits up to `timeout` for a LowState (the latest counts); whether one came. Any executor.
+    fn wait_state(&self, timeout: Duration) -> impl Future<Output = bool> + Send;
+
     /// Lets the robot's own controller go (Unitree's motion_switcher), from any executor.
     fn release(&self) -> impl Future<Output = Result<u32, String>> + Send;
 
@@ -102,6 +105,10 @@ impl Body for G1 {
         let _ = G1::damp(self);
     }
 
+    async fn wait_state(&self, timeout: Duration) -> bool {
+        G1::wait_state(self, timeout, |_| true).await.is_some()
+    }
+
     async fn release(&self) -> Result<u32, String> {
         G1::release(self).await.map_err(|e| e.to_string())
     }
@@ -139,6 +146,10 @@ impl Body for LowLevel<Go2> {
 
     fn damp(&self) {
         LowLevel::damp(self);
+    }
+
+    async fn wait_state(&self, timeout: Duration) -> bool {
+        LowLevel::wait_state(self, timeout, |_| true).await.is_some()
     }
 
     async fn release(&self) -> Result<u32, String> {

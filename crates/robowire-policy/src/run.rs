@@ -200,16 +200,10 @@ where
     };
     let motors = config.msg_type.motors();
     let (mut q, mut dq) = (vec![0.0; motors], vec![0.0; motors]);
-    let deadline = robowire_rt::now() + FIRST_STATE;
-    let reading = loop {
-        if let Some(reading) = robot.sense(&mut q, &mut dq).filter(|r| r.age <= STALE_STATE) {
-            break reading;
-        }
-        if robowire_rt::now() >= deadline {
-            return Err(StartError::NoState);
-        }
-        tokio::time::sleep(Duration::from_millis(10)).await;
-    };
+    if !robot.wait_state(FIRST_STATE).await {
+        return Err(StartError::NoState);
+    }
+    let reading = robot.sense(&mut q, &mut dq).filter(|r| r.age <= STALE_STATE).ok_or(StartError::NoState)?;
     if options.release {
         robot.release().await.map_err(StartError::Release)?;
     }
