@@ -102,6 +102,14 @@ struct Control {
 }
 
 impl Control {
+    /// What is left of a wait until `deadline`; `None` once it is over (woken, stopping, due).
+    fn left_until(&self, deadline: Time) -> Option<Duration> {
+        if self.woken.swap(false, Ordering::AcqRel) || self.stop.load(Ordering::Acquire) {
+            return None;
+        }
+        Some(deadline.saturating_duration_since(now())).filter(|left| !left.is_zero())
+    }
+
     /// Ends the thread's wait, parked or polling.
     fn notify(&self, thread: &Thread) {
         thread.unpark();
@@ -251,13 +259,7 @@ fn run<J: Job>(job: &mut J, control: &Control, mut wait: impl FnMut(Time)) {
 /// Parks until `spin` before `deadline` (or a wake), then spins until it.
 fn wait_until(deadline: Time, spin: Duration, control: &Control) {
     loop {
-        if control.woken.swap(false, Ordering::AcqRel) || control.stop.load(Ordering::Acquire) {
-            return;
-        }
-        let left = deadline.saturating_duration_since(now());
-        if left.is_zero() {
-            return;
-        }
+        let Some(left) = control.left_until(deadline) else { return };
         if left > spin {
             std::thread::park_timeout(left - spin);
         } else {

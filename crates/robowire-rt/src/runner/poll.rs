@@ -4,14 +4,13 @@
 
 use std::os::fd::{AsFd, OwnedFd};
 use std::os::unix::net::UnixDatagram;
-use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use robowire_core::schedule::Time;
 use rustix::event::{PollFd, PollFlags, Timespec, poll};
 use rustix::io::Errno;
 
-use super::{Control, Job, now};
+use super::{Control, Job};
 
 /// Wake-ups drained from the wake socket per look: more stay for the next look.
 const WAKE_DRAIN: usize = 16;
@@ -43,13 +42,7 @@ impl Readable {
     /// readable. `fds[0]` is the wake socket.
     fn wait_until(&self, deadline: Time, spin: Duration, control: &Control, fds: &mut [PollFd<'_>]) {
         loop {
-            if control.woken.swap(false, Ordering::AcqRel) || control.stop.load(Ordering::Acquire) {
-                return;
-            }
-            let left = deadline.saturating_duration_since(now());
-            if left.is_zero() {
-                return;
-            }
+            let Some(left) = control.left_until(deadline) else { return };
             // Zero in the last `spin`: a look, then the next turn of the spin.
             let timeout = left.saturating_sub(spin);
             let Ok(timeout_spec) = Timespec::try_from(timeout) else {
