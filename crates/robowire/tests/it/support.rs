@@ -73,13 +73,23 @@ pub(crate) fn start_observer(python: &Path, script: &str, args: &[&str]) -> (Chi
         .spawn()
         .unwrap();
     let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    let mut line = String::new();
-    stdout.read_line(&mut line).unwrap();
-    if line.trim() != "ready" {
-        let _ = child.kill();
-        let mut err = String::new();
-        child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
-        panic!("the observer saw no state: {line:?}\nits stderr: {err}");
+    // Unitree's SDK prints its own lines on stdout: `[Reader] take sample error` when a sample
+    // arrives while its reader is still being made (its listener races its constructor, seen on
+    // a loaded machine). The observer's `ready` comes once a state was read after all.
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        let read = stdout.read_line(&mut line).unwrap();
+        if line.trim() == "ready" {
+            break;
+        }
+        seen.push_str(&line);
+        if read == 0 || !line.starts_with("[Reader]") {
+            let _ = child.kill();
+            let mut err = String::new();
+            child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+            panic!("the observer saw no state: {seen:?}\nits stderr: {err}");
+        }
     }
     (child, stdout)
 }
