@@ -3,7 +3,7 @@
 //! the facade's 500 Hz LowCmd stream holds each tick's targets. Any fault damps the robot at once
 //! and ends the run with the reason; so do [`Running::stop`] and the end of the duration.
 
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -121,7 +121,8 @@ pub enum StartError {
 #[derive(Debug)]
 struct Shared {
     stop: AtomicBool,
-    phase: Mutex<Phase>,
+    /// The controller's [`Phase`] (`phase_code`): the job never waits to publish it.
+    phase: AtomicU8,
     ended: watch::Sender<Option<Ended>>,
     report: Mutex<StepReport>,
 }
@@ -148,7 +149,7 @@ impl<H: Send + Sync + 'static, B: Body> Running<H, B> {
 
     /// Where the sequence is.
     pub fn phase(&self) -> Phase {
-        *robowire_rt::lock(&self.shared.phase)
+        phase_of(self.shared.phase.load(Ordering::Acquire))
     }
 
     /// The last policy step.
@@ -219,7 +220,7 @@ where
     controller.start(now, &sensed, options.stand);
     let shared = Arc::new(Shared {
         stop: AtomicBool::new(false),
-        phase: Mutex::new(controller.phase()),
+        phase: AtomicU8::new(phase_code(controller.phase())),
         ended: watch::Sender::new(None),
         report: Mutex::new(StepReport::default()),
     });
@@ -242,6 +243,24 @@ where
     };
     let runner = Runner::spawn(RunnerOptions::named("policy"), job)?;
     Ok(Running { waker: runner.waker(), runner: Some(runner), shared })
+}
+
+fn phase_code(phase: Phase) -> u8 {
+    match phase {
+        Phase::Standing => 0,
+        Phase::Holding => 1,
+        Phase::Walking => 2,
+        Phase::Damped => 3,
+    }
+}
+
+fn phase_of(code: u8) -> Phase {
+    match code {
+        0 => Phase::Standing,
+        1 => Phase::Holding,
+        2 => Phase::Walking,
+        _ => Phase::Damped,
+    }
 }
 
 /// The run on the runner's thread.
@@ -272,7 +291,7 @@ impl<H: Send + Sync + 'static, B: Body> PolicyJob<H, B> {
         }
         self.controller.stop();
         self.done = true;
-        *robowire_rt::lock(&self.shared.phase) = Phase::Damped;
+        self.shared.phase.store(phase_code(Phase::Damped), Ordering::Release);
         self.shared.ended.send_replace(Some(why));
     }
 }
@@ -336,6 +355,6 @@ impl<H: Send + Sync + 'static, B: Body> Job for PolicyJob<H, B> {
                 shared.clone_from(report);
             }
         }
-        *robowire_rt::lock(&self.shared.phase) = phase;
+        self.shared.phase.store(phase_code(phase), Ordering::Release);
     }
 }
