@@ -26,6 +26,9 @@ pub struct Reading {
     pub quaternion_wxyz: [f32; 4],
     /// The IMU's angular velocity, rad/s.
     pub gyroscope_rad_s: [f32; 3],
+    /// The base's velocity in the world, m/s, where the body knows it with the state (else
+    /// [`Body::base_velocity`] reads it).
+    pub base_velocity_world_mps: Option<[f32; 3]>,
     /// How long ago it arrived.
     pub age: Duration,
 }
@@ -54,11 +57,9 @@ pub trait Body: Send + Sync + 'static {
     /// Lets the robot's own controller go (Unitree's motion_switcher), from any executor.
     fn release(&self) -> impl Future<Output = Result<u32, String>> + Send;
 
-    /// The runtime of the client's receive thread (where [`BaseVelocity`] reads).
-    fn runtime(&self) -> &tokio::runtime::Handle;
-
-    /// The client's DDS participant.
-    fn participant(&self) -> &Arc<robowire_dds::Participant>;
+    /// Starts reading the base's velocity for `base_lin_vel`, where [`Reading`] does not carry
+    /// it.
+    fn base_velocity(&self) -> Result<Option<Arc<BaseVelocity>>, robowire_dds::DdsError>;
 }
 
 fn joints<const N: usize>(targets: &[MotorTarget]) -> Result<[JointCommand; N], String> {
@@ -92,6 +93,7 @@ impl Body for G1 {
         Some(Reading {
             quaternion_wxyz: s.imu_state.quaternion.map(|v| v.get()),
             gyroscope_rad_s: s.imu_state.gyroscope.map(|v| v.get()),
+            base_velocity_world_mps: None,
             age: latest.age(),
         })
     }
@@ -113,12 +115,8 @@ impl Body for G1 {
         G1::release(self).await.map_err(|e| e.to_string())
     }
 
-    fn runtime(&self) -> &tokio::runtime::Handle {
-        self.receiving().runtime()
-    }
-
-    fn participant(&self) -> &Arc<robowire_dds::Participant> {
-        self.low_level().participant()
+    fn base_velocity(&self) -> Result<Option<Arc<BaseVelocity>>, robowire_dds::DdsError> {
+        BaseVelocity::read(self.low_level().participant(), self.receiving().runtime()).map(Some)
     }
 }
 
@@ -136,6 +134,7 @@ impl Body for LowLevel<Go2> {
         Some(Reading {
             quaternion_wxyz: s.imu_state.quaternion.map(|v| v.get()),
             gyroscope_rad_s: s.imu_state.gyroscope.map(|v| v.get()),
+            base_velocity_world_mps: None,
             age: latest.age(),
         })
     }
@@ -156,12 +155,8 @@ impl Body for LowLevel<Go2> {
         self.release_sport_mode().await.map_err(|e| e.to_string())
     }
 
-    fn runtime(&self) -> &tokio::runtime::Handle {
-        self.receiving().runtime()
-    }
-
-    fn participant(&self) -> &Arc<robowire_dds::Participant> {
-        LowLevel::participant(self)
+    fn base_velocity(&self) -> Result<Option<Arc<BaseVelocity>>, robowire_dds::DdsError> {
+        BaseVelocity::read(LowLevel::participant(self), self.receiving().runtime()).map(Some)
     }
 }
 
@@ -175,12 +170,16 @@ pub struct BaseVelocity {
 }
 
 impl BaseVelocity {
-    /// Starts reading `rt/sportmodestate` on `body`'s participant.
-    pub fn read(body: &impl Body) -> Result<Arc<Self>, robowire_dds::DdsError> {
-        let mut reader = body.participant().reader::<SportModeState>(SPORT_STATE_TOPIC, Qos::READER)?;
+    /// Starts reading `rt/sportmodestate` on `participant`, on `runtime` (a client's receive
+    /// thread).
+    pub fn read(
+        participant: &robowire_dds::Participant,
+        runtime: &tokio::runtime::Handle,
+    ) -> Result<Arc<Self>, robowire_dds::DdsError> {
+        let mut reader = participant.reader::<SportModeState>(SPORT_STATE_TOPIC, Qos::READER)?;
         let latest = Arc::new(Self::default());
         let weak = Arc::downgrade(&latest);
-        body.runtime().spawn(async move {
+        runtime.spawn(async move {
             while let Ok(sample) = reader.recv().await {
                 let Some(latest) = weak.upgrade() else { break };
                 for (slot, v) in latest.velocity.iter().zip(sample.value.velocity) {

@@ -8,7 +8,9 @@
 //! - [`control`]: `deploy_real.py`'s sequence and safety as a sans-IO machine on caller time;
 //! - [`run`]: that sequence on a robot ([`body`]: the G1 and the Go2 through their facades), on
 //!   robowire's runner;
-//! - [`record`]: each policy step as a frame of a capture's `policy` channel.
+//! - [`record`]: each policy step as a frame of a capture's `policy` channel;
+//! - `onboard` (feature `sim`): the policy as a simulated robot's own locomotion, walking when
+//!   its sport/loco service is asked to move.
 //!
 //! ```no_run
 //! use std::sync::Arc;
@@ -33,6 +35,8 @@ pub mod config;
 pub mod control;
 pub mod model;
 pub mod observation;
+#[cfg(feature = "sim")]
+pub mod onboard;
 pub mod record;
 pub mod run;
 mod term;

@@ -11,7 +11,7 @@ use robowire_core::schedule::Time;
 use robowire_rt::runner::{Job, Runner, RunnerOptions, Waker};
 use tokio::sync::watch;
 
-use crate::body::{BaseVelocity, Body};
+use crate::body::{BaseVelocity, Body, Reading};
 use crate::config::PolicyConfig;
 use crate::control::{Controller, Fault, Phase, STALE_STATE, StepReport, Tick};
 use crate::model::OnnxPolicy;
@@ -196,7 +196,7 @@ where
     }
     let robot = body(&holder).ok_or(StartError::NoBody(B::MSG_TYPE))?;
     let velocity = match config.observation.contains(&Term::BaseLinVel) {
-        true => Some(BaseVelocity::read(robot).map_err(StartError::SportState)?),
+        true => robot.base_velocity().map_err(StartError::SportState)?,
         false => None,
     };
     let motors = config.msg_type.motors();
@@ -236,6 +236,7 @@ where
         next: now,
         q,
         dq,
+        last_reading: Some((reading, now - reading.age)),
         shared: shared.clone(),
         done: false,
         tap: options.tap,
@@ -276,6 +277,8 @@ struct PolicyJob<H, B> {
     next: Time,
     q: Vec<f32>,
     dq: Vec<f32>,
+    /// The last state read, and when it arrived.
+    last_reading: Option<(Reading, Time)>,
     shared: Arc<Shared>,
     done: bool,
     tap: Option<robowire_tap::Tap>,
@@ -321,13 +324,21 @@ impl<H: Send + Sync + 'static, B: Body> Job for PolicyJob<H, B> {
         let Some(body) = (self.body)(&holder) else {
             return self.end(Ended::Refused("the device no longer holds the robot's client".into()));
         };
-        let reading = body.sense(&mut self.q, &mut self.dq);
-        let base_velocity = self.velocity.as_ref().and_then(|v| v.latest(STALE_STATE));
+        // A state the body could not read this tick (a writer mid-write) is the last one read,
+        // as old as it is.
+        let reading = match body.sense(&mut self.q, &mut self.dq) {
+            Some(reading) => {
+                self.last_reading = Some((reading, now - reading.age));
+                Some(reading)
+            }
+            None => self.last_reading.map(|(last, at)| Reading { age: now.saturating_duration_since(at), ..last }),
+        };
+        let read_velocity = || self.velocity.as_ref().and_then(|v| v.latest(STALE_STATE));
         let sensed = reading.map(|r| {
             let sensed = Sensed {
                 quaternion_wxyz: r.quaternion_wxyz,
                 gyroscope_rad_s: r.gyroscope_rad_s,
-                base_velocity_world_m_s: base_velocity,
+                base_velocity_world_m_s: r.base_velocity_world_mps.or_else(read_velocity),
                 motor_q_rad: &self.q,
                 motor_dq_rad_s: &self.dq,
             };

@@ -65,13 +65,13 @@ use unitree_proto::g1::{ARM_SDK_TOPIC, G1Variant};
 use unitree_proto::{CdrEncoding, DecodeError, HgLowCmd, HgLowState, Message};
 
 pub use crate::unitree::{
-    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as G1Fault, MAX_SPEED, SimClock, SimError as G1SimError,
-    StreamCounters,
+    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as G1Fault, GaitRequest, MAX_SPEED, Onboard, SimClock,
+    SimError as G1SimError, StreamCounters,
 };
 pub use model::{CONTROLLER_GAINS, G1Body, JOINTS, LET_GO_AFTER_S, STAND_POSE_RAD, SUPPLY_V, has_disabled_motor};
 pub use services::HOLDING_ACTIONS;
 
-use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};
+use crate::unitree::{CommandInbox, FlipSite, GaitAsk, Port, Report, Sim, StreamBody, StreamOptions};
 
 /// The `motion_switcher` mode that owns the motors at boot.
 pub const BOOT_MODE: &str = "ai";
@@ -105,6 +105,11 @@ pub struct G1SimConfig {
     pub answer_lowcmd: bool,
     /// Real time (default, at speed 1) or lock-step.
     pub clock: SimClock,
+    /// The robot's own locomotion is an onboard controller's ([`G1Sim::onboard`]): while a mode
+    /// owns the motors in a standing or walking loco FSM (4, 500, 501, 702, 706, 801), its
+    /// commands take the place of the controller's stand pose, and `SetVelocity` asks it a
+    /// velocity. Off (default): the controller holds [`STAND_POSE_RAD`].
+    pub onboard_gait: bool,
     /// MuJoCo physics instead of the kinematic joint model (`hanging`: the pelvis held, as on
     /// Unitree's elastic band; the robot's balance controller is not modelled, so a free G1
     /// stands only as long as its joints' PD holds it up).
@@ -125,6 +130,7 @@ impl G1SimConfig {
             services_tap: None,
             answer_lowcmd: false,
             clock: SimClock::default(),
+            onboard_gait: false,
             #[cfg(feature = "mujoco")]
             physics: None,
         }
@@ -203,6 +209,10 @@ struct G1Inbox {
     controller: AtomicBool,
     /// The loco FSM id (the services thread's, for the snapshot).
     fsm_id: AtomicI64,
+    /// The onboard controller's commands.
+    gait: CommandInbox<HgLowCmd>,
+    /// What the loco service asks of the onboard controller.
+    ask: GaitAsk,
     bad_mode_machine: Counter,
     bad_mode_pr: Counter,
     disabled_motors: Counter,
@@ -217,6 +227,7 @@ struct G1Robot {
     body: G1Body,
     seen_lowcmd: Option<Time>,
     seen_arm_sdk: Option<Time>,
+    seen_gait: Option<Time>,
 }
 
 impl StreamBody for G1Robot {
@@ -236,6 +247,9 @@ impl StreamBody for G1Robot {
         }
         if let Some(command) = inbox.arm_sdk.newer(&mut self.seen_arm_sdk) {
             self.body.arm_sdk(&command);
+        }
+        if let Some(command) = inbox.gait.newer(&mut self.seen_gait) {
+            self.body.gait(&command);
         }
     }
     fn published(&self) -> [f32; PUBLISHED] {
@@ -274,6 +288,22 @@ pub struct G1Sim {
     sim: Sim<G1Robot>,
     lowcmd: StatsHandle,
     arm_sdk: StatsHandle,
+    onboard_gait: bool,
+}
+
+impl Port<HgLowState, HgLowCmd> for crate::unitree::Handover<G1Robot> {
+    fn state(&self) -> Option<(Time, HgLowState)> {
+        self.state.read()
+    }
+    fn base(&self) -> Option<BasePose> {
+        self.base.read().map(|(_, pose)| pose)
+    }
+    fn drive(&self, command: &HgLowCmd, now: Time) {
+        self.inbox.gait.accept(command, now);
+    }
+    fn ask(&self) -> &GaitAsk {
+        &self.inbox.ask
+    }
 }
 
 impl G1Sim {
@@ -316,6 +346,8 @@ impl G1Sim {
             arm_sdk: CommandInbox::new(unitree_proto::g1::ARM_SDK_PERIOD),
             controller: AtomicBool::new(true),
             fsm_id: AtomicI64::new(BOOT_FSM_ID),
+            gait: CommandInbox::new(config.state_period),
+            ask: GaitAsk::default(),
             bad_mode_machine: Counter::default(),
             bad_mode_pr: Counter::default(),
             disabled_motors: Counter::default(),
@@ -335,12 +367,22 @@ impl G1Sim {
             name: "g1-sim",
             clock: config.clock,
         };
-        let robot = G1Robot { body, seen_lowcmd: None, seen_arm_sdk: None };
-        let robot_rules = services::Rules { variant: config.variant, mode_machine: config.mode_machine };
+        let robot = G1Robot { body, seen_lowcmd: None, seen_arm_sdk: None, seen_gait: None };
+        let robot_rules = services::Rules {
+            variant: config.variant,
+            mode_machine: config.mode_machine,
+            onboard_gait: config.onboard_gait,
+        };
         let sim = Sim::spawn(participant, options, robot, inbox, report, |handover, report| {
             move || services::run(handover, report, endpoints, robot_rules)
         })?;
-        Ok(Self { sim, lowcmd: lowcmd_stats, arm_sdk: arm_sdk_stats })
+        Ok(Self { sim, lowcmd: lowcmd_stats, arm_sdk: arm_sdk_stats, onboard_gait: config.onboard_gait })
+    }
+
+    /// The port of the robot's own locomotion, when it was asked for
+    /// ([`G1SimConfig::onboard_gait`]).
+    pub fn onboard(&self) -> Option<Onboard<HgLowState, HgLowCmd>> {
+        self.onboard_gait.then(|| Onboard::new(self.sim.handover.clone()))
     }
 
     crate::unitree::handle_methods!(G1Fault);

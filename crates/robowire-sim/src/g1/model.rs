@@ -116,6 +116,9 @@ pub struct G1Body {
     mode_pr: ModePr,
     arm_sdk: Option<HgLowCmd>,
     arm_sdk_age_s: f32,
+    /// The onboard controller's latest command (the robot's own locomotion), and its age.
+    gait: Option<HgLowCmd>,
+    gait_age_s: f32,
     /// The weight `rt/arm_sdk` is blended in with, 0..=1.
     arm_weight: f32,
     /// Motors that failed: they report mode 0 and produce no torque.
@@ -192,6 +195,8 @@ impl G1Body {
             mode_pr: ModePr::Pr,
             arm_sdk: None,
             arm_sdk_age_s: 0.0,
+            gait: None,
+            gait_age_s: 0.0,
             arm_weight: 0.0,
             faulted: [false; JOINTS],
             tick_ms: 0,
@@ -204,9 +209,14 @@ impl G1Body {
         self.plant.held()
     }
 
-    /// Whether the latest LowCmd, fresh, drives every leg joint (slots 0..12) with stiffness.
+    /// Whether the latest command of whoever owns the motors (a `rt/lowcmd` LowCmd once
+    /// released, the onboard controller's while the controller owns them), fresh, drives every
+    /// leg joint (slots 0..12) with stiffness.
     fn drives_legs(&self) -> bool {
-        let fresh = self.lowcmd.as_ref().filter(|_| !self.controller && self.lowcmd_age_s <= COMMAND_HOLD_S);
+        let fresh = match self.controller {
+            false => self.lowcmd.as_ref().filter(|_| self.lowcmd_age_s <= COMMAND_HOLD_S),
+            true => self.fresh_gait(),
+        };
         fresh.is_some_and(|cmd| {
             cmd.motor_cmd[..LEG_SLOTS]
                 .iter()
@@ -225,6 +235,7 @@ impl G1Body {
     pub fn set_controller(&mut self, owns: bool) {
         if owns && !self.controller {
             self.lowcmd = None;
+            self.gait = None;
             self.mode_pr = ModePr::Pr;
         }
         if !owns {
@@ -264,6 +275,23 @@ impl G1Body {
         self.arm_weight = if w.is_nan() { 0.0 } else { w.clamp(0.0, 1.0) };
         self.arm_sdk = Some(*command);
         self.arm_sdk_age_s = 0.0;
+    }
+
+    /// A command of the robot's own locomotion (an onboard controller, `mode_pr` PR): while the
+    /// controller owns the motors, each motor with `mode` 1 follows it in place of the stand
+    /// pose until it is [`COMMAND_HOLD_S`] old (`rt/arm_sdk` still blended in). Ignored once
+    /// released.
+    pub fn gait(&mut self, command: &HgLowCmd) {
+        if !self.controller {
+            return;
+        }
+        self.gait = Some(*command);
+        self.gait_age_s = 0.0;
+    }
+
+    /// The onboard controller's command, if fresh.
+    fn fresh_gait(&self) -> Option<&HgLowCmd> {
+        self.gait.as_ref().filter(|_| self.gait_age_s <= COMMAND_HOLD_S)
     }
 
     /// The weight `rt/arm_sdk` is blended in with now, 0..=1.
@@ -307,8 +335,19 @@ impl G1Body {
 
     /// What the controller commands slot `slot`, `rt/arm_sdk` blended in.
     fn controller_target(&self, slot: usize) -> PdTarget {
-        let own = CONTROLLER_GAINS[slot];
-        let target = PdTarget { q_rad: STAND_POSE_RAD[slot], kp: own.kp, kd: own.kd, ..PdTarget::default() };
+        let target = match self.fresh_gait().map(|cmd| &cmd.motor_cmd[slot]) {
+            Some(m) if m.mode == 1 => PdTarget {
+                q_rad: m.q.get(),
+                qd_radps: m.dq.get(),
+                kp: m.kp.get(),
+                kd: m.kd.get(),
+                tau_ff_nm: m.tau.get(),
+            },
+            _ => {
+                let own = CONTROLLER_GAINS[slot];
+                PdTarget { q_rad: STAND_POSE_RAD[slot], kp: own.kp, kd: own.kd, ..PdTarget::default() }
+            }
+        };
         let w = self.arm_weight;
         match &self.arm_sdk {
             Some(arm) if w > 0.0 && ARM_SDK_JOINTS.contains(&slot) => {
@@ -364,6 +403,7 @@ impl G1Body {
     pub fn step(&mut self, dt_s: f32) {
         self.lowcmd_age_s += dt_s;
         self.arm_sdk_age_s += dt_s;
+        self.gait_age_s += dt_s;
         if self.arm_sdk_age_s > COMMAND_HOLD_S {
             self.arm_weight = (self.arm_weight - ARM_SDK_WEIGHT_RATE_PER_S * dt_s).max(0.0);
         }

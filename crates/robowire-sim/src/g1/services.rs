@@ -4,6 +4,7 @@
 
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use robowire_core::schedule::Time;
 use robowire_dds::{Reader, Writer};
@@ -34,12 +35,18 @@ pub(super) struct Endpoints {
 pub(super) struct Rules {
     pub(super) variant: G1Variant,
     pub(super) mode_machine: u8,
+    /// The loco service drives an onboard controller (`G1SimConfig::onboard_gait`).
+    pub(super) onboard_gait: bool,
 }
 
 /// The loco FSM ids the simulator takes: Unitree's C++ `LocoClient` (0 zero torque, 1 damp,
 /// 2 squat, 3 sit, 4 stand up, 500 start), its Python one (702 lie to stand, 706 squat/stand),
 /// 501 (walking with the 3-dof waist) and 801 (running).
 const FSM_IDS: [i64; 10] = [0, 1, 2, 3, 4, 500, 501, 702, 706, 801];
+
+/// The FSMs in which the robot stands or walks under its own locomotion: 4 stand up, 500 start,
+/// 501 walking with the 3-dof waist, 702 lie to stand, 706 squat/stand, 801 running.
+const GAIT_FSMS: [i64; 6] = [4, 500, 501, 702, 706, 801];
 
 /// The FSMs in which arm actions run (the walking and running controllers).
 const ARM_ACTION_FSMS: [i64; 3] = [500, 501, 801];
@@ -159,6 +166,7 @@ impl Services {
         if !owns {
             self.held_action = None;
         }
+        self.sync_gait();
     }
 
     /// The weight `rt/arm_sdk` is blended in with, as the state stream last stepped the body.
@@ -169,6 +177,14 @@ impl Services {
     fn set_fsm(&mut self, id: i64) {
         self.loco.fsm_id = id;
         self.handover.inbox.fsm_id.store(id, Ordering::Relaxed);
+        self.sync_gait();
+    }
+
+    /// The onboard locomotion runs while a mode owns the motors in a standing or walking FSM.
+    fn sync_gait(&self) {
+        if self.rules.onboard_gait {
+            self.handover.inbox.ask.set_on(self.owner.owns() && GAIT_FSMS.contains(&self.loco.fsm_id));
+        }
     }
 }
 
@@ -197,6 +213,7 @@ pub(super) async fn run(
         arm_sdk_logged: false,
         held_action: None,
     }));
+    lock(&services).sync_gait();
     let answered = &handover.requests_answered;
     // Each LowCmd is taken on the participant's background thread as it arrives: no task to wake
     // between the datagram and the stream's seqlock (or the answer's `sendto`).
@@ -320,6 +337,8 @@ fn answer_loco(s: &mut Services, request: &ApiRequest) -> (i32, String) {
                     s.owner.say(format!("loco SetVelocity {v:?} for {duration_s} s"));
                 }
                 s.loco.velocity = v;
+                let until = robowire_rt::now() + Duration::try_from_secs_f64(duration_s).unwrap_or(Duration::MAX);
+                s.handover.inbox.ask.set_velocity(v.map(|x| x as f32), until);
                 ok()
             }
             None => bad_parameter(),

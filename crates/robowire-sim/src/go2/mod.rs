@@ -29,11 +29,13 @@ use unitree_proto::api::{motion_switcher, sport};
 use unitree_proto::{LowCmd, LowState, Message, go2};
 
 pub use crate::unitree::{
-    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as Go2Fault, MAX_SPEED, SimClock, SimError as Go2SimError,
+    AdvanceError, BasePose, COMMAND_HOLD_S, Fault as Go2Fault, GaitRequest, MAX_SPEED, Onboard, SimClock,
+    SimError as Go2SimError,
 };
 pub use model::{Go2Body, JOINTS, LYING_POSE_RAD, STAND_POSE_RAD};
+pub use services::MOVE_HOLDS;
 
-use crate::unitree::{CommandInbox, FlipSite, Report, Sim, StreamBody, StreamOptions};
+use crate::unitree::{CommandInbox, FlipSite, GaitAsk, Port, Report, Sim, StreamBody, StreamOptions};
 
 /// The sport mode that owns the motors at boot.
 pub const BOOT_SPORT_MODE: &str = "normal";
@@ -58,6 +60,12 @@ pub struct Go2SimConfig {
     pub services_tap: Option<Tap>,
     /// Real time (default, at speed 1) or lock-step.
     pub clock: SimClock,
+    /// The robot's own locomotion is an onboard controller's ([`Go2Sim::onboard`]): `sport`
+    /// StandUp, BalanceStand, RecoveryStand and Move switch it on while the sport mode owns the
+    /// motors (Move asks a velocity for [`MOVE_HOLDS`]), StopMove asks zero, Damp and StandDown
+    /// switch it off; its commands drive the motors as a LowCmd does. Off (default): the sport
+    /// mode leaves the motors passive and Move is not implemented.
+    pub onboard_gait: bool,
     /// MuJoCo physics instead of the kinematic joint model: the Go2 lying on its floor.
     #[cfg(feature = "mujoco")]
     pub physics: Option<crate::physics::PhysicsOptions>,
@@ -73,6 +81,7 @@ impl Default for Go2SimConfig {
             low_level_tap: None,
             services_tap: None,
             clock: SimClock::default(),
+            onboard_gait: false,
             #[cfg(feature = "mujoco")]
             physics: None,
         }
@@ -126,6 +135,10 @@ pub struct Go2Snapshot {
 struct Go2Inbox {
     lowcmd: CommandInbox<LowCmd>,
     bad_head: Counter,
+    /// The onboard controller's commands.
+    gait: CommandInbox<LowCmd>,
+    /// What the sport service asks of the onboard controller.
+    ask: GaitAsk,
 }
 
 /// The body as the state stream drives it.
@@ -133,6 +146,7 @@ struct Go2Robot {
     body: Go2Body,
     /// The stamp of the LowCmd the body follows.
     seen_command: Option<Time>,
+    seen_gait: Option<Time>,
 }
 
 impl StreamBody for Go2Robot {
@@ -144,6 +158,11 @@ impl StreamBody for Go2Robot {
 
     fn take(&mut self, inbox: &Go2Inbox) {
         if let Some(command) = inbox.lowcmd.newer(&mut self.seen_command) {
+            self.body.command(&command);
+        }
+        if let Some(command) = inbox.gait.newer(&mut self.seen_gait)
+            && inbox.ask.request(robowire_rt::now()).on
+        {
             self.body.command(&command);
         }
     }
@@ -158,6 +177,22 @@ impl StreamBody for Go2Robot {
 pub struct Go2Sim {
     sim: Sim<Go2Robot>,
     lowcmd: StatsHandle,
+    onboard_gait: bool,
+}
+
+impl Port<LowState, LowCmd> for crate::unitree::Handover<Go2Robot> {
+    fn state(&self) -> Option<(Time, LowState)> {
+        self.state.read()
+    }
+    fn base(&self) -> Option<BasePose> {
+        self.base.read().map(|(_, pose)| pose)
+    }
+    fn drive(&self, command: &LowCmd, now: Time) {
+        self.inbox.gait.accept(command, now);
+    }
+    fn ask(&self) -> &GaitAsk {
+        &self.inbox.ask
+    }
 }
 
 impl Go2Sim {
@@ -184,8 +219,14 @@ impl Go2Sim {
         let services_tap = config.services_tap.clone();
         let switcher = crate::unitree::service_server(&participant, motion_switcher::SERVICE, services_tap.clone())?;
         let sport = crate::unitree::service_server(&participant, sport::SERVICE, services_tap)?;
-        let endpoints = services::Endpoints { lowcmd: reader, answers, switcher, sport };
-        let inbox = Go2Inbox { lowcmd: CommandInbox::new(config.state_period), bad_head: Counter::default() };
+        let endpoints =
+            services::Endpoints { lowcmd: reader, answers, switcher, sport, onboard_gait: config.onboard_gait };
+        let inbox = Go2Inbox {
+            lowcmd: CommandInbox::new(config.state_period),
+            bad_head: Counter::default(),
+            gait: CommandInbox::new(config.state_period),
+            ask: GaitAsk::default(),
+        };
         let report = Report::booted(
             BOOT_SPORT_MODE,
             format!("booted lying down; sport mode \"{BOOT_SPORT_MODE}\" owns the motors"),
@@ -197,11 +238,17 @@ impl Go2Sim {
             name: "go2-sim",
             clock: config.clock,
         };
-        let robot = Go2Robot { body, seen_command: None };
+        let robot = Go2Robot { body, seen_command: None, seen_gait: None };
         let sim = Sim::spawn(participant, options, robot, inbox, report, |handover, report| {
             move || services::run(handover, report, endpoints)
         })?;
-        Ok(Self { sim, lowcmd })
+        Ok(Self { sim, lowcmd, onboard_gait: config.onboard_gait })
+    }
+
+    /// The port of the robot's own locomotion, when it was asked for
+    /// ([`Go2SimConfig::onboard_gait`]).
+    pub fn onboard(&self) -> Option<Onboard<LowState, LowCmd>> {
+        self.onboard_gait.then(|| Onboard::new(self.sim.handover.clone()))
     }
 
     crate::unitree::handle_methods!(Go2Fault);

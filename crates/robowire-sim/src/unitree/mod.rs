@@ -4,6 +4,7 @@
 //! services' server with `motion_switcher`. Each robot brings its body ([`StreamBody`]), its
 //! inbox (what its services thread hands its stream) and its services' answers.
 
+mod gait;
 mod services;
 mod stream;
 
@@ -23,6 +24,8 @@ use robowire_tap::Tap;
 use tokio::sync::watch;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout};
 
+pub(crate) use gait::{GaitAsk, Port};
+pub use gait::{GaitRequest, Onboard};
 pub(crate) use services::{CommandInbox, Owner, ServiceServer, answer_at_once, serve, service_server};
 pub(crate) use stream::{FlipSite, StreamBody, forward_to_body};
 

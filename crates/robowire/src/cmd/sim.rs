@@ -392,11 +392,13 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
         low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL)),
         services_tap: recorder.as_ref().map(|r| r.link("go2/api", &unitree_proto::description::API_SERVER)),
         clock: args.body.clock(),
+        onboard_gait: args.body.walks(),
         #[cfg(feature = "mujoco")]
         physics,
         ..Go2SimConfig::default()
     };
     let sim = Go2Sim::spawn(config).context("starting the Go2 simulator")?;
+    let walker = args.body.start_walker::<unitree_proto::robot::Go2>(|| sim.onboard())?;
     let interface = args.dds.interface.as_deref().unwrap_or("the default interface");
     // The first line, alone, for scripts.
     println!("go2 domain {} {interface}", args.dds.domain);
@@ -410,7 +412,7 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     let last = std::cell::Cell::new((0.0, 0.0));
     until_ctrl_c_with_log(
         args.report_every_s,
-        || sim.take_log(),
+        || logs(sim.take_log(), walker.as_ref()),
         || {
             let s = sim.snapshot();
             go2_report(&s) + &physics_report(s.base, s.sim_time_s, s.wall_time_s, &last)
@@ -421,9 +423,16 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
         "lowcmd accepted {} ignored {} bad CRC {} bad head {}; final q {:?}",
         s.lowcmd.accepted, s.lowcmd.ignored_sport_mode, s.lowcmd.bad_crc, s.lowcmd.bad_head, s.joints_rad
     );
+    drop(walker);
     drop(sim);
     crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The simulator's log lines and the walker's.
+fn logs(mut lines: Vec<String>, walker: Option<&robowire_policy::onboard::Walker>) -> Vec<String> {
+    lines.extend(walker.into_iter().flat_map(robowire_policy::onboard::Walker::take_log));
+    lines
 }
 
 fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
@@ -443,7 +452,8 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
         Some(_) => {}
     }
     #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
-    let physics = args.body.physics(!args.free_base)?;
+    // A walking G1 stands on the floor.
+    let physics = args.body.physics(!(args.free_base || args.body.walks()))?;
     let recorder = args.record.start("robowire sim g1")?;
     let config = G1SimConfig {
         participant: args.dds.participant(),
@@ -451,11 +461,13 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
         low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &unitree_proto::description::HG_LOW_LEVEL)),
         services_tap: recorder.as_ref().map(|r| r.link("g1/api", &unitree_proto::description::API_SERVER)),
         clock: args.body.clock(),
+        onboard_gait: args.body.walks(),
         #[cfg(feature = "mujoco")]
         physics,
         ..G1SimConfig::new(variant)
     };
     let sim = G1Sim::spawn(config).context("starting the G1 simulator")?;
+    let walker = args.body.start_walker::<unitree_proto::robot::Hg>(|| sim.onboard())?;
     let interface = args.dds.interface.as_deref().unwrap_or("the default interface");
     // The first line, alone, for scripts.
     println!("g1 domain {} {interface} dof {dof} mode_machine {mode_machine}", args.dds.domain);
@@ -469,7 +481,7 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     let last = std::cell::Cell::new((0.0, 0.0));
     until_ctrl_c_with_log(
         args.report_every_s,
-        || sim.take_log(),
+        || logs(sim.take_log(), walker.as_ref()),
         || {
             let s = sim.snapshot();
             g1_report(&s) + &physics_report(s.base, s.stream.sim_time_s, s.stream.wall_time_s, &last)
@@ -485,6 +497,7 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
         s.arm_sdk.weight,
         s.joints_rad
     );
+    drop(walker);
     drop(sim);
     crate::cmd::record::finish(recorder)?;
     Ok(ExitCode::SUCCESS)

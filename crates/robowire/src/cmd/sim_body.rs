@@ -1,8 +1,11 @@
 //! The body behind `robowire sim go2|g1` and behind `sim:go2`/`sim:g1` opened by address
 //! (`robowire status|watch`, `robowire ros2 --device`): the kinematic joint model or MuJoCo
 //! physics (`--physics [--model MJCF]`, in a build with the `mujoco` feature), and how a
-//! simulator's time runs (`--speed X`).
+//! simulator's time runs (`--speed X`), and the robot's own locomotion (`--walk CONFIG`).
 
+use std::path::PathBuf;
+
+use anyhow::Context;
 use clap::Args;
 
 /// The simulated robot's body: its kinematic joints or MuJoCo physics.
@@ -16,7 +19,7 @@ pub(crate) struct PhysicsArgs {
     /// and the robot, e.g. unitree_mujoco's or MuJoCo Menagerie's scene.xml); its joints are
     /// found by the motors' names (FR_hip_joint, …, left_hip_pitch_joint, …).
     #[arg(long, value_name = "MJCF", requires = "physics")]
-    model: Option<std::path::PathBuf>,
+    model: Option<PathBuf>,
 }
 
 /// The body of a `sim:go2` or `sim:g1` opened by address (`robowire status|watch`,
@@ -59,6 +62,12 @@ pub(crate) struct BodyArgs {
     /// Simulated seconds per wall second (0 < X <= 100).
     #[arg(long, value_name = "X", default_value_t = 1.0)]
     speed: f32,
+    /// With --physics: the robot's own locomotion is this walking policy (unitree_rl_gym's deploy
+    /// config, its ONNX model beside it): the Go2's sport StandUp/BalanceStand/Move and the
+    /// G1's loco Start/SetVelocity (Unitree's SportClient.Move, LocoClient.Move) make it stand and
+    /// walk, StopMove asks zero velocity, Damp stops it. The G1 starts free on the floor.
+    #[arg(long, value_name = "CONFIG.yaml", requires = "physics")]
+    walk: Option<PathBuf>,
 }
 
 impl BodyArgs {
@@ -67,12 +76,35 @@ impl BodyArgs {
         robowire_sim::go2::SimClock::RealTime { speed: self.speed }
     }
 
+    /// Whether `--walk` was given.
+    pub(crate) fn walks(&self) -> bool {
+        self.walk.is_some()
+    }
+
+    /// Starts `--walk`'s policy on the simulator's onboard port (`None` without `--walk`).
+    pub(crate) fn start_walker<R: robowire_policy::onboard::OnboardRobot>(
+        &self,
+        port: impl FnOnce() -> Option<robowire_sim::go2::Onboard<R::State, R::Cmd>>,
+    ) -> anyhow::Result<Option<robowire_policy::onboard::Walker>> {
+        let Some(path) = &self.walk else { return Ok(None) };
+        anyhow::ensure!(self.speed == 1.0, "--walk runs the policy in real time: --speed must be 1");
+        let config = robowire_policy::PolicyConfig::load(path).map_err(anyhow::Error::msg)?;
+        let port = port().context("the simulator has no onboard port")?;
+        let walker = robowire_policy::onboard::Walker::start::<R>(port, config)
+            .with_context(|| format!("--walk {}", path.display()))?;
+        Ok(Some(walker))
+    }
+
     /// What the startup line says of the body.
     pub(crate) fn describe(&self) -> String {
         let body = match (&self.body.physics, &self.body.model) {
             (false, _) => "kinematic joints".to_string(),
             (true, None) => "MuJoCo physics, robowire's model".to_string(),
             (true, Some(model)) => format!("MuJoCo physics, {}", model.display()),
+        };
+        let body = match &self.walk {
+            Some(config) => format!("{body}, walking under {}", config.display()),
+            None => body,
         };
         if self.speed == 1.0 { body } else { format!("{body}, {}× real time", self.speed) }
     }

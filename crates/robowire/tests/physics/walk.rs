@@ -3,14 +3,16 @@
 //! `robowire policy run g1_walk.yaml --device g1:lo` in another, and the pelvis watched on
 //! `rt/sportmodestate` by a participant of the test's own. A Go2 config (its observation starting
 //! with the base's velocity from `rt/sportmodestate`) with a model that holds the default pose, on
-//! `sim:go2 --physics` started by `policy run` itself. Where loopback carries multicast
-//! (`robowire_dds::netns`).
+//! `sim:go2 --physics` started by `policy run` itself. The policy as the simulators' own
+//! locomotion (`robowire sim g1|go2 --physics --walk`): the G1 walked by Unitree's `LocoClient`
+//! from its Python SDK (`physics_interop/loco_walk.py`), the Go2 stood up by `sport` StandUp and
+//! laid down by Damp. Where loopback carries multicast (`robowire_dds::netns`).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use crate::support::{Running, robowire};
+use crate::support::{Running, robowire, start_observer};
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_fixtures::{interop, peers};
@@ -143,4 +145,95 @@ fn a_go2_policy_stands_the_physics_go2_on_its_default_pose() {
     let steps = count("/go2/policy/sent/robowire.PolicyStep ");
     // At most 2 s of steps on the 50 Hz grid (a loaded machine misses some, never adds).
     assert!((1..=101).contains(&steps), "policy steps recorded: {steps}\n{summary}");
+}
+
+#[test]
+fn unitrees_loco_client_walks_the_physics_g1_under_its_policy() {
+    let Some(dir) = interop::require(peers::policies_dir()) else { return };
+    let Some(python) = interop::require(peers::unitree_python()) else { return };
+    robowire_dds::netns::with_loopback_multicast(|| {
+        let config = dir.join("g1_walk.yaml");
+        let config = config.to_str().unwrap();
+        let sim =
+            Running::start(&["sim", "g1", "--physics", "--walk", config, "--interface", "lo", "--report-every-s", "0"]);
+        assert!(sim.first_line.starts_with("g1 domain 0 lo"), "{}", sim.first_line);
+        // LocoClient.Move(0.5, 0, 0) every 0.1 s for 12 s (the first 3 s the robot stands up
+        // under the policy's stand sequence), then StopMove and Damp.
+        let walker = start_observer(&python, "tests/physics_interop/loco_walk.py", &["lo", "0.5", "0", "0", "12"]);
+        let seen = crate::support::observer_summary(walker.0, walker.1);
+        let log = sim.interrupt().stdout;
+        assert_eq!(seen["timed_out"], false, "{seen}\n{log}");
+        assert_eq!(seen["fsm"], serde_json::json!([0, 500]), "GetFsmId: the walking controller\n{log}");
+        let coordinate = |at: &str, i: usize| seen[at][i].as_f64().unwrap_or_else(|| panic!("{at}: {seen}"));
+        let forward = coordinate("last", 0) - coordinate("first", 0);
+        let lowest = seen["lowest"].as_f64().unwrap();
+        eprintln!("walked {forward:.2} m, lowest {lowest:.3} m: {seen}");
+        assert!(forward >= 2.0, "walked {forward:.2} m under LocoClient.Move(0.5, 0, 0)\n{log}");
+        assert!(lowest >= 0.5, "the pelvis stayed above 0.5 m: {lowest:.3}\n{log}");
+        assert!(log.contains("walker: standing up, then walking"), "{log}");
+        assert!(log.contains("loco SetFsmId 1") && log.contains("walker: stopped"), "Damp stops the walker: {log}");
+    });
+}
+
+/// Polls (every 10 ms, up to 20 s) until the last body height on `track` passes `reached`; the
+/// heights seen.
+fn wait_for_height(track: &Track, reached: impl Fn(f32) -> bool) -> Vec<f32> {
+    let deadline = std::time::Instant::now() + Duration::from_secs(20);
+    loop {
+        let heights: Vec<f32> = track.0.lock().unwrap().iter().map(|p| p[2]).collect();
+        if heights.last().is_some_and(|z| reached(*z)) || std::time::Instant::now() > deadline {
+            return heights;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn a_go2_walking_policy_stands_the_physics_go2_on_sport_stand_up_and_damp_lays_it_down() {
+    use unitree_proto::api::sport;
+    let dir = std::env::temp_dir().join(format!("robowire-go2-walk-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = robowire_policy::tiny::matmul(48, 12, vec![0.0; 48 * 12]).write();
+    std::fs::copy(model, dir.join("zeros.onnx")).unwrap();
+    std::fs::write(dir.join("go2.yaml"), GO2_YAML).unwrap();
+    let config = dir.join("go2.yaml");
+    robowire_dds::netns::with_loopback_multicast(|| {
+        let sim = Running::start(&[
+            "sim",
+            "go2",
+            "--physics",
+            "--walk",
+            config.to_str().unwrap(),
+            "--interface",
+            "lo",
+            "--report-every-s",
+            "0",
+        ]);
+        let done = Arc::new(AtomicBool::new(false));
+        let (track, watcher) = watch(done.clone());
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        let options = ParticipantOptions { interface: Some("lo".into()), ..ParticipantOptions::default() };
+        let participant = Participant::new(options).unwrap();
+        let _on = runtime.enter();
+        let client = unitree::services::ServiceClient::new(&participant, sport::SERVICE).unwrap();
+        let call = |api: i64, parameter: &str| {
+            runtime.block_on(client.call(api, parameter, Duration::from_secs(3))).map(|a| a.code)
+        };
+        // Lying on its floor until the sport service stands it up through the walker.
+        let lying = wait_for_height(&track, |z| z > 0.0);
+        eprintln!("lying at {:?}", lying.last());
+        assert!(lying.iter().all(|z| *z < 0.15), "booted lying");
+        assert_eq!(call(sport::STAND_UP, "{}").unwrap(), 0);
+        let standing = wait_for_height(&track, |z| z > 0.18);
+        assert!(standing.last().is_some_and(|z| *z > 0.18), "stood up under the policy: {:?}", standing.last());
+        assert_eq!(call(sport::MOVE, r#"{"x":0.3,"y":0,"z":0}"#).unwrap(), 0, "Move is taken with --walk");
+        assert_eq!(call(sport::DAMP, "{}").unwrap(), 0);
+        let lying = wait_for_height(&track, |z| z < 0.15);
+        eprintln!("standing at {:?}, damped to {:?}", standing.last(), lying.last());
+        assert!(lying.last().is_some_and(|z| *z < 0.15), "sinks once damped: {:?}", lying.last());
+        done.store(true, Ordering::Release);
+        watcher.join().unwrap();
+        let log = sim.interrupt().stdout;
+        assert!(log.contains("walker: standing up, then walking") && log.contains("walker: stopped"), "{log}");
+    });
 }
