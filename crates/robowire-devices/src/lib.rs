@@ -77,8 +77,12 @@ pub struct SimPhysics {
     pub model: Option<PathBuf>,
     /// The base held where it starts by a stiff spring (as on Unitree's elastic band), or free on
     /// the floor; `None`: as `robowire sim` has it, a Go2 free (lying on its floor) and a G1
-    /// hanging (its balance controller is not simulated).
+    /// hanging (its balance controller is not simulated); a walking G1 free.
     pub hanging: Option<bool>,
+    /// The robot's own locomotion is this walking policy (a deploy config, its ONNX model beside
+    /// it), walked by the robot's sport/loco service as `robowire sim go2|g1 --walk` has it (a
+    /// build with the `walk` feature, else [`DeviceError::Unsupported`]).
+    pub walk: Option<PathBuf>,
 }
 
 impl Default for OpenOptions {
@@ -206,6 +210,9 @@ pub fn error_chain(error: &dyn std::error::Error) -> String {
 pub struct AnyDevice {
     address: DeviceAddress,
     facade: Box<dyn Facade>,
+    /// The simulator's walking policy, stopped before the simulator.
+    #[cfg(feature = "walk")]
+    walker: Option<robowire_policy::onboard::Walker>,
     /// Dropped after the facade: the client says its last word to a live simulator.
     #[cfg(feature = "sim")]
     simulator: Option<Simulator>,
@@ -236,6 +243,8 @@ pub fn open(address: &DeviceAddress, options: &OpenOptions) -> Result<AnyDevice,
     Ok(AnyDevice {
         address: address.clone(),
         facade,
+        #[cfg(feature = "walk")]
+        walker: None,
         #[cfg(feature = "sim")]
         simulator: None,
     })
@@ -253,13 +262,24 @@ fn physics_possible(address: &DeviceAddress, options: &OpenOptions) -> Result<()
     if !cfg!(feature = "mujoco") {
         return Err(DeviceError::PhysicsNotBuilt { address: address.clone() });
     }
+    if options.sim_physics.as_ref().is_some_and(|p| p.walk.is_some()) && !cfg!(feature = "walk") {
+        return Err(DeviceError::Unsupported {
+            what: "a walking policy in the simulator (robowire-devices' `walk` feature)",
+        });
+    }
     Ok(())
 }
 
 #[cfg(feature = "sim")]
 fn open_simulated(address: &DeviceAddress, kind: DeviceKind, options: &OpenOptions) -> Result<AnyDevice, DeviceError> {
     let (simulator, facade) = sim::open(address, kind, options)?;
-    Ok(AnyDevice { address: address.clone(), facade, simulator: Some(simulator) })
+    Ok(AnyDevice {
+        address: address.clone(),
+        facade,
+        #[cfg(feature = "walk")]
+        walker: sim::walker(address, &simulator, options)?,
+        simulator: Some(simulator),
+    })
 }
 
 #[cfg(not(feature = "sim"))]
@@ -412,6 +432,12 @@ impl AnyDevice {
     /// The G1 client, if this is a G1 (`g1:`, `sim:g1`).
     pub fn g1(&self) -> Option<&unitree::g1::G1> {
         self.facade().as_any().downcast_ref()
+    }
+
+    #[cfg(feature = "walk")]
+    /// The walking policy of a simulator asked to walk ([`SimPhysics::walk`]).
+    pub fn walker(&self) -> Option<&robowire_policy::onboard::Walker> {
+        self.walker.as_ref()
     }
 
     #[cfg(feature = "zsl1")]

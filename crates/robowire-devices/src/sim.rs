@@ -80,6 +80,7 @@ pub(crate) fn open(
             let client = crate::kinds::unitree::low_level_options::<unitree::Go2>(Some(interface), options);
             let sim = Go2Sim::spawn(Go2SimConfig {
                 participant: client.participant.clone(),
+                onboard_gait: walks(options),
                 #[cfg(feature = "mujoco")]
                 physics: physics(options, false),
                 ..Go2SimConfig::default()
@@ -95,6 +96,7 @@ pub(crate) fn open(
             let participant = client.low_level.participant.clone();
             let sim = G1Sim::spawn(G1SimConfig {
                 participant,
+                onboard_gait: walks(options),
                 #[cfg(feature = "mujoco")]
                 physics: physics(options, true),
                 ..G1SimConfig::default()
@@ -112,6 +114,34 @@ pub(crate) fn open(
     })
 }
 
+/// Whether the simulator's own locomotion is a walking policy.
+fn walks(options: &OpenOptions) -> bool {
+    options.sim_physics.as_ref().is_some_and(|p| p.walk.is_some())
+}
+
+/// The walking policy of a simulator asked to walk ([`crate::SimPhysics::walk`]), started on its
+/// onboard port.
+#[cfg(feature = "walk")]
+pub(crate) fn walker(
+    address: &DeviceAddress,
+    simulator: &Simulator,
+    options: &OpenOptions,
+) -> Result<Option<robowire_policy::onboard::Walker>, DeviceError> {
+    use robowire_policy::onboard::Walker;
+    use unitree_proto::robot::{Go2, Hg};
+    let Some(path) = options.sim_physics.as_ref().and_then(|p| p.walk.as_ref()) else { return Ok(None) };
+    let failed =
+        |source: Box<dyn std::error::Error + Send + Sync>| DeviceError::Simulator { address: address.clone(), source };
+    let config = robowire_policy::PolicyConfig::load(path).map_err(|e| failed(e.into()))?;
+    let walker = match simulator {
+        Simulator::Go2(sim) => sim.onboard().map(|port| Walker::start::<Go2>(port, config)),
+        Simulator::G1(sim) => sim.onboard().map(|port| Walker::start::<Hg>(port, config)),
+        #[allow(unreachable_patterns)] // only the Unitree simulators take physics
+        _ => None,
+    };
+    walker.transpose().map_err(|e| failed(e.into()))
+}
+
 /// The simulator's physics (`hanging`: whether the robot hangs unless told), `None` for the
 /// kinematic body. Physics reaches here only in a build with MuJoCo (`crate::physics_possible`).
 #[cfg(feature = "mujoco")]
@@ -119,6 +149,6 @@ fn physics(options: &OpenOptions, hanging: bool) -> Option<robowire_sim::physics
     let physics = options.sim_physics.as_ref()?;
     Some(robowire_sim::physics::PhysicsOptions {
         model: physics.model.clone(),
-        hanging: physics.hanging.unwrap_or(hanging),
+        hanging: physics.hanging.unwrap_or(hanging && physics.walk.is_none()),
     })
 }

@@ -58,3 +58,43 @@ fn a_simulated_g1_by_address() {
         });
     });
 }
+
+#[test]
+fn a_g1_is_driven_through_its_loco_service_and_stopped_when_dropped() {
+    use robowire_sim::g1::{G1Sim, G1SimConfig};
+    with_loopback_multicast(|| {
+        let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+        runtime.block_on(async {
+            let participant = robowire_dds::ParticipantOptions { interface: Some("lo".into()), ..Default::default() };
+            let sim = G1Sim::spawn(G1SimConfig { participant, ..G1SimConfig::default() }).unwrap();
+            let g1 = open(&"g1:lo".parse().unwrap(), &OpenOptions::default()).unwrap();
+            assert!(g1.wait_state(WAIT).await, "rt/lowstate from the simulator");
+            assert!(g1.can_drive());
+            assert!(g1.drive(f32::NAN, 0.0, 0.0).is_err(), "checked before anything is sent");
+            assert!(g1.drive(3.0, 0.0, 0.0).is_err(), "past robowire's 1 m/s");
+            g1.drive(0.3, 0.0, 0.2).unwrap();
+            until(|| sim.snapshot().loco_velocity == [0.3, 0.0, 0.2], "the loco service asked 0.3, 0, 0.2").await;
+            assert!(g1.stats_line().contains("velocity asked 1 refused 0"), "{}", g1.stats_line());
+
+            // Released, the loco service refuses: counted, and said in the stats line.
+            g1.g1().unwrap().release().await.unwrap();
+            g1.drive(0.3, 0.0, 0.0).unwrap();
+            until(|| g1.stats_line().contains("refused 1 (last: "), "the refusal counted").await;
+            g1.g1().unwrap().select_mode(robowire_sim::g1::BOOT_MODE).await.unwrap();
+            g1.drive(0.2, 0.0, 0.0).unwrap();
+            until(|| sim.snapshot().loco_velocity == [0.2, 0.0, 0.0], "asked again once selected").await;
+            // Its last word: zero velocity.
+            drop(g1);
+            assert_eq!(sim.snapshot().loco_velocity, [0.0; 3], "stopped when the client was dropped");
+        });
+    });
+}
+
+/// Polls `reached` (every 5 ms, up to [`WAIT`]) until it holds, else fails saying `what`.
+async fn until(reached: impl Fn() -> bool, what: &str) {
+    let deadline = tokio::time::Instant::now() + WAIT;
+    while !reached() {
+        assert!(tokio::time::Instant::now() < deadline, "{what}: not within {WAIT:?}");
+        tokio::time::sleep(Duration::from_millis(5)).await;
+    }
+}

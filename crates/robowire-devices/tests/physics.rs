@@ -18,7 +18,8 @@ const WAIT: Duration = Duration::from_secs(20);
 /// Opens `address` with physics (`hanging`: as `SimPhysics::hanging`) and waits for its first
 /// state and for `sim_time_s` of simulated time.
 async fn open_with_physics(address: &str, hanging: Option<bool>, sim_time_s: f64) -> AnyDevice {
-    let options = OpenOptions { sim_physics: Some(SimPhysics { model: None, hanging }), ..OpenOptions::default() };
+    let options =
+        OpenOptions { sim_physics: Some(SimPhysics { model: None, hanging, walk: None }), ..OpenOptions::default() };
     let device = open(&address.parse().unwrap(), &options).unwrap();
     assert!(device.wait_state(WAIT).await, "{address}: rt/lowstate from the simulator");
     tokio::time::timeout(WAIT, async {
@@ -72,7 +73,7 @@ fn a_physics_go2_by_address_lies_on_its_floor() {
             go2.close().unwrap();
 
             // A user's model is the one loaded.
-            let model = SimPhysics { model: Some("/robowire-no-such/scene.xml".into()), hanging: None };
+            let model = SimPhysics { model: Some("/robowire-no-such/scene.xml".into()), hanging: None, walk: None };
             let options = OpenOptions { sim_physics: Some(model), ..OpenOptions::default() };
             let error = open(&"sim:go2".parse().unwrap(), &options).unwrap_err();
             let chain = robowire_devices::error_chain(&error);

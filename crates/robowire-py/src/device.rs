@@ -251,7 +251,7 @@ fn sim_physics(physics: bool, model: Option<std::path::PathBuf>, free_base: bool
     if !physics && (model.is_some() || free_base) {
         return Err(error(Kind::Argument, "model and free_base need physics=True"));
     }
-    Ok(physics.then(|| SimPhysics { model, hanging: free_base.then_some(false) }))
+    Ok(physics.then(|| SimPhysics { model, hanging: free_base.then_some(false), walk: None }))
 }
 
 /// Opens the device at `address` (`kmc:/dev/ttyUSB0`, `zsl1:192.168.234.1`, `zsl1w:IP`,

@@ -150,6 +150,18 @@ impl ServiceHandle {
         self.client.service
     }
 
+    /// Calls `api_id` with `parameter` without waiting: the call runs on the device's receive
+    /// thread, its outcome handed to `answered` there.
+    pub(crate) fn call_detached(
+        &self,
+        api_id: i64,
+        parameter: String,
+        answered: impl FnOnce(Result<ApiResponse, UnitreeError>) + Send + 'static,
+    ) {
+        let (client, timeout) = (self.client.clone(), self.timeout);
+        self.runtime.spawn(async move { answered(client.call(api_id, &parameter, timeout).await) });
+    }
+
     /// Calls `api_id` with `parameter` (JSON by convention) and waits up to the service timeout
     /// for its answer, as [`ServiceClient::call`] does. Any executor.
     pub async fn call(&self, api_id: i64, parameter: impl Into<String>) -> Result<ApiResponse, UnitreeError> {

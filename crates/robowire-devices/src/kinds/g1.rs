@@ -1,9 +1,14 @@
 //! A Unitree G1 through `unitree::g1`: the joints its variant drives, by their URDF names; the
 //! pelvis IMU; the battery from `rt/lf/bmsstate`; the HG LowState itself to pass through. It is
-//! commanded joint by joint, not by a velocity: it is not driven, and has no services here.
+//! driven through its locomotion service (`SetVelocity`, each velocity held [`DRIVE_HOLDS_S`],
+//! sent without waiting for the answer); it has no services here.
 
 use serde_json::Value;
-use unitree::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS};
+use unitree::g1::{Device, G1, G1Options, G1Variant, HgBmsState, HgLowState, JOINT_NAMES, JOINTS, Velocity};
+
+/// How long the G1's controller holds a velocity of [`Facade::drive`], s: a bridge refreshes it
+/// with every twist, and its deadman asks zero sooner.
+pub(crate) const DRIVE_HOLDS_S: f32 = 1.0;
 
 use super::unitree::{imu, low_level_stats, lowstate_passthrough};
 use crate::facade::{Describe, Facade, Observations, floats};
@@ -115,12 +120,16 @@ impl Describe for G1 {
 
     fn stats_line(&self) -> String {
         let s = self.stats();
+        let asks = self.loco().velocity_asks();
+        let refusal = asks.last_refusal.map_or(String::new(), |why| format!(" (last: {why})"));
         format!(
-            "{} | arm_sdk sent {} weight {:.2} | bmsstate received {}",
+            "{} | arm_sdk sent {} weight {:.2} | bmsstate received {} | velocity asked {} refused {}{refusal}",
             low_level_stats(&s.low_level),
             s.arm_sdk_sent,
             s.arm_sdk_weight,
-            s.bmsstate.samples
+            s.bmsstate.samples,
+            asks.sent,
+            asks.refused
         )
     }
 }
@@ -136,6 +145,21 @@ impl Facade for G1 {
         Observations::new(self.every_state(), move |state: &HgLowState| {
             observation(state, options.variant_of(state.mode_machine), battery.latest().as_ref())
         })
+    }
+
+    /// `SetVelocity` for [`DRIVE_HOLDS_S`], checked now, the robot's answer counted in the
+    /// stats line (refused while no walking FSM runs: `LOCO_STATE_UNAVAILABLE`).
+    fn drive(&self, vx_mps: f32, vy_mps: f32, yaw_rate_radps: f32) -> Result<(), DeviceError> {
+        let velocity = Velocity { vx_mps, vy_mps, yaw_radps: yaw_rate_radps, duration_s: DRIVE_HOLDS_S };
+        Ok(self.loco().ask_velocity(velocity)?)
+    }
+
+    fn can_drive(&self) -> bool {
+        true
+    }
+
+    fn stop_motion(&self) -> Result<(), DeviceError> {
+        self.drive(0.0, 0.0, 0.0)
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

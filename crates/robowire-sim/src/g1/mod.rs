@@ -185,6 +185,9 @@ pub struct G1Snapshot {
     pub mode: String,
     /// The loco FSM id.
     pub fsm_id: i64,
+    /// The velocity the loco service was last asked (`SetVelocity`: vx m/s, vy m/s, yaw rate
+    /// rad/s), zero once its duration ran out.
+    pub loco_velocity: [f32; 3],
     /// Joint positions by slot, rad (pitch and roll for the parallel joints; 0 on the slots
     /// the variant does not drive).
     pub joints_rad: [f32; JOINTS],
@@ -395,6 +398,7 @@ impl G1Sim {
         G1Snapshot {
             mode: self.sim.mode(),
             fsm_id: inbox.fsm_id.load(Ordering::Relaxed),
+            loco_velocity: inbox.ask.request(robowire_rt::now()).velocity,
             joints_rad: core::array::from_fn(|j| published[j]),
             lowcmd: G1LowCmdCounters {
                 accepted: inbox.lowcmd.accepted.get(),

@@ -20,6 +20,12 @@ pub(crate) struct PhysicsArgs {
     /// found by the motors' names (FR_hip_joint, …, left_hip_pitch_joint, …).
     #[arg(long, value_name = "MJCF", requires = "physics")]
     model: Option<PathBuf>,
+    /// With --physics: the robot's own locomotion is this walking policy (unitree_rl_gym's deploy
+    /// config, its ONNX model beside it): the Go2's sport StandUp/BalanceStand/Move and the
+    /// G1's loco Start/SetVelocity (Unitree's SportClient.Move, LocoClient.Move) make it stand and
+    /// walk, StopMove asks zero velocity, Damp stops it. The G1 starts free on the floor.
+    #[arg(long, value_name = "CONFIG.yaml", requires = "physics")]
+    walk: Option<PathBuf>,
 }
 
 /// The body of a `sim:go2` or `sim:g1` opened by address (`robowire status|watch`,
@@ -50,6 +56,7 @@ impl SimPhysicsArgs {
         self.body.physics.then(|| robowire_devices::SimPhysics {
             model: self.body.model.clone(),
             hanging: self.free_base.then_some(false),
+            walk: self.body.walk.clone(),
         })
     }
 }
@@ -62,12 +69,6 @@ pub(crate) struct BodyArgs {
     /// Simulated seconds per wall second (0 < X <= 100).
     #[arg(long, value_name = "X", default_value_t = 1.0)]
     speed: f32,
-    /// With --physics: the robot's own locomotion is this walking policy (unitree_rl_gym's deploy
-    /// config, its ONNX model beside it): the Go2's sport StandUp/BalanceStand/Move and the
-    /// G1's loco Start/SetVelocity (Unitree's SportClient.Move, LocoClient.Move) make it stand and
-    /// walk, StopMove asks zero velocity, Damp stops it. The G1 starts free on the floor.
-    #[arg(long, value_name = "CONFIG.yaml", requires = "physics")]
-    walk: Option<PathBuf>,
 }
 
 impl BodyArgs {
@@ -78,7 +79,7 @@ impl BodyArgs {
 
     /// Whether `--walk` was given.
     pub(crate) fn walks(&self) -> bool {
-        self.walk.is_some()
+        self.body.walk.is_some()
     }
 
     /// Starts `--walk`'s policy on the simulator's onboard port (`None` without `--walk`).
@@ -86,7 +87,7 @@ impl BodyArgs {
         &self,
         port: impl FnOnce() -> Option<robowire_sim::go2::Onboard<R::State, R::Cmd>>,
     ) -> anyhow::Result<Option<robowire_policy::onboard::Walker>> {
-        let Some(path) = &self.walk else { return Ok(None) };
+        let Some(path) = &self.body.walk else { return Ok(None) };
         anyhow::ensure!(self.speed == 1.0, "--walk runs the policy in real time: --speed must be 1");
         let config = robowire_policy::PolicyConfig::load(path).map_err(anyhow::Error::msg)?;
         let port = port().context("the simulator has no onboard port")?;
@@ -102,7 +103,7 @@ impl BodyArgs {
             (true, None) => "MuJoCo physics, robowire's model".to_string(),
             (true, Some(model)) => format!("MuJoCo physics, {}", model.display()),
         };
-        let body = match &self.walk {
+        let body = match &self.body.walk {
             Some(config) => format!("{body}, walking under {}", config.display()),
             None => body,
         };

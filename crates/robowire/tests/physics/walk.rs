@@ -5,8 +5,8 @@
 //! with the base's velocity from `rt/sportmodestate`) with a model that holds the default pose, on
 //! `sim:go2 --physics` started by `policy run` itself. The policy as the simulators' own
 //! locomotion (`robowire sim g1|go2 --physics --walk`): the G1 walked by Unitree's `LocoClient`
-//! from its Python SDK (`physics_interop/loco_walk.py`), the Go2 stood up by `sport` StandUp and
-//! laid down by Damp. Where loopback carries multicast (`robowire_dds::netns`).
+//! from its Python SDK (`physics_interop/loco_walk.py`) and by `cmd_vel` through
+//! `robowire ros2`, the Go2 stood up by `sport` StandUp and laid down by Damp. Where loopback carries multicast (`robowire_dds::netns`).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -235,5 +235,47 @@ fn a_go2_walking_policy_stands_the_physics_go2_on_sport_stand_up_and_damp_lays_i
         watcher.join().unwrap();
         let log = sim.interrupt().stdout;
         assert!(log.contains("walker: standing up, then walking") && log.contains("walker: stopped"), "{log}");
+    });
+}
+
+#[test]
+fn cmd_vel_through_the_ros2_bridge_walks_the_physics_g1_under_its_policy() {
+    use ros2_proto::geometry::{Twist, Vector3};
+    let Some(dir) = interop::require(peers::policies_dir()) else { return };
+    robowire_dds::netns::with_loopback_multicast(|| {
+        let config = dir.join("g1_walk.yaml");
+        let mut bridge = robowire()
+            .args(["ros2", "--device", "sim:g1", "--physics", "--walk"])
+            .arg(&config)
+            .args(["--interface", "lo", "--namespace", "g1", "--arm", "--duration", "16", "--json"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let done = Arc::new(AtomicBool::new(false));
+        let (track, watcher) = watch(done.clone());
+        // A teleop's twist, 20 Hz, while the bridge runs (it ends on its --duration).
+        let options = ParticipantOptions { interface: Some("lo".into()), ..ParticipantOptions::default() };
+        let participant = Participant::new(options).unwrap();
+        let writer = participant.writer::<Twist>("rt/g1/cmd_vel", Qos::ROS_DEFAULT).unwrap();
+        let forward = Twist { linear: Vector3 { x: 0.5, y: 0.0, z: 0.0 }, angular: Vector3::default() };
+        while bridge.try_wait().unwrap().is_none() {
+            let _ = writer.write(forward);
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let out = bridge.wait_with_output().unwrap();
+        done.store(true, Ordering::Release);
+        watcher.join().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
+        let counters: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let cmd_vel = &counters[0]["cmd_vel"];
+        assert!(cmd_vel["applied"].as_u64().unwrap() > 100, "{counters}");
+        let track = std::mem::take(&mut *track.0.lock().unwrap());
+        let (Some(first), Some(last)) = (track.first(), track.last()) else { panic!("no rt/sportmodestate") };
+        let walked = last[0] - first[0];
+        eprintln!("walked {walked:.2} m, lowest {:.3} m", lowest(&track));
+        assert!(walked >= 2.0, "walked {walked:.2} m under cmd_vel 0.5 m/s for 16 s (3 s standing up)\n{stderr}");
+        assert!(lowest(&track) >= 0.5, "the pelvis stayed above 0.5 m: {:.3}", lowest(&track));
     });
 }

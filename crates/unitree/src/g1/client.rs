@@ -384,6 +384,8 @@ impl Device for G1 {
 
 impl Drop for G1 {
     fn drop(&mut self) {
+        // Velocities asked without waiting end with zero (its answer awaited 0.5 s at most).
+        self.loco.stop_asked(self.options.low_level.service_timeout.min(Duration::from_millis(500)));
         self.battery.task.abort();
         if let Some(arm_stream) = self.arm_stream.take() {
             // The arm stream ramps its weight to 0 (bounded: see `arm_stream`) and ends by itself.

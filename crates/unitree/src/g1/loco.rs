@@ -3,6 +3,9 @@
 //! the service's documented refusals are typed ([`G1Error::LocoStateUnavailable`],
 //! [`G1Error::InvalidFsmId`], [`G1Error::InvalidTaskId`]).
 
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
 use crate::UnitreeError;
 use crate::services::ServiceHandle;
 use serde_json::Value;
@@ -75,6 +78,26 @@ impl Velocity {
 #[derive(Debug, Clone)]
 pub struct Loco {
     service: ServiceHandle,
+    asked: Arc<Asked>,
+}
+
+/// The velocities [`Loco::ask_velocity`] sent without waiting, and how they were answered.
+#[derive(Debug, Default)]
+struct Asked {
+    sent: AtomicU64,
+    refused: AtomicU64,
+    last_refusal: Mutex<Option<String>>,
+}
+
+/// What [`Loco::ask_velocity`] sent and the robot refused (or did not answer).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct VelocityAsks {
+    /// SetVelocity calls sent.
+    pub sent: u64,
+    /// Refused or unanswered.
+    pub refused: u64,
+    /// Why the last one was.
+    pub last_refusal: Option<String>,
 }
 
 /// `{"data": value}`.
@@ -84,7 +107,7 @@ fn data(value: impl std::fmt::Display) -> String {
 
 impl Loco {
     pub(crate) fn new(service: ServiceHandle) -> Self {
-        Self { service }
+        Self { service, asked: Arc::default() }
     }
 
     /// Calls `api_id` with `parameter`; the documented refusals typed (`fsm`, `task`: the ids
@@ -165,6 +188,49 @@ impl Loco {
     pub async fn set_velocity(&self, vx_mps: f32, vy_mps: f32, yaw_radps: f32, duration_s: f32) -> Result<(), G1Error> {
         let parameter = Velocity { vx_mps, vy_mps, yaw_radps, duration_s }.parameter()?;
         self.call(g1_loco::SET_VELOCITY, parameter, None).await.map(drop)
+    }
+
+    /// SetVelocity without waiting for the answer, for a thread that must not block (a
+    /// bridge's `cmd_vel` listener): checked now (see [`Velocity`]; nothing sent on a bad value),
+    /// the call made on the client's receive thread; refusals counted in
+    /// [`velocity_asks`](Self::velocity_asks).
+    pub fn ask_velocity(&self, velocity: Velocity) -> Result<(), G1Error> {
+        let parameter = velocity.parameter()?;
+        let asked = self.asked.clone();
+        asked.sent.fetch_add(1, Ordering::Relaxed);
+        self.service.call_detached(g1_loco::SET_VELOCITY, parameter, move |answer| {
+            if let Err(e) = answer {
+                asked.refused.fetch_add(1, Ordering::Relaxed);
+                *robowire_rt::lock(&asked.last_refusal) = Some(e.to_string());
+            }
+        });
+        Ok(())
+    }
+
+    /// After [`ask_velocity`](Self::ask_velocity) sent anything: asks zero velocity and waits
+    /// up to `wait` for the answer (a closing client's last word; the controller would otherwise
+    /// hold the last velocity for its duration).
+    pub(crate) fn stop_asked(&self, wait: std::time::Duration) {
+        if self.asked.sent.load(Ordering::Relaxed) == 0 {
+            return;
+        }
+        let (answered, answer) = std::sync::mpsc::channel();
+        let zero = Velocity { vx_mps: 0.0, vy_mps: 0.0, yaw_radps: 0.0, duration_s: 1.0 };
+        if let Ok(parameter) = zero.parameter() {
+            self.service.call_detached(g1_loco::SET_VELOCITY, parameter, move |a| {
+                let _ = answered.send(a.is_ok());
+            });
+            let _ = answer.recv_timeout(wait);
+        }
+    }
+
+    /// What [`ask_velocity`](Self::ask_velocity) sent and the robot refused so far.
+    pub fn velocity_asks(&self) -> VelocityAsks {
+        VelocityAsks {
+            sent: self.asked.sent.load(Ordering::Relaxed),
+            refused: self.asked.refused.load(Ordering::Relaxed),
+            last_refusal: robowire_rt::lock(&self.asked.last_refusal).clone(),
+        }
     }
 
     /// Stops walking: velocity 0 for 1 s (Unitree's `StopMove`).

@@ -81,7 +81,8 @@ pub use battery::Battery;
 pub use client::{ARM_JOINTS, G1, G1Stats};
 pub use error::G1Error;
 pub use loco::{
-    BalanceMode, HEIGHT_MAX_M, Loco, VELOCITY_DURATION_MAX_S, VX_MAX_MPS, VY_MAX_MPS, Velocity, YAW_RATE_MAX_RADPS,
+    BalanceMode, HEIGHT_MAX_M, Loco, VELOCITY_DURATION_MAX_S, VX_MAX_MPS, VY_MAX_MPS, Velocity, VelocityAsks,
+    YAW_RATE_MAX_RADPS,
 };
 pub use options::G1Options;
 pub use unitree_proto::bms::HgBmsState;
