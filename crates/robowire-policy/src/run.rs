@@ -8,7 +8,9 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use robowire_core::schedule::Time;
+use robowire_core::timing::LatenessSummary;
 use robowire_rt::runner::{Job, Runner, RunnerOptions, Waker};
+use robowire_rt::stats::{SharedLateness, micros};
 use tokio::sync::watch;
 
 use crate::body::{BaseVelocity, Body, Reading};
@@ -125,6 +127,8 @@ struct Shared {
     phase: AtomicU8,
     ended: watch::Sender<Option<Ended>>,
     report: Mutex<StepReport>,
+    /// Each tick's lateness against its deadline on the `control_dt` grid, µs.
+    lateness: SharedLateness<4096>,
 }
 
 /// A policy running on a robot.
@@ -150,6 +154,12 @@ impl<H: Send + Sync + 'static, B: Body> Running<H, B> {
     /// Where the sequence is.
     pub fn phase(&self) -> Phase {
         phase_of(self.shared.phase.load(Ordering::Acquire))
+    }
+
+    /// How late the ticks ran against their deadlines on the `control_dt` grid, µs (the last
+    /// 4096).
+    pub fn tick_lateness(&self) -> LatenessSummary {
+        self.shared.lateness.summary()
     }
 
     /// The last policy step.
@@ -223,6 +233,7 @@ where
         phase: AtomicU8::new(phase_code(controller.phase())),
         ended: watch::Sender::new(None),
         report: Mutex::new(StepReport::default()),
+        lateness: SharedLateness::new(),
     });
     let job = PolicyJob {
         holder,
@@ -311,6 +322,7 @@ impl<H: Send + Sync + 'static, B: Body> Job for PolicyJob<H, B> {
         if now < self.next {
             return;
         }
+        self.shared.lateness.record(micros(now.saturating_duration_since(self.next)));
         // The next deadline on the grid, skipping ticks missed.
         while self.next <= now {
             self.next = self.next + self.period;

@@ -224,14 +224,16 @@ pub(crate) fn dds_rows(meta: &Value) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// The G1 walking policy's inference beside a matrix product of the same weights, p50 and p99.
+/// The G1 walking policy's inference beside a matrix product of the same weights, p50 and p99;
+/// running on a G1, its ticks' lateness beside the LowCmd stream's, and the stream's lateness
+/// while it runs beside the stream holding a pose without it.
 pub(crate) fn policy_rows(policy: Option<&Value>) -> anyhow::Result<Vec<Row>> {
     let Some(policy) = policy else { return Ok(Vec::new()) };
     let ns = |model: &str, pct: &str| {
         policy[model][format!("{pct}_ns")].as_f64().with_context(|| format!("policy meta {model}.{pct}_ns"))
     };
     let shape = format!("{}×{}", policy["matmul"]["rows"], policy["matmul"]["columns"]);
-    ["p50", "p99"]
+    let mut rows = ["p50", "p99"]
         .into_iter()
         .map(|pct| {
             let (model, plain) = (ns("g1", pct)?, ns("matmul", pct)?);
@@ -244,7 +246,39 @@ pub(crate) fn policy_rows(policy: Option<&Value>) -> anyhow::Result<Vec<Row>> {
                 met: None,
             })
         })
-        .collect()
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let running = &policy["running"];
+    if running.is_null() {
+        return Ok(rows);
+    }
+    let us = |phase: &str, pct: &str| {
+        running[phase][format!("{pct}_us")].as_f64().with_context(|| format!("policy meta running.{phase}.{pct}_us"))
+    };
+    for pct in ["p50", "p99"] {
+        let (ticks, stream) = (us("ticks", pct)?, us("stream_walking", pct)?);
+        rows.push(Row {
+            path: format!(
+                "The G1 policy's ticks at 50 Hz on robowire's runner (kinematic sim G1, facade), lateness {pct}"
+            ),
+            figure: format!("{ticks:.0} µs"),
+            baseline: format!("the facade's 500 Hz LowCmd stream meanwhile: {stream:.0} µs"),
+            ratio: "–".into(),
+            target: "–".into(),
+            met: None,
+        });
+    }
+    for pct in ["p50", "p99"] {
+        let (walking, holding) = (us("stream_walking", pct)?, us("stream_holding", pct)?);
+        rows.push(Row {
+            path: format!("The G1's 500 Hz LowCmd stream while the policy runs, send lateness {pct}"),
+            figure: format!("{walking:.0} µs"),
+            baseline: format!("the same stream holding a pose, no policy: {holding:.0} µs"),
+            ratio: if holding > 0.0 { format!("{:.2}×", walking / holding) } else { "–".into() },
+            target: "–".into(),
+            met: None,
+        });
+    }
+    Ok(rows)
 }
 
 #[cfg(test)]

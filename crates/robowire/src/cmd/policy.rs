@@ -146,8 +146,13 @@ async fn walk<B: Body>(
         command[2],
     );
     let ended = until_ended(&running).await;
+    let late = running.tick_lateness();
     drop(running);
     eprintln!("ended: {ended}; the robot was damped");
+    eprintln!(
+        "policy ticks: {} late p50 {} µs, p99 {} µs, max {} µs",
+        late.count, late.p50_us, late.p99_us, late.max_us
+    );
     Ok(ended)
 }
 
