@@ -8,7 +8,9 @@
 //! - [`control`]: `deploy_real.py`'s sequence and safety as a sans-IO machine on caller time;
 //! - [`run`]: that sequence on a robot ([`body`]: the G1 and the Go2 through their facades), on
 //!   robowire's runner;
-//! - [`record`]: each policy step as a frame of a capture's `policy` channel.
+//! - [`record`]: each policy step as a frame of a capture's `policy` channel;
+//! - `device` (feature `devices`): the addresses a policy drives, and a run on a device opened
+//!   by address (`robowire_devices`).
 //!
 //! ```no_run
 //! use std::sync::Arc;
@@ -31,6 +33,8 @@
 pub mod body;
 pub mod config;
 pub mod control;
+#[cfg(feature = "devices")]
+pub mod device;
 pub mod model;
 pub mod observation;
 pub mod record;
