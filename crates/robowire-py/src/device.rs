@@ -18,7 +18,7 @@ use crate::stats::dict;
 
 /// A `DeviceError` as the exception a Python user expects: the facade's own mapping where there
 /// is one.
-fn raise(e: DeviceError) -> PyErr {
+pub(crate) fn raise(e: DeviceError) -> PyErr {
     match e {
         DeviceError::Kmc(e) => crate::kmc::raise(e),
         DeviceError::Unitree(e) => crate::errors::unitree_error(e),
@@ -247,7 +247,11 @@ impl Device {
 }
 
 /// `physics`, `model` and `free_base` as `OpenOptions::sim_physics`: the latter two need the first.
-fn sim_physics(physics: bool, model: Option<std::path::PathBuf>, free_base: bool) -> PyResult<Option<SimPhysics>> {
+pub(crate) fn sim_physics(
+    physics: bool,
+    model: Option<std::path::PathBuf>,
+    free_base: bool,
+) -> PyResult<Option<SimPhysics>> {
     if !physics && (model.is_some() || free_base) {
         return Err(error(Kind::Argument, "model and free_base need physics=True"));
     }
