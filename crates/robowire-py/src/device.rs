@@ -223,15 +223,7 @@ impl Device {
     /// Does the device's safe thing (a stop burst, a stop, damping) and closes it, then stops its
     /// simulator, then finishes the capture of `record=PATH`. Idempotent.
     fn close(&self, py: Python<'_>) -> PyResult<()> {
-        let closed = match self.device.take().map(Arc::try_unwrap) {
-            None => Ok(()),
-            Some(Ok(device)) => py.detach(move || device.close()).map_err(raise),
-            // Another thread is inside a call: the last one out closes it (dropping does the same).
-            Some(Err(shared)) => {
-                py.detach(move || drop(shared));
-                Ok(())
-            }
-        };
+        let closed = close(py, &self.device);
         let finished = self.capture.finish(py);
         closed.and(finished)
     }
@@ -243,6 +235,20 @@ impl Device {
     #[pyo3(signature = (*_exc))]
     fn __exit__(&self, py: Python<'_>, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<()> {
         self.close(py)
+    }
+}
+
+/// Closes the device `owned` holds, the GIL released: its safe action, then its simulator.
+/// Idempotent.
+pub(crate) fn close(py: Python<'_>, owned: &Owned<Arc<AnyDevice>>) -> PyResult<()> {
+    match owned.take().map(Arc::try_unwrap) {
+        None => Ok(()),
+        Some(Ok(device)) => py.detach(move || device.close()).map_err(raise),
+        // Another thread is inside a call: the last one out closes it (dropping does the same).
+        Some(Err(shared)) => {
+            py.detach(move || drop(shared));
+            Ok(())
+        }
     }
 }
 

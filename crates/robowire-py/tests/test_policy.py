@@ -163,3 +163,9 @@ def test_a_run_ends_when_its_duration_runs_out(dds, tmp_path):
         assert walk.wait() == "duration"
         assert walk.reason == "the duration ran out" and walk.phase == "damped"
         assert walk.last_step["step"] >= 1
+
+
+def test_a_robot_that_sends_no_state_raises_no_state_error(dds, tmp_path):
+    path = write_config(tmp_path, G1_YAML, "g1", 47)
+    with pytest.raises(robowire.NoStateError, match="no LowState from the robot within 3 s"):
+        robowire.policy.run(path, "g1:lo", domain=22)

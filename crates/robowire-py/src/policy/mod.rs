@@ -167,14 +167,7 @@ impl PyRun {
         // The run's thread joins, and lets the device go.
         let run = self.run.take();
         py.detach(move || drop(run));
-        let closed = match self.device.take().map(Arc::try_unwrap) {
-            None => Ok(()),
-            Some(Ok(device)) => py.detach(move || device.close()).map_err(crate::device::raise),
-            Some(Err(shared)) => {
-                py.detach(move || drop(shared));
-                Ok(())
-            }
-        };
+        let closed = crate::device::close(py, &self.device);
         let finished = self.capture.finish(py);
         stopped.and(closed).and(finished)
     }
