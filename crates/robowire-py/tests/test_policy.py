@@ -3,6 +3,7 @@ same lines as ``robowire policy run``), and, on the physics Go2 (a wheel built w
 feature ``mujoco``, gated as test_physics.py's), a run that stands, holds, walks and is damped."""
 
 import math
+import threading
 
 import pytest
 
@@ -149,7 +150,13 @@ def test_a_run_stands_holds_walks_and_stop_damps(dds, tmp_path):
         with pytest.raises(robowire.ArgumentError):
             walk.set_command(math.inf, 0.0, 0.0)
         assert walk.reason is None
+        # A thread waits without a timeout, the GIL released: this one stops the run meanwhile.
+        ended = []
+        waiter = threading.Thread(target=lambda: ended.append(walk.wait()))
+        waiter.start()
         assert walk.stop() == "stopped"
+        waiter.join()
+        assert ended == ["stopped"]
         assert (walk.phase, walk.wait(), walk.reason) == ("damped", "stopped", "stopped")
     assert walk.phase == "damped" and walk.wait(timeout_s=0.0) == "stopped"
     with pytest.raises(robowire.ClosedError):
