@@ -174,5 +174,7 @@ def test_a_run_ends_when_its_duration_runs_out(dds, tmp_path):
 
 def test_a_robot_that_sends_no_state_raises_no_state_error(dds, tmp_path):
     path = write_config(tmp_path, G1_YAML, "g1", 47)
+    capture = tmp_path / "silent.mcap"
     with pytest.raises(robowire.NoStateError, match="no LowState from the robot within 3 s"):
-        robowire.policy.run(path, "g1:lo", domain=22)
+        robowire.policy.run(path, "g1:lo", domain=22, record=capture)
+    assert capture.stat().st_size > 0, "the capture was finished"

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use robowire_devices::{AnyDevice, DeviceAddress, OpenOptions};
 use robowire_policy::device::{DeviceRun, check, policy_link, start_on};
-use robowire_policy::{CommandSlot, Ended, ModelError, OnnxPolicy, RunOptions, StartError};
+use robowire_policy::{CommandSlot, Ended, ModelError, OnnxPolicy, PolicyConfig, RunOptions, StartError};
 
 use crate::errors::{Kind, chain, error, service_error};
 use crate::owned::Owned;
@@ -193,6 +193,8 @@ impl PyRun {
 /// `control_dt` until `duration_s` (`None`: until stopped) or a fault. Refusals (a kinematic
 /// simulator, a robot of the other family, a config or model that disagree) raise
 /// `ArgumentError` before anything is sent; no state within 3 s raises `NoStateError`.
+/// `record`: a path or a `robowire.Recorder`, for the device's links and the policy's steps
+/// (`g1/policy`, `go2/policy`); `domain` and `model` as for `robowire.open`.
 #[pyfunction]
 #[pyo3(name = "run_policy", signature = (config, device, *, cmd = (0.0, 0.0, 0.0), duration_s = None, stand = true, record = None, domain = 0, physics = false, model = None))]
 #[allow(clippy::too_many_arguments)]
@@ -223,32 +225,13 @@ pub(crate) fn run(
     // A policy walks a simulated robot on the floor.
     let sim_physics = crate::device::sim_physics(physics, model, physics)?;
     let (links, capture) = record_arg(record, &format!("robowire.policy.run({device:?})"))?;
-    let options = OpenOptions { domain, record: links.clone(), sim_physics, ..OpenOptions::default() };
-    let opened = Arc::new(py.detach(|| robowire_devices::open(&address, &options)).map_err(crate::device::raise)?);
+    let open = OpenOptions { domain, record: links, sim_physics, ..OpenOptions::default() };
     let slot = CommandSlot::new(asked);
-    let options = RunOptions {
-        command: slot.clone(),
-        duration,
-        stand,
-        tap: links.map(|links| policy_link(&opened, &links)),
-        ..RunOptions::default()
-    };
-    let holder = opened.clone();
-    let started = runtime::wait(py, None, async move { start_on(holder, &config, policy, options).await });
-    let started = match started {
-        Ok(Some(Ok(run))) => Ok(run),
-        Ok(Some(Err(e))) => Err(start_error(&e)),
-        Ok(None) => Err(error(Kind::Error, "the start did not end")),
-        Err(interrupted) => Err(interrupted),
-    };
-    let run = match started {
-        Ok(run) => run,
-        Err(e) => {
-            // Nothing runs: the device's safe action, and its simulator stopped.
-            py.detach(move || drop(opened));
-            capture.finish(py)?;
-            return Err(e);
-        }
+    let options = RunOptions { command: slot.clone(), duration, stand, ..RunOptions::default() };
+    let (opened, run) = match open_and_start(py, &address, &open, config, policy, options) {
+        Ok(started) => started,
+        // The capture holds what the device said before it closed.
+        Err(e) => return capture.finish(py).and(Err(e)),
     };
     Ok(PyRun {
         run: Owned::new("policy run", Arc::new(run)),
@@ -258,6 +241,33 @@ pub(crate) fn run(
         ended: Mutex::new(None),
         capture,
     })
+}
+
+/// Opens the device at `address` and starts the policy on it, its steps recorded beside the
+/// device's links (`open.record`). On an error the device is closed again (its safe action, its
+/// simulator stopped).
+fn open_and_start(
+    py: Python<'_>,
+    address: &DeviceAddress,
+    open: &OpenOptions,
+    config: PolicyConfig,
+    policy: OnnxPolicy,
+    mut options: RunOptions,
+) -> PyResult<(Arc<AnyDevice>, DeviceRun)> {
+    let opened = Arc::new(py.detach(|| robowire_devices::open(address, open)).map_err(crate::device::raise)?);
+    options.tap = open.record.as_ref().map(|links| policy_link(&opened, links));
+    let holder = opened.clone();
+    match runtime::wait(py, None, async move { start_on(holder, &config, policy, options).await }) {
+        Ok(Some(Ok(run))) => Ok((opened, run)),
+        failed => {
+            py.detach(move || drop(opened));
+            Err(match failed {
+                Ok(Some(Err(e))) => start_error(&e),
+                Err(interrupted) => interrupted,
+                _ => error(Kind::Error, "the start did not end"),
+            })
+        }
+    }
 }
 
 /// Adds the classes and the function to the extension module.
