@@ -75,7 +75,7 @@ pub fn test_python() -> anyhow::Result<()> {
         python,
         wheel: wheel.clone(),
         require: require.into(),
-        tests: "",
+        tests: &[],
         mujoco: None,
     };
     let runs = py310.map(|python| suite(python, "vendor,sdk,mcap,cli")).into_iter().chain([suite(second_venv, "cli")]);
@@ -89,7 +89,7 @@ pub fn test_python() -> anyhow::Result<()> {
         Ok(dir) => {
             let venv = bare_venv(&target, &format!("{version}-physics"), &second)?;
             let wheel = build_wheel_with(&root, &target, &venv, Some(&dir))?;
-            let tests = "test_physics.py";
+            let tests = &["test_physics.py", "test_policy.py"];
             let physics = PytestRun { python: venv, wheel, require: "physics".into(), tests, mujoco: Some(dir) };
             pytest_run(&root, &target, &physics, &userns, dds)
         }
@@ -115,12 +115,16 @@ fn pytest_run(
     };
     let inside = if matches!(userns, Ok(true)) { " in a user + network namespace" } else { "" };
     println!("\n== pytest on {}{inside} (required here: {require})", run_.python.display());
-    let tests = root.join("crates/robowire-py/tests").join(run_.tests);
+    let suite = root.join("crates/robowire-py/tests");
+    let tests: Vec<PathBuf> = match run_.tests {
+        [] => vec![suite],
+        files => files.iter().map(|f| suite.join(f)).collect(),
+    };
     run(
         "pytest",
         pytest
             .args(["-m", "pytest"])
-            .arg(tests)
+            .args(tests)
             .args(["-q", "-p", "no:cacheprovider", "-rs"])
             .env("ROBOWIRE_REQUIRE", &require)
             .env("ROBOWIRE_CLI", target.join("debug/robowire"))
@@ -130,13 +134,13 @@ fn pytest_run(
     Ok(())
 }
 
-/// One pytest run: `tests` (a file of the suite, or all of it) with `python`, on `wheel`,
+/// One pytest run: `tests` (files of the suite; none: all of it) with `python`, on `wheel`,
 /// `require` naming what must not be missing; `mujoco`: MuJoCo's directory for the loader.
 struct PytestRun {
     python: PathBuf,
     wheel: PathBuf,
     require: String,
-    tests: &'static str,
+    tests: &'static [&'static str],
     mujoco: Option<PathBuf>,
 }
 

@@ -10,6 +10,8 @@ mod address;
 mod facade;
 mod kinds;
 mod observation;
+#[cfg(feature = "policy")]
+pub mod policy;
 #[cfg(feature = "sim")]
 mod sim;
 

@@ -89,6 +89,18 @@ pub enum Phase {
     Damped,
 }
 
+impl Phase {
+    /// `standing`, `holding`, `walking` or `damped`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Standing => "standing",
+            Phase::Holding => "holding",
+            Phase::Walking => "walking",
+            Phase::Damped => "damped",
+        }
+    }
+}
+
 /// What a tick decided.
 #[derive(Debug, PartialEq)]
 pub enum Tick<'a> {

@@ -90,6 +90,18 @@ pub enum Ended {
     Refused(String),
 }
 
+impl Ended {
+    /// `duration`, `stopped`, `fault` or `refused`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Ended::Duration => "duration",
+            Ended::Stopped => "stopped",
+            Ended::Fault(_) => "fault",
+            Ended::Refused(_) => "refused",
+        }
+    }
+}
+
 /// Why a run could not start. Nothing was sent.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

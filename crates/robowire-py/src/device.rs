@@ -18,7 +18,7 @@ use crate::stats::dict;
 
 /// A `DeviceError` as the exception a Python user expects: the facade's own mapping where there
 /// is one.
-fn raise(e: DeviceError) -> PyErr {
+pub(crate) fn raise(e: DeviceError) -> PyErr {
     match e {
         DeviceError::Kmc(e) => crate::kmc::raise(e),
         DeviceError::Unitree(e) => crate::errors::unitree_error(e),
@@ -223,15 +223,7 @@ impl Device {
     /// Does the device's safe thing (a stop burst, a stop, damping) and closes it, then stops its
     /// simulator, then finishes the capture of `record=PATH`. Idempotent.
     fn close(&self, py: Python<'_>) -> PyResult<()> {
-        let closed = match self.device.take().map(Arc::try_unwrap) {
-            None => Ok(()),
-            Some(Ok(device)) => py.detach(move || device.close()).map_err(raise),
-            // Another thread is inside a call: the last one out closes it (dropping does the same).
-            Some(Err(shared)) => {
-                py.detach(move || drop(shared));
-                Ok(())
-            }
-        };
+        let closed = close(py, &self.device);
         let finished = self.capture.finish(py);
         closed.and(finished)
     }
@@ -246,8 +238,26 @@ impl Device {
     }
 }
 
+/// Closes the device `owned` holds, the GIL released: its safe action, then its simulator.
+/// Idempotent.
+pub(crate) fn close(py: Python<'_>, owned: &Owned<Arc<AnyDevice>>) -> PyResult<()> {
+    match owned.take().map(Arc::try_unwrap) {
+        None => Ok(()),
+        Some(Ok(device)) => py.detach(move || device.close()).map_err(raise),
+        // Another thread is inside a call: the last one out closes it (dropping does the same).
+        Some(Err(shared)) => {
+            py.detach(move || drop(shared));
+            Ok(())
+        }
+    }
+}
+
 /// `physics`, `model` and `free_base` as `OpenOptions::sim_physics`: the latter two need the first.
-fn sim_physics(physics: bool, model: Option<std::path::PathBuf>, free_base: bool) -> PyResult<Option<SimPhysics>> {
+pub(crate) fn sim_physics(
+    physics: bool,
+    model: Option<std::path::PathBuf>,
+    free_base: bool,
+) -> PyResult<Option<SimPhysics>> {
     if !physics && (model.is_some() || free_base) {
         return Err(error(Kind::Argument, "model and free_base need physics=True"));
     }

@@ -10,6 +10,7 @@ mod go2;
 mod joints;
 mod kmc;
 mod owned;
+mod policy;
 mod pyjson;
 mod record;
 mod runtime;
@@ -33,5 +34,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     spline::register(m)?;
     device::register(m)?;
     record::register(m)?;
+    policy::register(m)?;
     Ok(())
 }

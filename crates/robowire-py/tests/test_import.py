@@ -21,6 +21,7 @@ def test_importing_every_module_starts_no_thread_and_opens_nothing():
         before = (tasks(), fds())
         import robowire, robowire.zsl1, robowire.zsl1w, robowire.kmc, robowire.unitree
         import robowire.go2, robowire.g1, robowire.sim, robowire.spline, robowire.errors, robowire.device, robowire.record
+        import robowire.policy
         after = (tasks(), fds())
         print(before, after)
         assert before == after, (before, after)

@@ -20,7 +20,7 @@ BLOCKS = python_blocks("README.md") + DEVICE_BLOCKS
 
 def test_the_python_docs_have_an_example_per_device():
     text = "".join(DEVICE_BLOCKS)
-    for module in ["robowire.zsl1", "robowire.kmc", "robowire.go2", "robowire.g1", "robowire.unitree", "robowire.spline"]:
+    for module in ["robowire.zsl1", "robowire.kmc", "robowire.go2", "robowire.g1", "robowire.unitree", "robowire.spline", "robowire.policy"]:
         assert module in text, module
 
 

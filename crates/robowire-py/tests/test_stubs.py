@@ -11,7 +11,7 @@ import pytest
 
 import robowire
 
-MODULES = ["zsl1", "zsl1w", "kmc", "unitree", "go2", "g1", "sim", "spline", "device", "record"]
+MODULES = ["zsl1", "zsl1w", "kmc", "unitree", "go2", "g1", "sim", "spline", "device", "record", "policy"]
 PACKAGE = Path(robowire.__file__).parent
 
 

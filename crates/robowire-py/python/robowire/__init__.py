@@ -7,6 +7,8 @@
 - :mod:`robowire.go2`: the Go2's low-level interface over DDS.
 - :mod:`robowire.g1`: the Unitree G1 humanoid over DDS (low level, ``rt/arm_sdk``, its services).
 - :mod:`robowire.sim`: every simulator, in-process, as a context manager.
+- :mod:`robowire.policy`: a trained locomotion policy (ONNX) on a G1 or Go2, or their physics
+  simulators, as ``robowire policy run`` runs it.
 - :func:`robowire.open`: any device by its address (``kmc:/dev/ttyUSB0``, ``zsl1:IP``,
   ``go2:eth0``, ``sim:zsl1``, …) as a :class:`robowire.Device` of one shape.
 - :class:`robowire.Recorder`: an MCAP capture of the links of every device given ``record=``.

@@ -7,12 +7,12 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use clap::{Args, Subcommand};
-use robowire_devices::{AnyDevice, DeviceAddress, DeviceKind};
+use robowire_devices::policy::{DeviceRun, policy_link, start_on};
+use robowire_devices::{AnyDevice, DeviceAddress};
 use robowire_policy::control::{HOLD_S, STAND_S};
-use robowire_policy::record::POLICY;
-use robowire_policy::{Body, CommandSlot, Ended, MsgType, OnnxPolicy, Phase, PolicyConfig, RunOptions, Running};
+use robowire_policy::{CommandSlot, Ended, OnnxPolicy, Phase, PolicyConfig, RunOptions};
 
 use crate::cmd::device::ReachArgs;
 
@@ -69,15 +69,7 @@ fn parse_command(text: &str) -> Result<[f32; 3], String> {
 pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::Loopback>) -> anyhow::Result<ExitCode> {
     let PolicyCommand::Run(mut args) = command;
     let config = PolicyConfig::load(&args.config).map_err(anyhow::Error::msg)?;
-    let msg_type = robot_of(&args.device, args.reach.body.physics())?;
-    if config.msg_type != msg_type {
-        bail!(
-            "msg_type: {} is a config for {} robots, {} speaks {msg_type}",
-            args.config.display(),
-            config.msg_type,
-            args.device,
-        );
-    }
+    robowire_devices::policy::check(&config, &args.device, args.reach.body.physics()).map_err(anyhow::Error::msg)?;
     let duration = args.duration.map(|s| crate::cmd::seconds("--duration", s)).transpose()?;
     let policy =
         OnnxPolicy::load(&config.policy_path, config.num_obs, config.num_actions).map_err(anyhow::Error::msg)?;
@@ -88,14 +80,9 @@ pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::
     let mut ended = None;
     let code = crate::cmd::device::on_loopback(loopback, || {
         args.reach.recording_with_links(&args.device, "robowire policy run", |device, links| async {
-            // The policy's steps beside the device's links (`g1/policy`, `go2/policy`).
-            options.tap = links.map(|links| links.link(&format!("{}/policy", device.kind().name()), &POLICY));
+            options.tap = links.map(|links| policy_link(&device, &links));
             let device = Arc::new(device);
-            let end = match msg_type {
-                MsgType::Hg => walk(device.clone(), AnyDevice::g1, &config, policy, options).await?,
-                MsgType::Go => walk(device.clone(), AnyDevice::go2, &config, policy, options).await?,
-            };
-            ended = Some(end);
+            ended = Some(walk(device.clone(), &config, policy, options).await?);
             Arc::try_unwrap(device).map_err(|_| anyhow::anyhow!("the policy's thread still holds the device"))
         })
     })?;
@@ -105,38 +92,15 @@ pub(crate) fn run(command: PolicyCommand, loopback: Option<robowire_dds::netns::
     })
 }
 
-/// Which message family the robot at `address` speaks, or why a policy cannot drive it.
-fn robot_of(address: &DeviceAddress, physics: bool) -> anyhow::Result<MsgType> {
-    let msg_type = match address {
-        DeviceAddress::G1(_) | DeviceAddress::Sim(DeviceKind::G1) => MsgType::Hg,
-        DeviceAddress::Go2(_) | DeviceAddress::Sim(DeviceKind::Go2) => MsgType::Go,
-        DeviceAddress::Hg(_) => {
-            bail!("{address}: a policy drives a G1 as g1:IFACE (hg:/h1: robots are not supported yet)")
-        }
-        other => {
-            bail!("{other}: a policy drives a Unitree robot: g1:IFACE, go2:IFACE, sim:g1 or sim:go2 with --physics")
-        }
-    };
-    if address.is_simulated() && !physics {
-        bail!(
-            "{address} is the kinematic simulator: its joints follow the commands and nothing walks; \
-             add --physics (a build with --features mujoco)"
-        );
-    }
-    Ok(msg_type)
-}
-
-/// Runs the policy on the robot `body` finds in `device` until it ends or Ctrl-C, a line each
-/// second.
-async fn walk<B: Body>(
+/// Runs the policy on the robot `device` holds until it ends or Ctrl-C, a line each second.
+async fn walk(
     device: Arc<AnyDevice>,
-    body: fn(&AnyDevice) -> Option<&B>,
     config: &PolicyConfig,
     policy: OnnxPolicy,
     options: RunOptions,
 ) -> anyhow::Result<Ended> {
     let command = options.command.get();
-    let running = robowire_policy::start(device, body, config, policy, options).await.context("starting the policy")?;
+    let running = start_on(device, config, policy, options).await.context("starting the policy")?;
     eprintln!(
         "policy {} every {} ms: standing {STAND_S} s, holding {HOLD_S} s, then walking at ({}, {}, {})",
         config.policy_path.display(),
@@ -156,7 +120,7 @@ async fn walk<B: Body>(
     Ok(ended)
 }
 
-async fn until_ended<H: Send + Sync + 'static, B: Body>(running: &Running<H, B>) -> Ended {
+async fn until_ended(running: &DeviceRun) -> Ended {
     let ended = running.ended();
     tokio::pin!(ended);
     let ctrl_c = tokio::signal::ctrl_c();
