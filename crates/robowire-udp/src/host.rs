@@ -1,6 +1,6 @@
 //! What this host's network looks like from the calling thread's network namespace, read
 //! without changing anything: interfaces with their flags, IPv4 addresses and MTU
-//! (`getifaddrs`), the IPv4 routes of the main table (`/proc/net/route`), reverse-path filtering
+//! (`getifaddrs`), the IPv4 routes of the main table (`/proc/thread-self/net/route`), reverse-path filtering
 //! (`/proc/sys/net/ipv4/conf`) and the nftables ruleset (`nft list ruleset`).
 
 use std::io;
@@ -107,9 +107,12 @@ fn neighbour(ip: Ipv4Addr, prefix: u8, own: &[Ipv4Addr]) -> Option<Ipv4Addr> {
         .find(|candidate| u32::from(*candidate) & !mask != !mask && !own.contains(candidate))
 }
 
-/// The IPv4 routes of the main table (`/proc/net/route`, this namespace's).
+/// The IPv4 routes of the main table in the calling thread's network namespace
+/// (`/proc/thread-self/net/route`; `/proc/net/route` is the process's).
 pub fn ipv4_routes() -> io::Result<Vec<InterfaceRoute>> {
-    Ok(parse_proc_net_route(&std::fs::read_to_string("/proc/net/route")?))
+    let text = std::fs::read_to_string("/proc/thread-self/net/route")
+        .or_else(|_| std::fs::read_to_string("/proc/net/route"))?;
+    Ok(parse_proc_net_route(&text))
 }
 
 /// The routes of a `/proc/net/route` text; lines that do not parse are left out.

@@ -1,0 +1,58 @@
+//! `robowire doctor`: why a robot does not answer, each check with ✓/✗/? and the fix for a ✗.
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+use robowire_devices::DeviceAddress;
+use robowire_doctor::{Options, Target};
+
+use crate::output::Output;
+
+#[derive(Debug, Args)]
+pub(crate) struct DoctorArgs {
+    /// The device (go2:IFACE, g1:IFACE, hg:IFACE, sim:go2, sim:g1); without one, whatever is on
+    /// --interface.
+    address: Option<DeviceAddress>,
+    /// The network interface (overrides the address's).
+    #[arg(long)]
+    interface: Option<String>,
+    /// DDS domain.
+    #[arg(long, default_value_t = 0)]
+    domain: u16,
+    /// Print the checks as JSON on stdout (the checklist goes to stderr).
+    #[arg(long)]
+    json: bool,
+    /// Seconds to listen on the network (twice that when nobody is heard and domains 0–9 are
+    /// listened on).
+    #[arg(long, default_value_t = 3.0)]
+    timeout: f64,
+}
+
+impl DoctorArgs {
+    /// Whether it starts a simulator on DDS (which needs multicast on loopback).
+    pub(crate) fn simulates_dds(&self) -> bool {
+        self.address.as_ref().is_some_and(|a| a.is_simulated() && a.uses_dds())
+    }
+}
+
+pub(crate) fn run(args: &DoctorArgs) -> anyhow::Result<ExitCode> {
+    let options = Options {
+        interface: args.interface.clone(),
+        domain: args.domain,
+        timeout: super::seconds("--timeout", args.timeout)?,
+    };
+    let target = Target::of(args.address.as_ref(), &options)?;
+    let _simulator = match &args.address {
+        Some(address) => robowire_doctor::simulate(address, &options).context("starting the simulator")?,
+        None => None,
+    };
+    let report = robowire_doctor::diagnose(&target, &options);
+    let out = Output::new(args.json);
+    out.line(format!("robowire doctor {}", report.target));
+    out.write(&report.to_string());
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(if report.failed() { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
