@@ -46,9 +46,14 @@ pub struct HostExpectations {
 }
 
 /// Whether `ip` is on `network`/`prefix`.
-pub fn on_subnet(ip: Ipv4Addr, network: Ipv4Addr, prefix: u8) -> bool {
+pub fn on_subnet(ip: Ipv4Addr, subnet: Ipv4Addr, prefix: u8) -> bool {
+    network(ip, prefix) == network(subnet, prefix)
+}
+
+/// The network of `ip`/`prefix`.
+fn network(ip: Ipv4Addr, prefix: u8) -> Ipv4Addr {
     let mask = if prefix == 0 { 0 } else { u32::MAX << (32 - u32::from(prefix.min(32))) };
-    u32::from(ip) & mask == u32::from(network) & mask
+    Ipv4Addr::from(u32::from(ip) & mask)
 }
 
 fn addresses(i: &InterfaceInfo) -> String {
@@ -118,15 +123,16 @@ fn address(i: &InterfaceInfo, net: Option<RobotNet>) -> Check {
         return Check::pass("address", format!("{name} is loopback ({}): a simulator on this machine", addresses(i)));
     }
     match net {
-        Some(net) if i.ipv4.iter().any(|&(ip, _)| on_subnet(ip, net.robot, net.prefix)) => {
-            Check::pass("address", format!("{} on the robot's subnet {}/{}", addresses(i), net.robot, net.prefix))
-        }
+        Some(net) if i.ipv4.iter().any(|&(ip, _)| on_subnet(ip, net.robot, net.prefix)) => Check::pass(
+            "address",
+            format!("{} on the robot's subnet {}/{}", addresses(i), network(net.robot, net.prefix), net.prefix),
+        ),
         Some(net) => Check::fail(
             "address",
             format!(
                 "{name} has {}, not on the robot's subnet {}/{} (the robot is {})",
                 addresses(i),
-                net.robot,
+                network(net.robot, net.prefix),
                 net.prefix,
                 net.robot
             ),

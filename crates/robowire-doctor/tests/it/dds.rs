@@ -14,21 +14,6 @@ use unitree_proto::{LowCmd, Message};
 /// at once); the rest measures `rt/lowstate`.
 const LISTEN: Duration = Duration::from_secs(2);
 
-/// Runs `body` in a network namespace of this test's own, with multicast on `lo` (skipped with a
-/// line where none can be made, or where `lo` already carries multicast and the test would run
-/// in the host's namespace, whose routes and firewall it does not control).
-fn in_private_network(body: impl FnOnce() + Send) {
-    robowire_dds::netns::with_loopback_multicast(|| {
-        let ns = |of: &str| std::fs::read_link(format!("/proc/{of}/ns/net")).ok();
-        if ns("thread-self") == ns("self") && std::env::var_os(robowire_dds::netns::CHILD_ENV).is_none() {
-            return robowire_fixtures::interop::skip(
-                "lo carries multicast here: the test would run in this host's network",
-            );
-        }
-        body();
-    });
-}
-
 fn on_lo(domain: u16) -> ParticipantOptions {
     ParticipantOptions::new(domain, Some("lo"))
 }
@@ -48,7 +33,7 @@ fn failures(report: &Report) -> Vec<&str> {
 
 #[test]
 fn a_simulated_go2_on_loopback_passes_every_check() {
-    in_private_network(|| {
+    robowire_dds::netns::with_private_network(|| {
         let _sim = Go2Sim::spawn(Go2SimConfig { participant: on_lo(0), ..Go2SimConfig::default() }).unwrap();
         let report = diagnose(DeviceKind::Go2, 0);
         assert!(!report.failed(), "{report}");
@@ -61,7 +46,7 @@ fn a_simulated_go2_on_loopback_passes_every_check() {
 
 #[test]
 fn the_simulator_on_domain_1_and_the_doctor_on_0() {
-    in_private_network(|| {
+    robowire_dds::netns::with_private_network(|| {
         let _sim = Go2Sim::spawn(Go2SimConfig { participant: on_lo(1), ..Go2SimConfig::default() }).unwrap();
         let report = diagnose(DeviceKind::Go2, 0);
         assert_eq!(failures(&report), ["DDS participants"], "{report}");
@@ -76,7 +61,7 @@ fn the_simulator_on_domain_1_and_the_doctor_on_0() {
 
 #[test]
 fn a_second_lowcmd_writer() {
-    in_private_network(|| {
+    robowire_dds::netns::with_private_network(|| {
         let _sim = Go2Sim::spawn(Go2SimConfig { participant: on_lo(0), ..Go2SimConfig::default() }).unwrap();
         let other = Participant::new(on_lo(0)).unwrap();
         let writer = other.writer::<LowCmd>(LowCmd::TOPIC, Qos::STREAM_WRITER).unwrap();
@@ -94,7 +79,7 @@ fn a_second_lowcmd_writer() {
 
 #[test]
 fn a_g1_whose_lowstate_crc_is_corrupted() {
-    in_private_network(|| {
+    robowire_dds::netns::with_private_network(|| {
         let sim = G1Sim::spawn(G1SimConfig { participant: on_lo(0), ..G1SimConfig::default() }).unwrap();
         sim.inject(G1Fault::BitFlips { every: 2 });
         let report = diagnose(DeviceKind::G1, 0);
