@@ -5,7 +5,9 @@ pub mod check;
 pub mod dds;
 pub mod firewall;
 pub mod host;
+pub mod kmc;
 mod probe;
+pub mod zsl1;
 
 pub use check::{Check, Report, Verdict};
-pub use probe::{DoctorError, Options, Target, diagnose, simulate};
+pub use probe::{DoctorError, Options, Simulated, Target, diagnose, prepare};

@@ -2,17 +2,16 @@
 
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Args;
 use robowire_devices::DeviceAddress;
-use robowire_doctor::{Options, Target};
+use robowire_doctor::Options;
 
 use crate::output::Output;
 
 #[derive(Debug, Args)]
 pub(crate) struct DoctorArgs {
-    /// The device (go2:IFACE, g1:IFACE, hg:IFACE, sim:go2, sim:g1); without one, whatever is on
-    /// --interface.
+    /// The device (go2:IFACE, g1:IFACE, hg:IFACE, zsl1:IP, zsl1w:IP, kmc:PATH, sim:go2|g1|zsl1|kmc);
+    /// without one, whatever speaks DDS on --interface.
     address: Option<DeviceAddress>,
     /// The network interface (overrides the address's).
     #[arg(long)]
@@ -42,11 +41,7 @@ pub(crate) fn run(args: &DoctorArgs) -> anyhow::Result<ExitCode> {
         domain: args.domain,
         timeout: super::seconds("--timeout", args.timeout)?,
     };
-    let target = Target::of(args.address.as_ref(), &options)?;
-    let _simulator = match &args.address {
-        Some(address) => robowire_doctor::simulate(address, &options).context("starting the simulator")?,
-        None => None,
-    };
+    let (target, _simulator) = robowire_doctor::prepare(args.address.as_ref(), &options)?;
     let report = robowire_doctor::diagnose(&target, &options);
     let out = Output::new(args.json);
     out.line(format!("robowire doctor {}", report.target));
