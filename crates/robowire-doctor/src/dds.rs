@@ -30,6 +30,23 @@ pub struct DdsObservation {
     pub other_domains: Vec<(u16, usize)>,
     /// What `rt/lowstate`'s reader counted since it matched a writer, and over how many seconds.
     pub lowstate: Option<(TopicStats, f64)>,
+    /// The last HG LowState's `mode_machine`.
+    pub mode_machine: Option<u8>,
+    /// The sport mode owning the motors as motion_switcher's CheckMode named it ("": none), or
+    /// why it did not answer (`None`: not asked, no motion_switcher discovered).
+    pub motors_owner: Option<Result<String, String>>,
+}
+
+/// The services whose request topic (`rt/api/NAME/request`) has a reader: those that answer.
+pub fn services(endpoints: &[DiscoveredEndpoint]) -> Vec<String> {
+    let mut names: Vec<String> = endpoints
+        .iter()
+        .filter(|e| !e.writer)
+        .filter_map(|e| e.topic.strip_prefix("rt/api/")?.strip_suffix("/request").map(str::to_owned))
+        .collect();
+    names.sort();
+    names.dedup();
+    names
 }
 
 fn vendor(p: &DiscoveredParticipant) -> String {
@@ -91,7 +108,36 @@ pub fn checks(seen: &DdsObservation) -> Vec<Check> {
     out.push(locator_check(seen));
     out.extend(lowstate_checks(seen));
     out.push(lowcmd_writers(seen));
+    if let Some(mode_machine) = seen.mode_machine {
+        out.push(mode_machine_check(mode_machine));
+    }
+    let services = services(&seen.endpoints);
+    out.push(if services.is_empty() {
+        Check::unknown("services", "no service's request reader discovered (rt/api/*/request)")
+    } else {
+        Check::pass("services", services.join(", "))
+    });
+    if let Some(owner) = &seen.motors_owner {
+        out.push(match owner {
+            Ok(mode) if mode.is_empty() => Check::pass("motors", "no sport mode owns them: rt/lowcmd drives them"),
+            Ok(mode) => Check::pass(
+                "motors",
+                format!("sport mode {mode:?} owns them: release it before sending rt/lowcmd (robowire go2|g1 release)"),
+            ),
+            Err(why) => Check::unknown("motors", format!("motion_switcher's CheckMode did not answer: {why}")),
+        });
+    }
     out
+}
+
+fn mode_machine_check(mode_machine: u8) -> Check {
+    use unitree_proto::g1::G1Variant;
+    let name = "HG mode_machine";
+    match G1Variant::of_mode_machine(mode_machine) {
+        Some(variant) => Check::pass(name, format!("{mode_machine}: a G1 {variant:?}; LowCmds must carry it")),
+        None if mode_machine == 0 => Check::pass(name, "0: a simulator's (LowCmds must carry it)"),
+        None => Check::unknown(name, format!("{mode_machine}: in no G1 table (an H1-2, or a newer revision)")),
+    }
 }
 
 fn locator_check(seen: &DdsObservation) -> Check {

@@ -26,6 +26,8 @@ fn healthy() -> DdsObservation {
         endpoints: vec![endpoint(LOWSTATE, true, 2), endpoint(LOWCMD, false, 7)],
         other_domains: Vec::new(),
         lowstate: Some((TopicStats { samples: 1000, ..TopicStats::default() }, 2.0)),
+        mode_machine: None,
+        motors_owner: None,
     }
 }
 
@@ -98,4 +100,24 @@ fn no_lowstate_writer_says_so() {
     seen.endpoints.retain(|e| e.topic != LOWSTATE);
     seen.lowstate = None;
     assert_eq!(failed(&checks(&seen))[0].saw, "no participant publishes rt/lowstate");
+}
+
+#[test]
+fn services_the_motors_owner_and_the_mode_machine_are_reported() {
+    let mut seen = healthy();
+    seen.endpoints
+        .push(DiscoveredEndpoint { topic: "rt/api/motion_switcher/request".into(), ..endpoint("", false, 9) });
+    seen.motors_owner = Some(Ok("normal".into()));
+    seen.mode_machine = Some(5);
+    let checks = checks(&seen);
+    assert!(failed(&checks).is_empty(), "{checks:#?}");
+    let saw = |name: &str| checks.iter().find(|c| c.name == name).unwrap().saw.clone();
+    assert_eq!(saw("services"), "motion_switcher");
+    assert!(saw("motors").starts_with("sport mode \"normal\" owns them"));
+    assert_eq!(saw("HG mode_machine"), "5: a G1 Dof29; LowCmds must carry it");
+    seen.motors_owner = Some(Err("timed out".into()));
+    seen.mode_machine = Some(200);
+    let checks = super::checks(&seen);
+    let verdict = |name: &str| checks.iter().find(|c| c.name == name).unwrap().verdict;
+    assert_eq!((verdict("motors"), verdict("HG mode_machine")), (Verdict::Unknown, Verdict::Unknown));
 }

@@ -41,6 +41,9 @@ fn a_simulated_go2_on_loopback_passes_every_check() {
         assert!(state.saw.contains(" samples in "), "{state}");
         assert_eq!(check(&report, "LowState CRC").verdict, Verdict::Pass);
         assert!(check(&report, "DDS participants").saw.starts_with("1 on domain 0: robowire "), "{report}");
+        assert_eq!(check(&report, "services").saw, "motion_switcher, sport");
+        // The simulated Go2 boots as the robot does, its sport mode owning the motors.
+        assert!(check(&report, "motors").saw.starts_with("sport mode \"normal\" owns them"), "{report}");
     });
 }
 
@@ -88,5 +91,6 @@ fn a_g1_whose_lowstate_crc_is_corrupted() {
         assert!(found.saw.contains("with a good CRC ("), "{found}");
         assert!(!found.saw.starts_with("100.0%"), "{found}");
         assert!(found.fix.as_deref().unwrap().contains("Unitree's CRC"), "{found}");
+        assert_eq!(check(&report, "HG mode_machine").saw, "5: a G1 Dof29; LowCmds must carry it");
     });
 }
