@@ -89,6 +89,27 @@ pub fn checks(seen: &Zsl1Observation) -> Vec<Check> {
     out
 }
 
+/// What arrived on `port` without an address to ask: who sends ZSL-1 state there (a `?` when
+/// nobody does: there may be no ZSL-1).
+pub fn overheard(heard: &Result<Vec<(SocketAddr, u64)>, String>, port: u16, seconds: f64) -> Check {
+    match heard {
+        Err(why) => Check::unknown("ZSL-1", format!("cannot listen on UDP {port}: {why}")),
+        Ok(heard) if heard.is_empty() => Check::unknown(
+            "ZSL-1",
+            format!(
+                "no ZSL-1 state on port {port} in {seconds:.1} s (a ZSL-1 sends it to the target_ip and target_port of its sdk_config.yaml)"
+            ),
+        ),
+        Ok(heard) => {
+            let listed: Vec<String> = heard.iter().map(|(from, n)| format!("{from} ({n})")).collect();
+            Check::pass(
+                "ZSL-1",
+                format!("state on port {port} from {}: robowire doctor zsl1:{}", listed.join(", "), heard[0].0.ip()),
+            )
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,6 +153,14 @@ mod tests {
         );
         let answered = Zsl1Observation { states: 0, answered: Some(12), ..seen() };
         assert!(failures(&super::checks(&answered)).is_empty());
+    }
+
+    #[test]
+    fn state_overheard_without_an_address_names_its_sender() {
+        let heard = Ok(vec![("192.168.234.1:40000".parse().unwrap(), 9)]);
+        let check = overheard(&heard, 43988, 2.0);
+        assert_eq!(check.saw, "state on port 43988 from 192.168.234.1:40000 (9): robowire doctor zsl1:192.168.234.1");
+        assert_eq!(overheard(&Ok(Vec::new()), 43988, 2.0).verdict, Verdict::Unknown);
     }
 
     #[test]

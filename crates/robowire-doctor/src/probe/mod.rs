@@ -160,7 +160,12 @@ pub fn diagnose(target: &Target, options: &Options) -> Report {
             let net = RobotNet { robot: robot.into(), prefix: 24, host: [192, 168, 123, 99].into() };
             unitree(interface, Some(net), options)
         }
-        Target::Interface(interface) => unitree(interface, None, options),
+        Target::Interface(interface) => {
+            let mut checks = unitree(interface, None, options);
+            let heard = zsl1::overhear(DEFAULT_LOCAL_PORT, options.timeout);
+            checks.push(crate::zsl1::overheard(&heard, DEFAULT_LOCAL_PORT, options.timeout.as_secs_f64()));
+            checks
+        }
         Target::Zsl1 { robot, model, interface } => zsl1_checks(*robot, *model, interface.as_deref(), options),
         Target::Kmc(path) => crate::kmc::checks(&kmc::read(path, options.timeout)),
     };
@@ -213,18 +218,15 @@ fn zsl1_checks(robot: SocketAddr, model: Model, interface: Option<&str>, options
             "the ZSL-1 speaks IPv4: name its IPv4 address",
         )];
     };
+    let net = RobotNet { robot: ip, prefix: 24, host: Ipv4Addr::from(u32::from(ip) & !0xff | 99) };
     let Some(interface) = interface.map(str::to_owned).or_else(|| interface_toward(ip)) else {
         return vec![Check::fail(
             "interface",
             format!("no interface on {ip}'s subnet and no route to it"),
-            format!(
-                "sudo ip addr add {}/24 dev IFACE (the interface cabled to the robot)",
-                Ipv4Addr::from(u32::from(ip) & !0xff | 99)
-            ),
+            format!("sudo ip addr add {}/24 dev IFACE (the interface cabled to the robot)", net.host),
         )];
     };
     let seen = observe_host(&interface);
-    let net = RobotNet { robot: ip, prefix: 24, host: Ipv4Addr::from(u32::from(ip) & !0xff | 99) };
     let expect = HostExpectations {
         interface: interface.clone(),
         net: Some(net),

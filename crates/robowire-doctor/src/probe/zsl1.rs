@@ -56,6 +56,24 @@ pub(crate) fn listen(
     seen
 }
 
+/// The HighLevel state datagrams arriving on `local_port` within `timeout`, by source (at most
+/// `MAX_SOURCES`), asking nobody; or why the port could not be bound.
+pub(crate) fn overhear(local_port: u16, timeout: Duration) -> Result<Vec<(SocketAddr, u64)>, String> {
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(|e| e.to_string())?;
+    runtime.block_on(async {
+        let local = SocketAddr::new(Ipv4Addr::UNSPECIFIED.into(), local_port);
+        let codec = HighLevelClientCodec::new(Model::Zsl1, StateDecoding::Strict);
+        let (_, mut link) = UdpLink::bind(local, Peer::Any { reply_to: None }, codec)
+            .await
+            .map_err(|e| robowire_devices::error_chain(&e))?
+            .into_split();
+        let (mut heard, mut undecodable) = (Vec::new(), 0);
+        // Nothing comes from the unspecified address: every source is counted apart.
+        window(&mut link, &mut heard, &mut undecodable, Ipv4Addr::UNSPECIFIED.into(), timeout).await;
+        Ok(heard)
+    })
+}
+
 /// Counts state datagrams from `robot` for `timeout`; the others by source, the undecodable.
 async fn window(
     link: &mut UdpReceiver<HighLevelClientCodec>,

@@ -254,3 +254,16 @@ fn a_kmc_port_that_is_missing_or_not_ours() {
     assert!(text.contains(": permission denied (group "), "{text}");
     assert!(text.contains("\n  fix: sudo usermod -aG "), "{text}");
 }
+
+#[test]
+fn an_interface_without_an_address_names_the_zsl1_it_overhears() {
+    robowire_dds::netns::with_private_network(|| {
+        let _sim = Running::start(&["sim", "zsl1", "--client", "127.0.0.1:43988", "--report-every-s", "0"]);
+        let (out, text) = doctor(&["--interface", "lo"]);
+        // Nobody speaks DDS here: that check fails.
+        assert!(!out.status.success(), "{text}");
+        assert!(text.contains("✗ DDS participants: nobody heard on domain 0"), "{text}");
+        assert!(text.contains("✓ ZSL-1: state on port 43988 from 127.0.0.1:43997 ("), "{text}");
+        assert!(text.contains("): robowire doctor zsl1:127.0.0.1\n"), "{text}");
+    });
+}
