@@ -96,7 +96,7 @@ fn route_mtu(interface: &str, ip: Ipv4Addr, prefix: u8, own: &[Ipv4Addr]) -> Opt
 
 /// An address on `ip`'s subnet that is neither its network nor broadcast address nor one of `own`.
 fn neighbour(ip: Ipv4Addr, prefix: u8, own: &[Ipv4Addr]) -> Option<Ipv4Addr> {
-    if prefix >= 31 {
+    if prefix == 0 || prefix >= 31 {
         return None;
     }
     let mask = u32::MAX << (32 - u32::from(prefix));
@@ -199,6 +199,7 @@ mod tests {
         let ip = Ipv4Addr::new(192, 168, 123, 1);
         assert_eq!(neighbour(ip, 24, &[ip]), Some(Ipv4Addr::new(192, 168, 123, 2)));
         assert_eq!(neighbour(ip, 32, &[ip]), None);
+        assert_eq!(neighbour(ip, 0, &[ip]), None);
         assert_eq!(
             neighbour(Ipv4Addr::new(10, 0, 0, 1), 30, &[Ipv4Addr::new(10, 0, 0, 1)]),
             Some([10, 0, 0, 2].into())
