@@ -32,6 +32,9 @@ pub struct DdsObservation {
     pub lowstate: Option<(TopicStats, f64)>,
     /// The last HG LowState's `mode_machine`.
     pub mode_machine: Option<u8>,
+    /// The services discovered ([`services`]), each with its API version or why it did not
+    /// answer (`None`: a service robowire does not ask).
+    pub services: Vec<(String, Option<Result<String, String>>)>,
     /// The sport mode owning the motors as motion_switcher's CheckMode named it ("": none), or
     /// why it did not answer (`None`: not asked, no motion_switcher discovered).
     pub motors_owner: Option<Result<String, String>>,
@@ -111,12 +114,7 @@ pub fn checks(seen: &DdsObservation) -> Vec<Check> {
     if let Some(mode_machine) = seen.mode_machine {
         out.push(mode_machine_check(mode_machine));
     }
-    let services = services(&seen.endpoints);
-    out.push(if services.is_empty() {
-        Check::unknown("services", "no service's request reader discovered (rt/api/*/request)")
-    } else {
-        Check::pass("services", services.join(", "))
-    });
+    out.push(services_check(&seen.services));
     if let Some(owner) = &seen.motors_owner {
         out.push(match owner {
             Ok(mode) if mode.is_empty() => Check::pass("motors", "no sport mode owns them: rt/lowcmd drives them"),
@@ -128,6 +126,34 @@ pub fn checks(seen: &DdsObservation) -> Vec<Check> {
         });
     }
     out
+}
+
+fn services_check(services: &[(String, Option<Result<String, String>>)]) -> Check {
+    if services.is_empty() {
+        return Check::unknown("services", "no service's request reader discovered (rt/api/*/request)");
+    }
+    let silent: Vec<String> = services
+        .iter()
+        .filter_map(|(name, version)| match version {
+            Some(Err(why)) => Some(format!("{name} ({why})")),
+            _ => None,
+        })
+        .collect();
+    if !silent.is_empty() {
+        return Check::fail(
+            "services",
+            format!("discovered but not answering: {}", silent.join(", ")),
+            "requests reach the robot but no answer comes back (Unitree's \"send request error\"): see the DDS locators and firewall checks",
+        );
+    }
+    let listed: Vec<String> = services
+        .iter()
+        .map(|(name, version)| match version {
+            Some(Ok(version)) => format!("{name} {version}"),
+            _ => format!("{name} (not asked)"),
+        })
+        .collect();
+    Check::pass("services", listed.join(", "))
 }
 
 fn mode_machine_check(mode_machine: u8) -> Check {

@@ -27,6 +27,7 @@ fn healthy() -> DdsObservation {
         other_domains: Vec::new(),
         lowstate: Some((TopicStats { samples: 1000, ..TopicStats::default() }, 2.0)),
         mode_machine: None,
+        services: Vec::new(),
         motors_owner: None,
     }
 }
@@ -107,12 +108,14 @@ fn services_the_motors_owner_and_the_mode_machine_are_reported() {
     let mut seen = healthy();
     seen.endpoints
         .push(DiscoveredEndpoint { topic: "rt/api/motion_switcher/request".into(), ..endpoint("", false, 9) });
+    assert_eq!(services(&seen.endpoints), ["motion_switcher"]);
+    seen.services = vec![("motion_switcher".into(), Some(Ok("1.0.0.1".into()))), ("vui".into(), None)];
     seen.motors_owner = Some(Ok("normal".into()));
     seen.mode_machine = Some(5);
     let checks = checks(&seen);
     assert!(failed(&checks).is_empty(), "{checks:#?}");
     let saw = |name: &str| checks.iter().find(|c| c.name == name).unwrap().saw.clone();
-    assert_eq!(saw("services"), "motion_switcher");
+    assert_eq!(saw("services"), "motion_switcher 1.0.0.1, vui (not asked)");
     assert!(saw("motors").starts_with("sport mode \"normal\" owns them"));
     assert_eq!(saw("HG mode_machine"), "5: a G1 Dof29; LowCmds must carry it");
     seen.motors_owner = Some(Err("timed out".into()));
@@ -120,4 +123,15 @@ fn services_the_motors_owner_and_the_mode_machine_are_reported() {
     let checks = super::checks(&seen);
     let verdict = |name: &str| checks.iter().find(|c| c.name == name).unwrap().verdict;
     assert_eq!((verdict("motors"), verdict("HG mode_machine")), (Verdict::Unknown, Verdict::Unknown));
+}
+
+#[test]
+fn a_service_that_does_not_answer_fails() {
+    let mut seen = healthy();
+    seen.services = vec![("sport".into(), Some(Err("no answer within 2 s".into())))];
+    let checks = checks(&seen);
+    let failed = failed(&checks);
+    assert_eq!(failed.len(), 1);
+    assert_eq!(failed[0].saw, "discovered but not answering: sport (no answer within 2 s)");
+    assert!(failed[0].fix.as_deref().unwrap().contains("send request error"));
 }

@@ -1,5 +1,6 @@
 //! The DDS probe: a participant on the domain and interface, listening; `rt/lowstate` counted
-//! once a writer's type is known; motion_switcher's CheckMode asked when the service is there.
+//! once a writer's type is known; the services discovered asked their API version, and
+//! motion_switcher which mode owns the motors.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU16, Ordering};
@@ -8,7 +9,7 @@ use std::time::{Duration, Instant};
 use robowire_dds::qos::Qos;
 use robowire_dds::{DdsError, Listener, Participant, ParticipantOptions, StatsHandle};
 use unitree::services::ServiceClient;
-use unitree_proto::api::{self, motion_switcher};
+use unitree_proto::api::{self, g1_arm, motion_switcher, sport};
 use unitree_proto::{HgLowState, LowState, Message};
 
 use crate::dds::{DdsObservation, LOWSTATE, services};
@@ -39,19 +40,44 @@ fn count_lowstate(participant: &Participant, type_name: &str) -> Result<LowState
     Ok(LowStateCount { stats, since: Instant::now(), mode_machine, _listener: listener })
 }
 
-/// The sport mode owning the motors as motion_switcher's CheckMode names it ("": none), or why
-/// it did not answer within `timeout`.
-fn motors_owner(participant: &Participant, timeout: Duration) -> Result<String, String> {
-    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().map_err(|e| e.to_string())?;
+/// The services robowire knows how to ask their API version.
+const KNOWN_SERVICES: [&str; 3] = [motion_switcher::SERVICE, sport::SERVICE, g1_arm::SERVICE];
+
+/// Each discovered service with its API version (`None` for one robowire does not know), and the
+/// sport mode owning the motors as motion_switcher's CheckMode names it ("": none; `None`
+/// without a motion_switcher); each an error when it did not answer within `timeout`.
+#[allow(clippy::type_complexity, reason = "the observation's own field types")]
+fn ask(
+    participant: &Participant,
+    discovered: &[String],
+    timeout: Duration,
+) -> (Vec<(String, Option<Result<String, String>>)>, Option<Result<String, String>>) {
+    let runtime = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+        Ok(runtime) => runtime,
+        Err(e) => return (discovered.iter().map(|s| (s.clone(), Some(Err(e.to_string())))).collect(), None),
+    };
     runtime.block_on(async {
-        let client = ServiceClient::new(participant, motion_switcher::SERVICE).map_err(|e| e.to_string())?;
-        let answer = client
-            .call(motion_switcher::CHECK_MODE, "{}", timeout)
-            .await
-            .map_err(|e| robowire_devices::error_chain(&e))?;
-        api::mode_name(&answer.data)
-            .map(str::to_owned)
-            .ok_or_else(|| format!("an answer without a mode: {}", answer.data))
+        let call = |service: &'static str, api_id: i64| async move {
+            let client = ServiceClient::new(participant, service).map_err(|e| e.to_string())?;
+            let answer = client.call(api_id, "{}", timeout).await.map_err(|e| robowire_devices::error_chain(&e))?;
+            Ok::<String, String>(answer.data)
+        };
+        let mut services = Vec::new();
+        for name in discovered {
+            let known = KNOWN_SERVICES.into_iter().find(|k| k == name);
+            let version = match known {
+                Some(service) => Some(call(service, api::API_VERSION_ID).await),
+                None => None,
+            };
+            services.push((name.clone(), version));
+        }
+        let owner = match discovered.iter().any(|s| s == motion_switcher::SERVICE) {
+            true => Some(call(motion_switcher::SERVICE, motion_switcher::CHECK_MODE).await.and_then(|data| {
+                api::mode_name(&data).map(str::to_owned).ok_or_else(|| format!("an answer without a mode: {data}"))
+            })),
+            false => None,
+        };
+        (services, owner)
     })
 }
 
@@ -77,9 +103,7 @@ pub(crate) fn listen(domain: u16, interface: &str, timeout: Duration) -> Result<
     let lowstate = lowstate.map(|l| (l.stats.get(), l.since.elapsed().as_secs_f64()));
     let participants = participant.discovered_participants();
     let endpoints = participant.discovered_endpoints();
-    let motors_owner = services(&endpoints)
-        .contains(&motion_switcher::SERVICE.to_owned())
-        .then(|| motors_owner(&participant, timeout));
+    let (services, motors_owner) = ask(&participant, &services(&endpoints), timeout);
     let mut other_domains = Vec::new();
     if participants.is_empty() {
         let others: Vec<(u16, Participant)> = (0..10u16)
@@ -98,6 +122,7 @@ pub(crate) fn listen(domain: u16, interface: &str, timeout: Duration) -> Result<
         other_domains,
         lowstate,
         mode_machine,
+        services,
         motors_owner,
     })
 }

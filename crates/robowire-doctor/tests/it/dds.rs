@@ -41,7 +41,7 @@ fn a_simulated_go2_on_loopback_passes_every_check() {
         assert!(state.saw.contains(" samples in "), "{state}");
         assert_eq!(check(&report, "LowState CRC").verdict, Verdict::Pass);
         assert!(check(&report, "DDS participants").saw.starts_with("1 on domain 0: robowire "), "{report}");
-        assert_eq!(check(&report, "services").saw, "motion_switcher, sport");
+        assert_eq!(check(&report, "services").saw, "motion_switcher 1.0.0.1, sport 1.0.0.1");
         // The simulated Go2 boots as the robot does, its sport mode owning the motors.
         assert!(check(&report, "motors").saw.starts_with("sport mode \"normal\" owns them"), "{report}");
     });
