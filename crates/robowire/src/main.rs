@@ -54,7 +54,7 @@ enum Command {
     Replay(cmd::record::ReplayArgs),
     /// Draw a capture: one page per device, commanded against observed, faults and silences marked.
     Plot(cmd::plot::PlotArgs),
-    /// Why a robot does not answer: the host, the interface and DDS checked, with the fix for each failure.
+    /// Why a robot does not answer: the interface, DDS, the ZSL-1's port or the KMC's line checked, with the fix for each failure.
     Doctor(cmd::doctor::DoctorArgs),
     /// Encode a message from JSON and print its bytes in hex.
     #[command(subcommand)]

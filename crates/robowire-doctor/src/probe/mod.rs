@@ -67,7 +67,7 @@ pub enum DoctorError {
     )]
     Nothing,
     /// An address whose kind is not diagnosed.
-    #[error("robowire doctor does not diagnose {0:?} (the spline daemon is on this host's shared memory)")]
+    #[error("robowire doctor does not diagnose {0} (the spline daemon is on this host's shared memory)")]
     Unsupported(DeviceAddress),
     /// The simulator of a `sim:` address did not start.
     #[error("the simulator did not start")]

@@ -11,7 +11,7 @@ use crate::output::Output;
 #[derive(Debug, Args)]
 pub(crate) struct DoctorArgs {
     /// The device (go2:IFACE, g1:IFACE, hg:IFACE, zsl1:IP, zsl1w:IP, kmc:PATH, sim:go2|g1|zsl1|kmc);
-    /// without one, whatever speaks DDS on --interface.
+    /// without one, whatever speaks DDS on --interface, and the ZSL-1 whose state arrives.
     address: Option<DeviceAddress>,
     /// The network interface (overrides the address's).
     #[arg(long)]
