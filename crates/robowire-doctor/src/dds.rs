@@ -19,8 +19,10 @@ pub struct DdsObservation {
     pub domain: u16,
     /// How long it listened, seconds.
     pub seconds: f64,
-    /// The interface's IPv4 addresses and prefixes, and whether it is loopback.
-    pub interface: (Vec<(Ipv4Addr, u8)>, bool),
+    /// The interface's IPv4 addresses and prefixes.
+    pub interface_ipv4: Vec<(Ipv4Addr, u8)>,
+    /// Whether the interface is loopback.
+    pub loopback: bool,
     /// The participants heard on `domain`.
     pub participants: Vec<DiscoveredParticipant>,
     /// Their endpoints (SEDP).
@@ -70,10 +72,10 @@ fn locators(p: &DiscoveredParticipant) -> String {
 }
 
 /// Whether the interface reaches `address`: on one of its subnets, or loopback from loopback.
-fn reachable(interface: &(Vec<(Ipv4Addr, u8)>, bool), address: &SocketAddr) -> bool {
+fn reachable(seen: &DdsObservation, address: &SocketAddr) -> bool {
     match address.ip() {
-        IpAddr::V4(ip) if ip.is_loopback() => interface.1,
-        IpAddr::V4(ip) => interface.0.iter().any(|&(own, prefix)| on_subnet(ip, own, prefix)),
+        IpAddr::V4(ip) if ip.is_loopback() => seen.loopback,
+        IpAddr::V4(ip) => seen.interface_ipv4.iter().any(|&(own, prefix)| on_subnet(ip, own, prefix)),
         IpAddr::V6(_) => false,
     }
 }
@@ -170,13 +172,13 @@ fn locator_check(seen: &DdsObservation) -> Check {
     let unreachable: Vec<String> = seen
         .participants
         .iter()
-        .filter(|p| !p.unicast.iter().any(|a| reachable(&seen.interface, a)))
+        .filter(|p| !p.unicast.iter().any(|a| reachable(seen, a)))
         .map(|p| format!("{} {} announces {}", vendor(p), hex(&p.guid_prefix), locators(p)))
         .collect();
     if unreachable.is_empty() {
         return Check::pass("DDS locators", "every participant announces a unicast locator on this interface's subnet");
     }
-    let own: Vec<String> = seen.interface.0.iter().map(|(ip, p)| format!("{ip}/{p}")).collect();
+    let own: Vec<String> = seen.interface_ipv4.iter().map(|(ip, p)| format!("{ip}/{p}")).collect();
     Check::fail(
         "DDS locators",
         format!(

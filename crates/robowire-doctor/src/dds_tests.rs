@@ -21,7 +21,8 @@ fn healthy() -> DdsObservation {
     DdsObservation {
         domain: 0,
         seconds: 2.0,
-        interface: (vec![([192, 168, 123, 99].into(), 24)], false),
+        interface_ipv4: vec![([192, 168, 123, 99].into(), 24)],
+        loopback: false,
         participants: vec![robot()],
         endpoints: vec![endpoint(LOWSTATE, true, 2), endpoint(LOWCMD, false, 7)],
         other_domains: Vec::new(),
@@ -78,7 +79,7 @@ fn loopback_locators_are_reachable_from_loopback_only() {
     let mut seen = healthy();
     seen.participants[0].unicast = vec!["127.0.0.1:7410".parse().unwrap()];
     assert_eq!(failed(&checks(&seen))[0].name, "DDS locators");
-    seen.interface = (vec![([127, 0, 0, 1].into(), 8)], true);
+    (seen.interface_ipv4, seen.loopback) = (vec![([127, 0, 0, 1].into(), 8)], true);
     assert!(failed(&checks(&seen)).is_empty());
 }
 

@@ -116,7 +116,8 @@ pub(crate) fn listen(domain: u16, interface: &str, timeout: Duration) -> Result<
     Ok(DdsObservation {
         domain,
         seconds,
-        interface: (Vec::new(), false),
+        interface_ipv4: Vec::new(),
+        loopback: false,
         participants,
         endpoints,
         other_domains,

@@ -180,7 +180,7 @@ fn unitree(interface: &str, net: Option<RobotNet>, options: &Options) -> Vec<Che
     let Some(found) = found(&seen, interface) else { return checks };
     match dds::listen(options.domain, interface, options.timeout) {
         Ok(mut heard) => {
-            heard.interface = (found.ipv4.clone(), found.loopback);
+            (heard.interface_ipv4, heard.loopback) = (found.ipv4.clone(), found.loopback);
             checks.extend(crate::dds::checks(&heard));
         }
         Err(e) => checks.push(Check::unknown(
