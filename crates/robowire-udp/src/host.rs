@@ -158,7 +158,7 @@ pub enum FirewallError {
     /// `nft` could not be run.
     #[error("cannot run nft (nftables' command): {0}")]
     NoNft(#[source] io::Error),
-    /// `nft` refused (without the rights to read the ruleset, usually).
+    /// `nft` refused (without the rights to read the ruleset, usually): the first line it said.
     #[error("nft list ruleset: {0}")]
     Refused(String),
 }
@@ -168,7 +168,8 @@ pub enum FirewallError {
 pub fn nft_ruleset() -> Result<String, FirewallError> {
     let out = Command::new("nft").args(["list", "ruleset"]).output().map_err(FirewallError::NoNft)?;
     if !out.status.success() {
-        return Err(FirewallError::Refused(String::from_utf8_lossy(&out.stderr).trim().to_owned()));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        return Err(FirewallError::Refused(stderr.lines().next().unwrap_or_default().trim().to_owned()));
     }
     Ok(String::from_utf8_lossy(&out.stdout).into_owned())
 }
