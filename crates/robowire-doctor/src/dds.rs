@@ -12,7 +12,7 @@ pub const LOWSTATE: &str = "rt/lowstate";
 /// The robot's command topic.
 pub const LOWCMD: &str = "rt/lowcmd";
 
-/// What was heard on DDS during the listening time (`probe::dds` listens).
+/// What was heard on DDS during the listening time (`diagnose` listens with a participant).
 #[derive(Debug, Clone, Default)]
 pub struct DdsObservation {
     /// The domain listened on.

@@ -8,7 +8,7 @@ use robowire_udp::host::{InterfaceInfo, InterfaceRoute};
 use crate::check::Check;
 use crate::firewall;
 
-/// What was read of the host (`probe::host` reads it).
+/// What was read of the host (`diagnose` reads it through `robowire_udp::host`).
 #[derive(Debug, Clone)]
 pub struct HostObservation {
     /// Its interfaces, or why they could not be listed.
@@ -45,7 +45,7 @@ pub struct HostExpectations {
     pub ports: Vec<RangeInclusive<u16>>,
 }
 
-/// Whether `ip` is on `network`/`prefix`.
+/// Whether `ip` is on `subnet`/`prefix`.
 pub fn on_subnet(ip: Ipv4Addr, subnet: Ipv4Addr, prefix: u8) -> bool {
     network(ip, prefix) == network(subnet, prefix)
 }

@@ -26,7 +26,7 @@ pub enum OpenFailure {
     Other(String),
 }
 
-/// What the port showed (`probe::kmc` reads it).
+/// What the port showed (`diagnose` reads it with a serial link).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KmcObservation {
     /// The port.

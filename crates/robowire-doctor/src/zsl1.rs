@@ -4,7 +4,7 @@ use std::net::{IpAddr, SocketAddr};
 
 use crate::check::Check;
 
-/// What arrived on the local port (`probe::zsl1` listens).
+/// What arrived on the local port (`diagnose` listens with a UDP link).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Zsl1Observation {
     /// The robot's HighLevel address.
