@@ -267,3 +267,22 @@ fn an_interface_without_an_address_names_the_zsl1_it_overhears() {
         assert!(text.contains("): robowire doctor zsl1:127.0.0.1\n"), "{text}");
     });
 }
+
+#[test]
+fn a_second_lowcmd_writer_is_named() {
+    robowire_dds::netns::with_private_network(|| {
+        let _sim = Running::start(&["sim", "go2", "--interface", "lo", "--report-every-s", "0"]);
+        // A client of the robot publishes rt/lowcmd from its start: `watch` prints once it has
+        // a state.
+        let _client = Running::start(&["go2", "--interface", "lo", "watch"]);
+        let (out, text) = doctor(&["go2:lo"]);
+        assert!(!out.status.success(), "{text}");
+        assert!(text.contains("✗ rt/lowcmd writers: already published by 1: "), "{text}");
+        assert!(
+            text.contains(
+                " (robowire)\n  fix: stop that controller before starting yours: two writers of rt/lowcmd fight over the motors\n"
+            ),
+            "{text}"
+        );
+    });
+}
