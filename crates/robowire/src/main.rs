@@ -54,6 +54,8 @@ enum Command {
     Replay(cmd::record::ReplayArgs),
     /// Draw a capture: one page per device, commanded against observed, faults and silences marked.
     Plot(cmd::plot::PlotArgs),
+    /// Why a robot does not answer: the interface, DDS, the ZSL-1's port or the KMC's line checked, with the fix for each failure.
+    Doctor(cmd::doctor::DoctorArgs),
     /// Encode a message from JSON and print its bytes in hex.
     #[command(subcommand)]
     Encode(cmd::encode::EncodeCommand),
@@ -71,6 +73,7 @@ fn main() -> ExitCode {
         Command::Demo(args) if args.runs_go2() => Some(robowire_dds::netns::for_this_process()),
         Command::Status(args) if args.device.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Watch(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
+        Command::Doctor(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Policy(cmd::policy::PolicyCommand::Run(args)) if args.simulates_dds() => {
             Some(robowire_dds::netns::for_this_process())
         }
@@ -93,6 +96,7 @@ fn main() -> ExitCode {
         Command::Replay(args) => cmd::record::replay(&args),
         Command::Plot(args) => cmd::plot::run(&args),
         Command::Encode(command) => cmd::encode::run(&command),
+        Command::Doctor(args) => cmd::device::on_loopback(loopback, || cmd::doctor::run(&args)),
     };
     match result {
         Ok(code) => code,

@@ -6,6 +6,7 @@ pub(crate) mod dds_args;
 pub(crate) mod decode;
 pub(crate) mod demo;
 pub(crate) mod device;
+pub(crate) mod doctor;
 pub(crate) mod encode;
 pub(crate) mod g1;
 pub(crate) mod go2;

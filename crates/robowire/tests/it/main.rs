@@ -13,6 +13,7 @@ mod bad_input;
 mod cli;
 mod decode_rtps;
 mod devices;
+mod doctor;
 mod g1;
 mod g1_cli;
 mod go2;
