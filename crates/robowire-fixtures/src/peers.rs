@@ -223,3 +223,31 @@ pub fn unitree_g1_examples() -> Result<PathBuf, String> {
     unitree_python()?;
     Ok(env_dir().join("unitree_sdk2_python/example/g1"))
 }
+
+/// The npm packages of the project in `project` (its `package.json` and `package-lock.json`),
+/// installed by `npm ci` from the lock file under `target/interop/npm/{name}` (once per lock
+/// file, under a file lock): their `node_modules`, for `NODE_PATH`. An error says what is missing
+/// (node, npm, the npm registry).
+pub fn npm_project(name: &str, project: &Path) -> Result<PathBuf, String> {
+    run("node", Command::new("node").arg("--version"))?;
+    run("npm", Command::new("npm").arg("--version"))?;
+    let dir = env_dir().join("npm").join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let lock = std::fs::File::create(dir.join(".lock")).map_err(|e| e.to_string())?;
+    lock.lock().map_err(|e| format!("locking {}: {e}", dir.display()))?;
+    let read = |p: PathBuf| std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()));
+    let manifest = [read(project.join("package.json"))?, read(project.join("package-lock.json"))?];
+    let stamp = dir.join(".robowire-ready");
+    if std::fs::read(&stamp).ok() == Some(manifest.concat()) {
+        return Ok(dir.join("node_modules"));
+    }
+    let _ = std::fs::remove_file(&stamp);
+    std::fs::write(dir.join("package.json"), &manifest[0]).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("package-lock.json"), &manifest[1]).map_err(|e| e.to_string())?;
+    run(
+        &format!("npm ci in {} (packages from the npm registry)", project.display()),
+        Command::new("npm").args(["ci", "--no-audit", "--no-fund", "--ignore-scripts"]).current_dir(&dir),
+    )?;
+    std::fs::write(&stamp, manifest.concat()).map_err(|e| e.to_string())?;
+    Ok(dir.join("node_modules"))
+}

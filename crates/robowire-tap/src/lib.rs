@@ -126,7 +126,7 @@ impl TapRing {
 
     /// A tap for link number `link`.
     pub fn tap(&self, link: u16) -> Tap {
-        Tap { link, ring: self.ring.clone() }
+        Tap { link, ring: self.ring.clone(), also: None }
     }
 
     /// Hands the oldest frame in the ring to `read`, then frees its slot; `None` if the ring
@@ -203,6 +203,8 @@ impl Drop for HeldFrame {
 pub struct Tap {
     link: u16,
     ring: Arc<Ring>,
+    /// A tap of another ring that gets every frame too ([`and`](Self::and)).
+    also: Option<Box<Tap>>,
 }
 
 impl std::fmt::Debug for Tap {
@@ -214,7 +216,7 @@ impl std::fmt::Debug for Tap {
 /// Two taps are equal when they feed the same ring as the same link.
 impl PartialEq for Tap {
     fn eq(&self, other: &Self) -> bool {
-        self.link == other.link && Arc::ptr_eq(&self.ring, &other.ring)
+        self.link == other.link && Arc::ptr_eq(&self.ring, &other.ring) && self.also == other.also
     }
 }
 
@@ -233,15 +235,35 @@ impl Tap {
         self.record_parts(direction, &[bytes], SampleOrigin::NONE);
     }
 
+    /// This tap and `other` as one: every frame goes into both rings (a capture's and a live
+    /// view's), each counting its own.
+    pub fn and(self, other: Tap) -> Tap {
+        let also = match self.also {
+            Some(also) => also.and(other),
+            None => other,
+        };
+        Tap { also: Some(Box::new(also)), ..self }
+    }
+
     /// Counts a frame that was too long to record ([`TapCounters::oversize`]), for a caller that
     /// found so before copying it.
     pub fn count_oversize(&self) {
         self.ring.counters.oversize.fetch_add(1, Ordering::Relaxed);
+        if let Some(also) = &self.also {
+            also.count_oversize();
+        }
     }
 
     /// As [`record`](Self::record), for a frame in `parts` (a DDS payload's encapsulation header
     /// and body, say) that the middleware says `origin` of.
     pub fn record_parts(&self, direction: Direction, parts: &[&[u8]], origin: SampleOrigin) {
+        self.record_into_ring(direction, parts, origin);
+        if let Some(also) = &self.also {
+            also.record_parts(direction, parts, origin);
+        }
+    }
+
+    fn record_into_ring(&self, direction: Direction, parts: &[&[u8]], origin: SampleOrigin) {
         let counters = &self.ring.counters;
         let total = parts.iter().map(|p| p.len()).fold(0usize, usize::saturating_add);
         let Some(len) = u16::try_from(total).ok().filter(|_| total <= SLOT_BYTES) else {
@@ -318,6 +340,22 @@ mod tests {
         assert_eq!(ring.pop(bytes), Some(vec![9; SLOT_BYTES]));
         assert_eq!(ring.pop(bytes), Some(vec![7; 3]));
         assert_eq!(ring.counters().recorded(), 4);
+    }
+
+    #[test]
+    fn a_tap_and_another_fill_both_rings_each_counting_its_own() {
+        let (capture, live) = (TapRing::with_slots(4), TapRing::with_slots(1));
+        let tap = capture.tap(3).and(live.tap(0));
+        tap.record(Direction::Sent, &[1]);
+        tap.record(Direction::Received, &[2]);
+        tap.record(Direction::Sent, &[0; SLOT_BYTES + 1]);
+        let read = |f: &TappedFrame| (f.link, f.direction, f.bytes().to_vec());
+        assert_eq!(capture.pop(read), Some((3, Direction::Sent, vec![1])));
+        assert_eq!(capture.pop(read), Some((3, Direction::Received, vec![2])));
+        assert_eq!(live.pop(read), Some((0, Direction::Sent, vec![1])));
+        assert!(live.pop(read).is_none());
+        let counts = |r: &TapRing| (r.counters().recorded(), r.counters().dropped(), r.counters().oversize());
+        assert_eq!((counts(&capture), counts(&live)), ((2, 0, 1), (1, 1, 1)));
     }
 
     #[test]

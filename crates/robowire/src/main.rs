@@ -25,6 +25,8 @@ enum Command {
     Status(cmd::device::StatusArgs),
     /// Print the state of any device live, by address, until Ctrl-C.
     Watch(cmd::device::DeviceArgs),
+    /// Stream devices, by address, to Foxglove (ws://ADDR/) and the built-in page (http://ADDR/), until Ctrl-C.
+    Serve(cmd::serve::ServeArgs),
     /// Run a device simulator alone, for your own client to talk to.
     #[command(subcommand)]
     Sim(cmd::sim::SimCommand),
@@ -73,6 +75,7 @@ fn main() -> ExitCode {
         Command::Demo(args) if args.runs_go2() => Some(robowire_dds::netns::for_this_process()),
         Command::Status(args) if args.device.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Watch(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
+        Command::Serve(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Doctor(args) if args.simulates_dds() => Some(robowire_dds::netns::for_this_process()),
         Command::Policy(cmd::policy::PolicyCommand::Run(args)) if args.simulates_dds() => {
             Some(robowire_dds::netns::for_this_process())
@@ -83,6 +86,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => cmd::demo::run(&args, loopback),
         Command::Status(args) => cmd::device::on_loopback(loopback, || cmd::device::status(&args)),
         Command::Watch(args) => cmd::device::on_loopback(loopback, || cmd::device::watch(&args)),
+        Command::Serve(args) => cmd::device::on_loopback(loopback, || cmd::serve::serve(&args)),
         Command::Sim(command) => cmd::sim::run(command),
         Command::Kmc(args) => cmd::kmc::run(args),
         Command::Zsl1(args) => cmd::zsl1::run(args),

@@ -12,12 +12,19 @@ pub(crate) struct Output {
     json: bool,
     /// A live line is on screen and must be cleared before the next report line.
     live_line_shown: AtomicBool,
+    /// Where report lines also go as events (`--live`).
+    events: std::sync::OnceLock<(robowire_live::LiveEvents, &'static str)>,
 }
 
 impl Output {
     /// Human output on stdout; with `json`, on stderr (stdout is for the JSON).
     pub(crate) fn new(json: bool) -> Self {
-        Self { json, live_line_shown: AtomicBool::new(false) }
+        Self { json, live_line_shown: AtomicBool::new(false), events: std::sync::OnceLock::new() }
+    }
+
+    /// Report lines also go to a live view's log, from `name` (`demo`).
+    pub(crate) fn also_to(&self, events: robowire_live::LiveEvents, name: &'static str) {
+        let _ = self.events.set((events, name));
     }
 
     /// Whether the report goes to a terminal (a live line can be redrawn in place).
@@ -28,6 +35,12 @@ impl Output {
     /// One report line.
     pub(crate) fn line(&self, text: impl Display) {
         self.clear_live();
+        if let Some((events, name)) = self.events.get() {
+            let text = text.to_string();
+            if !text.trim().is_empty() {
+                events.log(robowire_live::Level::Info, name, text.trim());
+            }
+        }
         if self.json {
             eprintln!("{text}");
         } else {

@@ -33,30 +33,10 @@ fn run(what: &str, command: &mut Command) -> Result<String, String> {
     Ok(String::from_utf8_lossy(&out.stdout).trim().to_owned())
 }
 
-/// Foxglove's packages installed (once per target directory, under a lock: the tests run in
-/// parallel) by `npm ci` from the committed lock file; their `node_modules`.
+/// Foxglove's packages, installed once per target directory by `npm ci` from the committed lock
+/// file; their `node_modules`.
 fn foxglove() -> Result<PathBuf, String> {
-    run("node", Command::new("node").arg("--version"))?;
-    run("npm", Command::new("npm").arg("--version"))?;
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("omgidl");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let lock = std::fs::File::create(dir.join(".lock")).map_err(|e| e.to_string())?;
-    lock.lock().map_err(|e| format!("locking {}: {e}", dir.display()))?;
-    let read = |p: PathBuf| std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()));
-    let manifest = [read(project().join("package.json"))?, read(project().join("package-lock.json"))?];
-    let stamp = dir.join(".robowire-ready");
-    if std::fs::read(&stamp).ok() == Some(manifest.concat()) {
-        return Ok(dir.join("node_modules"));
-    }
-    let _ = std::fs::remove_file(&stamp);
-    std::fs::write(dir.join("package.json"), &manifest[0]).map_err(|e| e.to_string())?;
-    std::fs::write(dir.join("package-lock.json"), &manifest[1]).map_err(|e| e.to_string())?;
-    run(
-        "npm ci (Foxglove's packages from the npm registry)",
-        Command::new("npm").args(["ci", "--no-audit", "--no-fund", "--ignore-scripts"]).current_dir(&dir),
-    )?;
-    std::fs::write(&stamp, manifest.concat()).map_err(|e| e.to_string())?;
-    Ok(dir.join("node_modules"))
+    robowire_fixtures::peers::npm_project("omgidl", &project())
 }
 
 /// Foxglove's decoding of each `(schema, payload)`: `{"value", "decoded_bytes", "length"}` or

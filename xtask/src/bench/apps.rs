@@ -46,6 +46,7 @@ pub(crate) fn record_rows(recorded: &Value, meta: &Value) -> anyhow::Result<Vec<
             &recorded["spline_stream"],
             "spline daemon simulator (1 kHz) send lateness, its shared memory recorded",
         )?,
+        live_row(&recorded["live_stream"])?,
         throughput_row(&meta["unpaced_raw"], "Recorder capacity: 560-byte frames as fast as one thread taps, raw")?,
         throughput_row(
             &meta["unpaced_json"],
@@ -99,6 +100,24 @@ fn paced_row(run: &Value, path: &str) -> anyhow::Result<Row> {
         ratio: "–".into(),
         target: "none dropped".into(),
         met: Some(dropped == 0.0),
+    })
+}
+
+/// The ZSL-1 stream streamed live to a viewer that reads nothing, beside the live view alone.
+fn live_row(run: &Value) -> anyhow::Result<Row> {
+    let n = |key: &str| run[key].as_f64().with_context(|| format!("live meta {key}"));
+    let (p99, b99) = (n("stalled_p99_us")?, n("plain_p99_us")?);
+    Ok(Row {
+        path: "ZSL-1 HighLevel stream send lateness, its link live at 1 kHz to a viewer that reads nothing".into(),
+        figure: format!(
+            "p50 {:.0} µs, p99 {p99:.0} µs ({:.0} messages dropped for the viewer)",
+            n("stalled_p50_us")?,
+            n("viewer_dropped")?
+        ),
+        baseline: format!("live, no viewer: p50 {:.0} µs, p99 {b99:.0} µs", n("plain_p50_us")?),
+        ratio: format!("p99 {:+.0} µs", p99 - b99),
+        target: "–".into(),
+        met: None,
     })
 }
 
@@ -294,6 +313,7 @@ mod tests {
         let recorded = json!({
             "lateness_plain_p50_us": 0, "lateness_plain_p99_us": 40, "lateness_recorded_p50_us": 0,
             "lateness_recorded_p99_us": 45, "stream_frames_dropped": 0, "kmc_stream": stream, "spline_stream": stream,
+            "live_stream": {"plain_p50_us": 1, "plain_p99_us": 50, "stalled_p50_us": 1, "stalled_p99_us": 52, "viewer_dropped": 7},
         });
         let run = json!({
             "offered": 100, "offered_per_s": 1e6, "written": 100, "written_per_s": 1e6, "mb_per_s": 560,
@@ -304,10 +324,12 @@ mod tests {
             "links_100_at_1khz": run, "links_100_at_1khz_zstd": run,
         });
         let rows = record_rows(&recorded, &record).unwrap();
-        assert_eq!(rows.len(), 9);
+        assert_eq!(rows.len(), 10);
         assert_eq!(rows[0].ratio, "p99 +5 µs");
         assert_eq!(rows[1].ratio, "p99 +10 µs");
-        assert_eq!(rows[8].met, Some(true));
+        assert_eq!(rows[3].ratio, "p99 +2 µs");
+        assert!(rows[3].figure.contains("7 messages dropped for the viewer"), "{}", rows[3].figure);
+        assert_eq!(rows[9].met, Some(true));
         assert!(record_rows(&record, &recorded).is_err(), "the two benches' figures apart");
     }
 }

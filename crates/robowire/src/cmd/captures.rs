@@ -17,6 +17,17 @@ pub(crate) fn descriptions() -> Vec<&'static dyn LinkDescription> {
     .concat()
 }
 
+/// What each codec plots of its links (`robowire plot`, the live page).
+pub(crate) fn link_plots() -> Vec<&'static robowire_core::json::LinkPlots> {
+    let lists: [&'static [robowire_core::json::LinkPlots]; 4] = [
+        &kmc_proto::description::PLOTS,
+        &zsl_proto::description::PLOTS,
+        &unitree_proto::description::PLOTS,
+        &robowire_policy::record::PLOTS,
+    ];
+    lists.into_iter().flatten().collect()
+}
+
 /// Devices whose links were recorded under another name: the ZSL-1's were `dog/…` before they
 /// were `zsl1/…`. Such a capture still reads (kept for one release, as the `dog` command alias):
 /// its links belong to the device's current name, and a link asked for under either name is

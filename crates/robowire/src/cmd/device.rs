@@ -84,15 +84,44 @@ impl ReachArgs {
         command: &str,
         run: impl FnOnce(AnyDevice, Option<RecordLinks>) -> F,
     ) -> anyhow::Result<ExitCode> {
-        let recorder = self.record.start(&format!("{command} {address}"))?;
-        let links = || recorder.as_ref().map(robowire_record::Recorder::links);
+        let taps = self.record.start(&format!("{command} {address}"))?;
+        let links = || taps.links();
         let ran = runtime()?.block_on(async {
             let device = run(self.open(address, links()).await?, links()).await?;
             eprintln!("{}", device.stats_line());
             device.close().context("closing the device")
         });
         // The device is closed (or never opened): the capture holds all it saw.
-        crate::cmd::record::finish(recorder)?;
+        taps.finish()?;
+        ran.map(|()| ExitCode::SUCCESS)
+    }
+
+    /// Every device at `addresses` opened and waited for, its links streamed live (`--live`,
+    /// 127.0.0.1:8765 unless given) and recorded with `--record`; handed to `run`, then each
+    /// device's statistics printed and all closed.
+    pub(crate) fn serving<F: Future<Output = anyhow::Result<Vec<AnyDevice>>>>(
+        &self,
+        addresses: &[DeviceAddress],
+        run: impl FnOnce(Vec<AnyDevice>) -> F,
+    ) -> anyhow::Result<ExitCode> {
+        let mut record = self.record.clone();
+        if record.live.live.is_none() {
+            record.live.live = Some(crate::cmd::taps::DEFAULT_LIVE.parse()?);
+        }
+        let taps = record.start("robowire serve")?;
+        let ran = runtime()?.block_on(async {
+            let mut devices = Vec::new();
+            for address in addresses {
+                devices.push(self.open(address, taps.links()).await?);
+            }
+            eprintln!("serving {} device(s); Ctrl-C stops", devices.len());
+            for device in run(devices).await? {
+                eprintln!("{}", device.stats_line());
+                device.close().context("closing the device")?;
+            }
+            Ok::<(), anyhow::Error>(())
+        });
+        taps.finish()?;
         ran.map(|()| ExitCode::SUCCESS)
     }
 
@@ -165,7 +194,7 @@ pub(crate) fn status(args: &StatusArgs) -> anyhow::Result<ExitCode> {
 /// Ctrl-C.
 pub(crate) fn watch(args: &DeviceArgs) -> anyhow::Result<ExitCode> {
     args.recording("robowire watch", |device| async move {
-        crate::cmd::live::watch_until_ctrl_c(device.connection_events(), || device.status_line()).await?;
+        crate::cmd::watch_loop::watch_until_ctrl_c(device.connection_events(), || device.status_line()).await?;
         Ok(device)
     })
 }

@@ -65,7 +65,7 @@ pub(crate) fn run(args: G1Args) -> anyhow::Result<ExitCode> {
                 ExitCode::SUCCESS
             }
             G1Command::Watch => {
-                crate::cmd::live::watch_until_ctrl_c(robot.connection_events(), || robot.status_line()).await?;
+                crate::cmd::watch_loop::watch_until_ctrl_c(robot.connection_events(), || robot.status_line()).await?;
                 ExitCode::SUCCESS
             }
             G1Command::Release => {

@@ -124,5 +124,5 @@ fn pose(q: &[f32; 12]) -> String {
 }
 
 async fn watch(robot: &LowLevel<Go2>) -> anyhow::Result<()> {
-    crate::cmd::live::watch_until_ctrl_c(robot.connection_events(), || robot.status_line()).await
+    crate::cmd::watch_loop::watch_until_ctrl_c(robot.connection_events(), || robot.status_line()).await
 }

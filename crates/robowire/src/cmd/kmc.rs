@@ -71,11 +71,8 @@ pub(crate) fn run(args: KmcArgs) -> anyhow::Result<ExitCode> {
         rts_cts_flow_control: !args.no_flow_control,
         ..SerialPortOptions::default()
     };
-    let recorder = args.record.start("robowire kmc")?;
-    let taps = recorder
-        .as_ref()
-        .map(|r| robowire_devices::kmc_taps(&r.links(), &kmc_proto::description::HOST))
-        .unwrap_or_default();
+    let sinks = args.record.start("robowire kmc")?;
+    let taps = sinks.links().map(|l| robowire_devices::kmc_taps(&l, &kmc_proto::description::HOST)).unwrap_or_default();
     let port = &args.port;
     let result = match args.command {
         KmcCommand::Drive(drive) => run_drive(port, DriverOptions { serial, taps, ..Default::default() }, &drive),
@@ -88,7 +85,7 @@ pub(crate) fn run(args: KmcArgs) -> anyhow::Result<ExitCode> {
         KmcCommand::AllState(one) => one_shot(port, &serial, taps, &one, "all-state", |c, m| c.request_all_state(m)),
     };
     // The link is closed by now: the capture holds all it saw, the stop burst too.
-    crate::cmd::record::finish(recorder)?;
+    sinks.finish()?;
     result
 }
 

@@ -11,16 +11,18 @@ pub(crate) mod encode;
 pub(crate) mod g1;
 pub(crate) mod go2;
 pub(crate) mod kmc;
-pub(crate) mod live;
 pub(crate) mod plot;
 pub(crate) mod policy;
 pub(crate) mod record;
 pub(crate) mod replay_device;
 pub(crate) mod ros2;
+pub(crate) mod serve;
 pub(crate) mod shm;
 pub(crate) mod sim;
 pub(crate) mod sim_body;
+pub(crate) mod taps;
 pub(crate) mod unitree;
+pub(crate) mod watch_loop;
 pub(crate) mod zsl1;
 
 /// A duration argument in seconds, 0–3600.

@@ -32,17 +32,6 @@ pub(crate) struct PlotArgs {
     to_s: Option<f64>,
 }
 
-/// What each codec plots of its links.
-fn link_plots() -> Vec<&'static LinkPlots> {
-    let lists: [&'static [LinkPlots]; 4] = [
-        &kmc_proto::description::PLOTS,
-        &zsl_proto::description::PLOTS,
-        &unitree_proto::description::PLOTS,
-        &robowire_policy::record::PLOTS,
-    ];
-    lists.into_iter().flatten().collect()
-}
-
 /// Which frames to draw: one device, a time window (s from the capture's first frame).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Selection {
@@ -103,7 +92,7 @@ pub(crate) fn pages(frames: &[RecordedFrame], capture: &str, selection: &Selecti
     let Some(start_ns) = frames.iter().map(|f| f.unix_ns).min() else { return Vec::new() };
     let seconds = |f: &RecordedFrame| f.unix_ns.saturating_sub(start_ns) as f64 / 1e9;
     let inside = |t: f64| selection.from_s.is_none_or(|from| t >= from) && selection.to_s.is_none_or(|to| t <= to);
-    let plots = link_plots();
+    let plots = crate::cmd::captures::link_plots();
     let mut pages = Vec::new();
     for (device, frames) in devices(frames) {
         if selection.device.as_deref().is_some_and(|d| crate::cmd::captures::current_device(d) != device) {

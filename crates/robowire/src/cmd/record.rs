@@ -9,8 +9,9 @@ use clap::Args;
 use robowire_record::{Compression, Recorder, RecorderOptions};
 
 use crate::cmd::captures::descriptions;
+use crate::cmd::taps::Taps;
 
-/// `--record FILE.mcap`, for the commands that record.
+/// `--record FILE.mcap` and `--live [ADDR]`, for the commands that open a device.
 #[derive(Debug, Clone, Args)]
 pub(crate) struct RecordArgs {
     /// Record every frame of the device's links, both ways, to this MCAP file (Foxglove opens
@@ -20,6 +21,8 @@ pub(crate) struct RecordArgs {
     /// How the capture's chunks are compressed (zstd: about 12 times smaller, at some CPU).
     #[arg(long, value_enum, default_value_t = CompressionArg::None, requires = "record")]
     pub(crate) compression: CompressionArg,
+    #[command(flatten)]
+    pub(crate) live: crate::cmd::taps::LiveArgs,
 }
 
 /// `--compression`.
@@ -31,9 +34,11 @@ pub(crate) enum CompressionArg {
 }
 
 impl RecordArgs {
-    /// The recorder, if asked for; `command` names what records in the capture's metadata.
-    pub(crate) fn start(&self, command: &str) -> anyhow::Result<Option<Recorder>> {
-        start_with(self.record.as_deref(), command, self.compression)
+    /// The recorder and the live view, each if asked for; `command` names what records in the
+    /// capture's metadata and what serves in the live view.
+    pub(crate) fn start(&self, command: &str) -> anyhow::Result<Taps> {
+        let recorder = start_with(self.record.as_deref(), command, self.compression)?;
+        Ok(Taps { recorder, live: self.live.start(command)? })
     }
 
     /// As [`start`](Self::start), a capture of ROS 2 topics only: the `ros2` profile, no JSON,
@@ -68,11 +73,6 @@ impl From<CompressionArg> for Compression {
             CompressionArg::Lz4 => Compression::Lz4,
         }
     }
-}
-
-/// A recorder on `path`, if given.
-pub(crate) fn start(path: Option<&Path>, command: &str) -> anyhow::Result<Option<Recorder>> {
-    start_with(path, command, CompressionArg::None)
 }
 
 /// A recorder on `path`, if given, its chunks compressed with `compression`.
@@ -146,6 +146,9 @@ pub(crate) struct ReplayArgs {
     /// With --as-device on a spline link: the IMU object to create (the robot's name).
     #[arg(long, default_value = "/imu_shm", requires = "as_device")]
     imu_name: String,
+    /// The capture played to a live view at --speed.
+    #[command(flatten)]
+    live: crate::cmd::taps::LiveArgs,
 }
 
 /// Replays a capture into the decoders, at the recorded pace (or `--speed`, or `--fast`).
@@ -158,6 +161,10 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
     let bytes = std::fs::read(&args.file).with_context(|| format!("reading {}", args.file.display()))?;
     let frames =
         robowire_record::read_frames(&bytes, &descriptions()).with_context(|| format!("{}", args.file.display()))?;
+    anyhow::ensure!(
+        !(args.as_device && args.live.live.is_some()),
+        "--live plays the capture to a live view; with --as-device, look at the client's own --live"
+    );
     if args.as_device {
         let target = crate::cmd::replay_device::Target {
             link: args.link.as_deref(),
@@ -172,6 +179,8 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
         eprintln!("{}: no frames", args.file.display());
         return Ok(ExitCode::SUCCESS);
     };
+    let live = args.live.start("robowire replay")?;
+    let mut taps = std::collections::HashMap::new();
     let started = Instant::now();
     let mut errors = 0u64;
     for frame in &frames {
@@ -181,6 +190,10 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
             if let Some(wait) = due.checked_sub(started.elapsed()) {
                 std::thread::sleep(wait);
             }
+        }
+        if let Some(live) = &live {
+            let tap = taps.entry(frame.link.as_str()).or_insert_with(|| live.links().link(&frame.link, frame.protocol));
+            tap.record(frame.direction, &frame.bytes);
         }
         let t = offset_ns as f64 / 1e9;
         let direction = frame.direction.name();
@@ -197,6 +210,7 @@ pub(crate) fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
         }
     }
     eprintln!("replay: {} frames, {errors} not decodable", frames.len());
+    Taps { recorder: None, live }.finish()?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -84,7 +84,8 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
     };
     let ros_distro = ros_distro(args.ros_distro.as_deref(), std::env::var("ROS_DISTRO").ok().as_deref())?;
     let recorder = args.record.start_ros2("robowire ros2")?;
-    let devices_recorder = args.record.beside("devices").start("robowire ros2")?;
+    // The live view shows the devices' links (the ROS topics are what ROS tools show).
+    let devices_taps = args.record.beside("devices").start("robowire ros2")?;
     let options = BridgeOptions {
         namespace: args.namespace.clone(),
         domain: args.domain,
@@ -93,7 +94,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         deadman: Duration::from_secs_f64(args.deadman),
         rate_cap_hz: args.rate,
         record: recorder.as_ref().map(robowire_record::Recorder::links),
-        record_devices: devices_recorder.as_ref().map(robowire_record::Recorder::links),
+        record_devices: devices_taps.links(),
         ros_distro,
         sim_physics: args.body.options(),
         ..BridgeOptions::new(args.devices.clone())
@@ -159,7 +160,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
     }
     drop(devices);
     crate::cmd::record::finish(recorder)?;
-    crate::cmd::record::finish(devices_recorder)?;
+    devices_taps.finish()?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     }

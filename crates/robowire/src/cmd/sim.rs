@@ -107,9 +107,8 @@ pub(crate) struct Zsl1SimArgs {
     /// Print the simulator's state every this many seconds (0: never).
     #[arg(long, default_value_t = 1.0)]
     report_every_s: f64,
-    /// Record every datagram both ways, raw and decoded, into this MCAP file.
-    #[arg(long, value_name = "FILE.mcap")]
-    record: Option<PathBuf>,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
 }
 
 #[derive(Debug, Args)]
@@ -187,13 +186,13 @@ fn until_ctrl_c(every_s: f64, mut report: impl FnMut()) -> anyhow::Result<()> {
 
 fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
     use zsl_proto::description::{IMU, SPLINE_DAEMON};
-    let recorder = args.record.start("robowire sim spline")?;
+    let taps = args.record.start("robowire sim spline")?;
     let config = robowire_sim::spline::SplineSimConfig {
         spline_name: args.name.clone(),
         imu_name: args.imu_name.clone(),
         create: robowire_shm::CreateOptions { mode: args.mode, unlink_on_drop: true },
-        tap: recorder.as_ref().map(|r| r.link(robowire_devices::SPLINE_LINK, &SPLINE_DAEMON)),
-        imu_tap: recorder.as_ref().map(|r| r.link(robowire_devices::SPLINE_IMU_LINK, &IMU)),
+        tap: taps.link(robowire_devices::SPLINE_LINK, &SPLINE_DAEMON),
+        imu_tap: taps.link(robowire_devices::SPLINE_IMU_LINK, &IMU),
         ..Default::default()
     };
     let sim = robowire_sim::spline::SplineSim::spawn(config).context("starting the spline daemon simulator")?;
@@ -218,18 +217,18 @@ fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
         );
     })?;
     drop(sim);
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(ExitCode::SUCCESS)
 }
 
 fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
-    let recorder = args.record.start("robowire sim kmc")?;
+    let taps = args.record.start("robowire sim kmc")?;
     let config = ChassisSimConfig {
         link: args.link.clone(),
         command_watchdog: (args.watchdog_ms > 0).then(|| Duration::from_millis(args.watchdog_ms)),
-        taps: recorder
-            .as_ref()
-            .map(|r| robowire_devices::kmc_taps(&r.links(), &kmc_proto::description::CHASSIS))
+        taps: taps
+            .links()
+            .map(|l| robowire_devices::kmc_taps(&l, &kmc_proto::description::CHASSIS))
             .unwrap_or_default(),
         ..ChassisSimConfig::default()
     };
@@ -260,22 +259,22 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
         );
     })?;
     drop(sim);
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(ExitCode::SUCCESS)
 }
 
 fn run_zsl1(args: &Zsl1SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::zsl1::{Zsl1Sim, Zsl1SimConfig};
     use zsl_proto::description::{HIGH_LEVEL, LOW_LEVEL};
-    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire sim zsl1")?;
+    let taps = args.record.start("robowire sim zsl1")?;
     let config = Zsl1SimConfig {
         bind: args.bind,
         high_level_port: args.high_level_port,
         low_level_port: args.low_level_port,
         client: args.client,
         model: args.model.into(),
-        high_level_tap: recorder.as_ref().map(|r| r.link("zsl1/high_level", &HIGH_LEVEL)),
-        low_level_tap: recorder.as_ref().map(|r| r.link("zsl1/low_level", &LOW_LEVEL)),
+        high_level_tap: taps.link("zsl1/high_level", &HIGH_LEVEL),
+        low_level_tap: taps.link("zsl1/low_level", &LOW_LEVEL),
         ..Zsl1SimConfig::default()
     };
     let sim = Zsl1Sim::spawn(config).context("starting the ZSL-1 simulator")?;
@@ -307,7 +306,7 @@ fn run_zsl1(args: &Zsl1SimArgs) -> anyhow::Result<ExitCode> {
         );
     })?;
     drop(sim); // its links (and taps) closed before the capture is
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -386,11 +385,11 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::go2::{Go2Sim, Go2SimConfig};
     #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
     let physics = args.body.physics(false)?;
-    let recorder = args.record.start("robowire sim go2")?;
+    let taps = args.record.start("robowire sim go2")?;
     let config = Go2SimConfig {
         participant: args.dds.participant(),
-        low_level_tap: recorder.as_ref().map(|r| r.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL)),
-        services_tap: recorder.as_ref().map(|r| r.link("go2/api", &unitree_proto::description::API_SERVER)),
+        low_level_tap: taps.link("go2/low_level", &unitree_proto::description::GO2_LOW_LEVEL),
+        services_tap: taps.link("go2/api", &unitree_proto::description::API_SERVER),
         clock: args.body.clock(),
         onboard_gait: args.body.walks(),
         #[cfg(feature = "mujoco")]
@@ -425,7 +424,7 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     );
     drop(walker);
     drop(sim);
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -454,12 +453,12 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
     // A walking G1 stands on the floor.
     let physics = args.body.physics(!(args.free_base || args.body.walks()))?;
-    let recorder = args.record.start("robowire sim g1")?;
+    let taps = args.record.start("robowire sim g1")?;
     let config = G1SimConfig {
         participant: args.dds.participant(),
         mode_machine,
-        low_level_tap: recorder.as_ref().map(|r| r.link("g1/low_level", &unitree_proto::description::HG_LOW_LEVEL)),
-        services_tap: recorder.as_ref().map(|r| r.link("g1/api", &unitree_proto::description::API_SERVER)),
+        low_level_tap: taps.link("g1/low_level", &unitree_proto::description::HG_LOW_LEVEL),
+        services_tap: taps.link("g1/api", &unitree_proto::description::API_SERVER),
         clock: args.body.clock(),
         onboard_gait: args.body.walks(),
         #[cfg(feature = "mujoco")]
@@ -499,6 +498,6 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     );
     drop(walker);
     drop(sim);
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(ExitCode::SUCCESS)
 }

@@ -41,11 +41,10 @@ impl RobotArgs {
     {
         let connect = seconds("--connect-timeout-s", self.connect_timeout_s)?;
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
-        let recorder = self.record.start(&format!("robowire {name}"))?;
-        let links = recorder.as_ref().map(robowire_record::Recorder::links);
+        let taps = self.record.start(&format!("robowire {name}"))?;
         let options = LowLevelOptions { participant: self.dds.participant(), ..LowLevelOptions::default() };
-        let code = runtime.block_on(body(options, links, connect));
-        crate::cmd::record::finish(recorder)?;
+        let code = runtime.block_on(body(options, taps.links(), connect));
+        taps.finish()?;
         code
     }
 

@@ -54,9 +54,8 @@ pub(crate) struct Zsl1Args {
     /// Seconds to wait for the robot's first state.
     #[arg(long, default_value_t = 3.0)]
     connect_timeout_s: f64,
-    /// Record every datagram both ways, raw and decoded, into this MCAP file.
-    #[arg(long, value_name = "FILE.mcap")]
-    record: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    record: crate::cmd::record::RecordArgs,
     #[command(subcommand)]
     command: Zsl1Command,
 }
@@ -143,10 +142,10 @@ fn options(args: &Zsl1Args) -> ClientOptions {
 use crate::cmd::seconds as duration;
 
 async fn run_async(args: Zsl1Args) -> anyhow::Result<ExitCode> {
-    let recorder = crate::cmd::record::start(args.record.as_deref(), "robowire zsl1")?;
+    let taps = args.record.start("robowire zsl1")?;
     let mut options = options(&args);
-    if let Some(recorder) = &recorder {
-        options = options.with_tap(recorder.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL));
+    if let Some(tap) = taps.link("zsl1/high_level", &zsl_proto::description::HIGH_LEVEL) {
+        options = options.with_tap(tap);
     }
     let dog = HighLevel::open(options).context("starting the HighLevel client")?;
     let timeout = Duration::from_secs_f64(args.connect_timeout_s);
@@ -213,13 +212,13 @@ async fn run_async(args: Zsl1Args) -> anyhow::Result<ExitCode> {
             true
         }
         Zsl1Command::Watch => {
-            crate::cmd::live::watch_until_ctrl_c(dog.connection_events(), || dog.status_line()).await?;
+            crate::cmd::watch_loop::watch_until_ctrl_c(dog.connection_events(), || dog.status_line()).await?;
             true
         }
     };
     eprintln!("{}", dog.stats_line());
     dog.close();
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     Ok(if outcome { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 

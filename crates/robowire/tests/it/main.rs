@@ -17,6 +17,7 @@ mod doctor;
 mod g1;
 mod g1_cli;
 mod go2;
+mod live;
 mod lowlevel;
 mod policy;
 mod record;

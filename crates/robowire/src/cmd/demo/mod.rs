@@ -149,8 +149,14 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
         (None, Some(dir)) => Some(dir.join("demo.mcap")),
         (None, None) => None,
     };
-    let recorder = crate::cmd::record::start_with(capture.as_deref(), "robowire demo", args.record.compression)?;
-    let record = recorder.as_ref().map(robowire_record::Recorder::links);
+    let taps = crate::cmd::taps::Taps {
+        recorder: crate::cmd::record::start_with(capture.as_deref(), "robowire demo", args.record.compression)?,
+        live: args.record.live.start("robowire demo")?,
+    };
+    let record = taps.links();
+    if let Some(events) = taps.events() {
+        out.also_to(events, "demo");
+    }
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
         if args.only.is_none_or(|d| d == device) && (dds || !device.uses_dds()) {
@@ -163,7 +169,7 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
             reports.push(report);
         }
     }
-    crate::cmd::record::finish(recorder)?;
+    taps.finish()?;
     if let (Some(dir), Some(capture)) = (&args.plot, &capture) {
         draw(dir, capture, &out)?;
     }

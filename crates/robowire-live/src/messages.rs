@@ -1,0 +1,178 @@
+//! The messages the live view makes itself, in Foxglove's well-known schemas (JSON encoded):
+//! `foxglove.Log` for events, `foxglove.FrameTransform` for a robot's attitude; and its own
+//! counts.
+
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use foxglove::{RawChannel, Schema};
+use robowire_core::json::Value;
+use serde_json::json;
+
+use crate::LiveStats;
+
+/// A `foxglove.Log` level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    /// Detail.
+    Debug = 1,
+    /// A change of state (connected, armed).
+    Info = 2,
+    /// Something a user should see (a refusal, a silent peer).
+    Warning = 3,
+    /// A fault (a damping trip, a lost device).
+    Error = 4,
+    /// The end of a run.
+    Fatal = 5,
+}
+
+/// Unix time now, ns (0 before 1970).
+pub(crate) fn unix_now_ns() -> u64 {
+    SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
+}
+
+fn time(unix_ns: u64) -> Value {
+    json!({ "sec": unix_ns / 1_000_000_000, "nsec": unix_ns % 1_000_000_000 })
+}
+
+/// `message` from `name` at `level` on the log channel.
+pub(crate) fn log(channel: &RawChannel, level: Level, name: &str, message: &str) {
+    let log = json!({
+        "timestamp": time(unix_now_ns()),
+        "level": level as u8,
+        "message": message,
+        "name": name,
+        "file": "",
+        "line": 0,
+    });
+    channel.log(&serde_json::to_vec(&log).unwrap_or_default());
+}
+
+/// The JSON schema of `foxglove.Log`.
+pub(crate) fn log_schema() -> Schema {
+    let schema = json!({
+        "title": "foxglove.Log",
+        "type": "object",
+        "properties": {
+            "timestamp": time_schema(),
+            "level": { "type": "integer", "minimum": 0, "maximum": 5 },
+            "message": { "type": "string" },
+            "name": { "type": "string" },
+            "file": { "type": "string" },
+            "line": { "type": "integer", "minimum": 0 },
+        },
+    });
+    Schema::new("foxglove.Log", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())
+}
+
+fn time_schema() -> Value {
+    json!({
+        "type": "object",
+        "properties": { "sec": { "type": "integer", "minimum": 0 }, "nsec": { "type": "integer", "minimum": 0 } },
+    })
+}
+
+/// A robot's base in the world from a decoded state: its attitude from the IMU's quaternion
+/// (`imu_state.quaternion`, Unitree's w, x, y, z) and, where the state says it
+/// (`rt/sportmodestate`), its position; the frame is `{device}/base`, the device the link's first
+/// name. `None` for a state with no attitude.
+pub(crate) fn frame_transform(link: &str, state: &Value, unix_ns: u64) -> Option<Value> {
+    let number = |v: &Value| v.as_f64().filter(|x| x.is_finite());
+    let quaternion = state.pointer("/imu_state/quaternion")?.as_array()?;
+    let [w, x, y, z] = <[&Value; 4]>::try_from(quaternion.iter().collect::<Vec<_>>()).ok()?.map(number);
+    let (w, x, y, z) = (w?, x?, y?, z?);
+    let norm = (w * w + x * x + y * y + z * z).sqrt();
+    if norm < 1e-6 {
+        return None;
+    }
+    let position = state.pointer("/position").and_then(Value::as_array).filter(|p| p.len() == 3);
+    let at = |i: usize| position.and_then(|p| number(&p[i])).unwrap_or(0.0);
+    let device = link.split('/').next().unwrap_or(link);
+    Some(json!({
+        "timestamp": time(unix_ns),
+        "parent_frame_id": "world",
+        "child_frame_id": format!("{device}/base"),
+        "translation": { "x": at(0), "y": at(1), "z": at(2) },
+        "rotation": { "x": x / norm, "y": y / norm, "z": z / norm, "w": w / norm },
+    }))
+}
+
+/// The JSON schema of `foxglove.FrameTransform`.
+pub(crate) fn frame_transform_schema() -> Schema {
+    let vector = |names: &[&str]| {
+        let properties: serde_json::Map<String, Value> =
+            names.iter().map(|n| ((*n).to_string(), json!({ "type": "number" }))).collect();
+        json!({ "type": "object", "properties": properties })
+    };
+    let schema = json!({
+        "title": "foxglove.FrameTransform",
+        "type": "object",
+        "properties": {
+            "timestamp": time_schema(),
+            "parent_frame_id": { "type": "string" },
+            "child_frame_id": { "type": "string" },
+            "translation": vector(&["x", "y", "z"]),
+            "rotation": vector(&["x", "y", "z", "w"]),
+        },
+    });
+    Schema::new("foxglove.FrameTransform", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())
+}
+
+/// The counts as `/robowire/live` says them.
+pub(crate) fn live_stats_json(stats: &LiveStats) -> Value {
+    json!({
+        "channels": stats.links.iter().map(|l| json!({
+            "topic": l.topic, "seen": l.seen, "sent": l.sent, "undecodable": l.undecodable,
+        })).collect::<Vec<_>>(),
+        "clients": stats.viewers.iter().map(|v| json!({
+            "addr": v.addr.to_string(), "forwarded": v.forwarded, "dropped": v.dropped,
+        })).collect::<Vec<_>>(),
+        "ring_dropped": stats.ring_dropped,
+    })
+}
+
+/// The JSON schema of `/robowire/live`.
+pub(crate) fn live_stats_schema() -> Schema {
+    let counts = |fields: &[&str]| {
+        let mut properties: serde_json::Map<String, Value> =
+            fields.iter().map(|n| ((*n).to_string(), json!({ "type": "integer", "minimum": 0 }))).collect();
+        for name in ["topic", "addr"] {
+            properties.insert(name.into(), json!({ "type": "string" }));
+        }
+        json!({ "type": "array", "items": { "type": "object", "properties": properties } })
+    };
+    let schema = json!({
+        "title": "robowire.LiveStats",
+        "type": "object",
+        "properties": {
+            "channels": counts(&["seen", "sent", "undecodable"]),
+            "clients": counts(&["forwarded", "dropped"]),
+            "ring_dropped": { "type": "integer", "minimum": 0 },
+        },
+    });
+    Schema::new("robowire.LiveStats", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_imu_quaternion_is_the_base_frame_and_a_position_its_place() {
+        let state = json!({ "imu_state": { "quaternion": [2.0, 0.0, 0.0, 0.0] } });
+        let t = frame_transform("go2/low_level", &state, 1_500_000_000).unwrap();
+        assert_eq!(t["child_frame_id"], "go2/base");
+        assert_eq!(t["rotation"], json!({ "x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0 }));
+        assert_eq!(t["translation"], json!({ "x": 0.0, "y": 0.0, "z": 0.0 }));
+        assert_eq!(t["timestamp"], json!({ "sec": 1, "nsec": 500_000_000 }));
+        let state = json!({ "imu_state": { "quaternion": [1, 0, 0, 0] }, "position": [1.0, 2.0, 0.3] });
+        assert_eq!(frame_transform("g1", &state, 0).unwrap()["translation"], json!({ "x": 1.0, "y": 2.0, "z": 0.3 }));
+        for bad in [
+            json!({}),
+            json!({ "imu_state": { "quaternion": [0, 0, 0, 0] } }),
+            json!({ "imu_state": { "quaternion": [1, 0, 0] } }),
+            json!({ "imu_state": { "quaternion": ["NaN", 0, 0, 0] } }),
+        ] {
+            assert!(frame_transform("go2", &bad, 0).is_none(), "{bad}");
+        }
+    }
+}

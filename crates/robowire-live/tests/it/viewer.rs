@@ -1,0 +1,272 @@
+//! Viewers of our own: a WebSocket client speaking the Foxglove protocol's JSON and binary
+//! messages by hand (the protocol's spec, not the server's code), and plain HTTP.
+
+use std::collections::HashMap;
+use std::io::{Read, Write};
+use std::time::Duration;
+
+use futures::{SinkExt, StreamExt};
+use robowire_fixtures::wait;
+use serde_json::{Value, json};
+use tokio::net::TcpStream;
+use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+use tokio_tungstenite::tungstenite::http::HeaderValue;
+use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
+use tokio_tungstenite::tungstenite::{Message, protocol::CloseFrame};
+use tokio_tungstenite::{MaybeTlsStream, WebSocketStream};
+
+use crate::feed::{Feed, live, low_state};
+
+type Socket = WebSocketStream<MaybeTlsStream<TcpStream>>;
+
+/// A bound on waiting for what must come, so that a broken server fails the test instead of
+/// hanging it; not a measure of speed.
+const WITHIN: Duration = Duration::from_secs(30);
+
+async fn connect(addr: std::net::SocketAddr) -> Socket {
+    let mut request = format!("ws://{addr}/").into_client_request().unwrap();
+    request.headers_mut().insert("Sec-WebSocket-Protocol", HeaderValue::from_static("foxglove.sdk.v1"));
+    let (socket, response) = tokio_tungstenite::connect_async(request).await.unwrap();
+    assert_eq!(response.headers()["sec-websocket-protocol"], "foxglove.sdk.v1");
+    socket
+}
+
+/// A channel as advertised.
+#[derive(Debug, Clone)]
+struct Channel {
+    topic: String,
+    encoding: String,
+    schema_name: String,
+    schema_encoding: String,
+    schema: String,
+}
+
+/// What a viewer saw: the server's info, the channels by id, the first and the latest message of
+/// each topic, and how many.
+#[derive(Debug, Default)]
+struct Seen {
+    server: Value,
+    channels: HashMap<u64, Channel>,
+    subscribed: HashMap<u32, u64>,
+    messages: HashMap<String, (Vec<u8>, Vec<u8>, u64)>,
+}
+
+impl Seen {
+    /// Takes one server message: JSON ops, or binary message data (opcode 1: subscription id,
+    /// log time, payload); subscribes to channels as they are advertised.
+    async fn take(&mut self, socket: &mut Socket, message: Message) {
+        match message {
+            Message::Text(text) => {
+                let op: Value = serde_json::from_str(&text).unwrap();
+                match op["op"].as_str().unwrap() {
+                    "serverInfo" => self.server = op,
+                    "advertise" => {
+                        let mut subscriptions = Vec::new();
+                        for c in op["channels"].as_array().unwrap() {
+                            let text = |k: &str| c[k].as_str().unwrap_or_default().to_owned();
+                            let id = c["id"].as_u64().unwrap();
+                            let channel = Channel {
+                                topic: text("topic"),
+                                encoding: text("encoding"),
+                                schema_name: text("schemaName"),
+                                schema_encoding: text("schemaEncoding"),
+                                schema: text("schema"),
+                            };
+                            self.channels.insert(id, channel);
+                            let sub = u32::try_from(self.subscribed.len()).unwrap();
+                            self.subscribed.insert(sub, id);
+                            subscriptions.push(json!({ "id": sub, "channelId": id }));
+                        }
+                        let subscribe = json!({ "op": "subscribe", "subscriptions": subscriptions });
+                        socket.send(Message::text(subscribe.to_string())).await.unwrap();
+                    }
+                    _ => {}
+                }
+            }
+            Message::Binary(bytes) => {
+                assert_eq!(bytes[0], 1, "message data");
+                let sub = u32::from_le_bytes(bytes[1..5].try_into().unwrap());
+                let channel = &self.channels[&self.subscribed[&sub]];
+                let payload = bytes[13..].to_vec();
+                let entry =
+                    self.messages.entry(channel.topic.clone()).or_insert_with(|| (payload.clone(), Vec::new(), 0));
+                entry.1 = payload;
+                entry.2 += 1;
+            }
+            _ => {}
+        }
+    }
+
+    fn json(&self, topic: &str) -> Value {
+        serde_json::from_slice(&self.messages[topic].1).unwrap()
+    }
+
+    fn channel(&self, topic: &str) -> &Channel {
+        self.channels.values().find(|c| c.topic == topic).unwrap_or_else(|| panic!("no channel {topic}"))
+    }
+}
+
+/// Reads `socket` until `done` holds of what it saw.
+async fn read_until(socket: &mut Socket, seen: &mut Seen, what: &str, done: impl Fn(&Seen) -> bool) {
+    let reading = async {
+        while !done(seen) {
+            let message = socket.next().await.expect("the server closed").unwrap();
+            seen.take(socket, message).await;
+        }
+    };
+    tokio::time::timeout(WITHIN, reading).await.unwrap_or_else(|_| panic!("not within {WITHIN:?}: {what}"));
+}
+
+const LOW_STATE: &str = "/go2/low_level/received/unitree_go::msg::dds_::LowState_";
+const LOW_CMD: &str = "/go2/low_level/sent/unitree_go::msg::dds_::LowCmd_";
+
+#[test]
+fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_base_frame() {
+    let live = live(50.0);
+    let feed = Feed::start(&live, Duration::from_millis(2));
+    let topics = [LOW_STATE, LOW_CMD, "/go2/low_level/received", "/go2/low_level/sent", "/tf", "/robowire/live"];
+    wait::runtime().block_on(async {
+        let mut socket = connect(live.addr()).await;
+        let mut seen = Seen::default();
+        let kmc = |seen: &Seen| seen.messages.keys().any(|t| t.starts_with("/kmc/serial/received/"));
+        read_until(&mut socket, &mut seen, "every channel's messages", |seen| {
+            topics.iter().all(|t| seen.messages.contains_key(*t)) && kmc(seen)
+        })
+        .await;
+
+        assert_eq!(seen.server["op"], "serverInfo");
+        let state = seen.json(LOW_STATE);
+        assert_eq!(state["motor_state"].as_array().map(Vec::len), Some(20), "{state}");
+        let (json_channel, cdr_channel) = (seen.channel(LOW_STATE), seen.channel("/go2/low_level/received"));
+        assert_eq!((json_channel.encoding.as_str(), json_channel.schema_encoding.as_str()), ("json", "jsonschema"));
+        let schema: Value = serde_json::from_str(&json_channel.schema).unwrap();
+        assert!(schema["properties"]["motor_state"].is_object(), "{schema}");
+        assert_eq!((cdr_channel.encoding.as_str(), cdr_channel.schema_encoding.as_str()), ("cdr", "omgidl"));
+        assert_eq!(cdr_channel.schema_name, "unitree_go::msg::dds_::LowState_");
+        // The CDR is the frame as it travelled: a LowState of the tick its JSON says.
+        let (first_cdr, last_cdr, _) = &seen.messages["/go2/low_level/received"];
+        let tick = |payload: &[u8]| (0..1_000_000).find(|&n| low_state(n) == payload);
+        assert!(tick(first_cdr).is_some() && tick(last_cdr).is_some(), "the CDR payloads are the frames");
+        let kmc_topic = seen.messages.keys().find(|t| t.starts_with("/kmc/serial/received/")).unwrap().clone();
+        assert_eq!(seen.json(&kmc_topic)["speed_mps"], 0.5, "{kmc_topic}");
+        let tf = seen.json("/tf");
+        assert_eq!((tf["parent_frame_id"].as_str(), tf["child_frame_id"].as_str()), (Some("world"), Some("go2/base")));
+        assert_eq!(tf["rotation"]["w"], 1.0);
+        assert_eq!(seen.channel("/tf").schema_name, "foxglove.FrameTransform");
+        let counts = seen.json("/robowire/live");
+        let go2 = counts["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/go2/low_level/received");
+        let go2 = go2.unwrap_or_else(|| panic!("{counts}"));
+        assert!(go2["seen"].as_u64() >= go2["sent"].as_u64() && go2["sent"].as_u64() > Some(0), "{counts}");
+    });
+    let tapped = feed.stop();
+    let stats = live.stop();
+    let go2 = stats.links.iter().find(|l| l.topic == "/go2/low_level/received").unwrap();
+    // Every frame was counted, seen or dropped by a full ring (none here but under a stall).
+    assert!(go2.seen <= tapped && go2.seen + stats.ring_dropped >= tapped, "{tapped} tapped: {stats:?}");
+    assert!(go2.sent <= go2.seen && go2.undecodable == 0, "{stats:?}");
+}
+
+/// `GET path` on `addr`: the status line and the body.
+fn get(addr: std::net::SocketAddr, request: &str) -> (String, Vec<u8>) {
+    let mut stream = std::net::TcpStream::connect(addr).unwrap();
+    stream.write_all(request.as_bytes()).unwrap();
+    let mut response = Vec::new();
+    stream.read_to_end(&mut response).unwrap();
+    let split = response.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&response[..split]).into_owned();
+    (head.lines().next().unwrap().to_owned(), response[split + 4..].to_vec())
+}
+
+#[test]
+fn the_page_what_it_loads_and_the_plots_of_every_link_are_served_on_the_same_address() {
+    let live = live(50.0);
+    let _feed = Feed::start(&live, Duration::from_millis(2));
+    let addr = live.addr();
+    let (status, page) = get(addr, "GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    let page = String::from_utf8(page).unwrap();
+    for file in ["live.js", "uPlot.iife.min.js", "uPlot.min.css"] {
+        assert!(page.contains(file), "the page loads {file}");
+        let (status, body) = get(addr, &format!("GET /{file} HTTP/1.1\r\n\r\n"));
+        assert_eq!(status, "HTTP/1.1 200 OK", "{file}");
+        assert!(body.len() > 100, "{file}");
+    }
+    let (status, plots) = get(addr, "GET /plots.json HTTP/1.1\r\n\r\n");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    let plots: Value = serde_json::from_slice(&plots).unwrap();
+    let links = plots["links"].as_array().unwrap();
+    let go2 = links.iter().find(|l| l["link"] == "go2/low_level").unwrap_or_else(|| panic!("{plots}"));
+    assert_eq!(go2["protocol"], "unitree_go.low_level");
+    let series = &go2["panels"][0]["series"][0];
+    assert!(series["pointer"].as_str().is_some_and(|p| p.starts_with('/')) && series["range"].is_array(), "{go2}");
+    assert!(links.iter().any(|l| l["link"] == "kmc/serial"), "{plots}");
+    assert_eq!(get(addr, "GET /nothing HTTP/1.1\r\n\r\n").0, "HTTP/1.1 404 Not Found");
+    assert_eq!(get(addr, "POST / HTTP/1.1\r\n\r\n").0, "HTTP/1.1 405 Method Not Allowed");
+    assert_eq!(get(addr, "GET / HTTP/1.1\r\n").0.split(' ').nth(1), Some("400"), "a head cut short");
+    let (status, body) = get(addr, "HEAD / HTTP/1.1\r\n\r\n");
+    assert_eq!((status.as_str(), body.len()), ("HTTP/1.1 200 OK", 0));
+}
+
+#[test]
+fn a_viewer_that_stops_reading_loses_counted_messages_and_another_is_not_held_up() {
+    let live = live(10_000.0);
+    let feed = Feed::start(&live, Duration::ZERO);
+    wait::runtime().block_on(async {
+        let mut stalled = connect(live.addr()).await;
+        let mut stalled_seen = Seen::default();
+        read_until(&mut stalled, &mut stalled_seen, "the stalled viewer subscribed", |s| s.messages.len() > 3).await;
+        // From here on it reads nothing: the kernel's buffers fill, then its queue in front.
+        let mut healthy = connect(live.addr()).await;
+        let mut seen = Seen::default();
+        read_until(&mut healthy, &mut seen, "the healthy viewer subscribed", |s| s.messages.contains_key(LOW_STATE))
+            .await;
+        let dropped =
+            |live: &robowire_live::LiveServer| -> u64 { live.stats().viewers.iter().map(|v| v.dropped).sum() };
+        read_until(&mut healthy, &mut seen, "the stalled viewer's queue overflowing", |_| dropped(&live) > 0).await;
+        // The healthy viewer goes on getting messages after that.
+        let before = seen.messages[LOW_STATE].2;
+        read_until(&mut healthy, &mut seen, "messages after the overflow", |s| s.messages[LOW_STATE].2 > before + 100)
+            .await;
+        let stats = live.stats();
+        let (fast, slow): (Vec<_>, Vec<_>) = stats.viewers.iter().partition(|v| v.dropped == 0);
+        assert_eq!((fast.len(), slow.len()), (1, 1), "{stats:?}");
+        drop(stalled);
+    });
+    drop(feed);
+}
+
+#[test]
+fn a_viewer_that_sends_what_no_foxglove_client_sends_is_closed_and_the_view_goes_on() {
+    let live = live(50.0);
+    let _feed = Feed::start(&live, Duration::from_millis(2));
+    wait::runtime().block_on(async {
+        let cases = [
+            ("not JSON", Message::text("not json")),
+            ("an unknown op", Message::text(r#"{"op":"nope"}"#)),
+            ("a 32 MiB frame", Message::binary(vec![0u8; 32 << 20])),
+        ];
+        for (case, message) in cases {
+            let mut socket = connect(live.addr()).await;
+            // A send may fail once the server has closed: the close is what is looked at.
+            let _ = socket.send(message).await;
+            let closed = async {
+                loop {
+                    match socket.next().await {
+                        Some(Ok(Message::Close(frame))) => return frame,
+                        Some(Ok(_)) => continue,
+                        Some(Err(_)) | None => return None,
+                    }
+                }
+            };
+            let frame = tokio::time::timeout(WITHIN, closed).await.unwrap_or_else(|_| panic!("{case}: not closed"));
+            if let Some(CloseFrame { code, .. }) = frame {
+                assert_eq!(code, CloseCode::Policy, "{case}");
+            }
+        }
+        // The view goes on: a new viewer gets messages.
+        let mut socket = connect(live.addr()).await;
+        let mut seen = Seen::default();
+        read_until(&mut socket, &mut seen, "messages after the bad viewers", |s| s.messages.contains_key(LOW_STATE))
+            .await;
+    });
+}
