@@ -251,3 +251,25 @@ pub fn npm_project(name: &str, project: &Path) -> Result<PathBuf, String> {
     std::fs::write(&stamp, manifest.concat()).map_err(|e| e.to_string())?;
     Ok(dir.join("node_modules"))
 }
+
+/// `node SCRIPT ARGS…` with the packages of `node_modules`: its stdout as JSON. Fails the test,
+/// with node's stderr, when the script fails.
+#[track_caller]
+pub fn node_json(node_modules: &Path, script: &Path, args: &[&str]) -> serde_json::Value {
+    let out = Command::new("node")
+        .arg(script)
+        .args(args)
+        .env("NODE_PATH", node_modules)
+        .output()
+        .unwrap_or_else(|e| panic!("running node {}: {e}", script.display()));
+    let name = script.display();
+    assert!(out.status.success(), "{name}: {}\n{}", out.status, String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{name}: {e}: {}", String::from_utf8_lossy(&out.stdout)))
+}
+
+/// Chromium for the browser tests: `$CHROMIUM`, else Debian's `/usr/bin/chromium`.
+pub fn chromium() -> Result<PathBuf, String> {
+    let path = std::env::var_os("CHROMIUM").map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
+    path.exists().then_some(path).ok_or_else(|| "no Chromium (/usr/bin/chromium, or set CHROMIUM)".into())
+}

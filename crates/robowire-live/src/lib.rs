@@ -5,6 +5,7 @@ mod front;
 mod messages;
 mod page;
 mod pump;
+mod relay;
 mod ws_frame;
 
 use std::net::SocketAddr;
@@ -22,7 +23,8 @@ pub use messages::Level;
 #[derive(Debug, Clone)]
 pub struct LiveOptions {
     /// At most this many messages a second per link, direction and frame length (a stand-in
-    /// for the message type that costs no decoding) reach the viewers; every frame is counted.
+    /// for the message type that costs no decoding), and 16 times as many per link and
+    /// direction, reach the viewers; every frame is counted.
     pub rate_hz: f64,
     /// The plots the page draws, by protocol (each codec's `PLOTS`).
     pub plots: Vec<&'static LinkPlots>,
@@ -69,7 +71,7 @@ pub struct LinkCount {
     pub topic: String,
     /// Frames tapped.
     pub seen: u64,
-    /// Frames let through (at most one per period).
+    /// Frames let through to the viewers.
     pub sent: u64,
     /// Of those, frames the link's description could not decode.
     pub undecodable: u64,
@@ -93,6 +95,8 @@ pub struct LiveStats {
     pub links: Vec<LinkCount>,
     /// Per viewer connected.
     pub viewers: Vec<ViewerCount>,
+    /// Data messages dropped for slow viewers, all viewers ever (those gone too).
+    pub viewer_dropped_total: u64,
     /// Frames the taps dropped because the live view's thread fell behind.
     pub ring_dropped: u64,
 }
@@ -127,7 +131,28 @@ pub struct LiveServer {
     stop: Arc<AtomicBool>,
     pump: Option<std::thread::JoinHandle<()>>,
     foxglove: Option<WebSocketServerHandle>,
-    runtime: Option<tokio::runtime::Runtime>,
+    runtime: Background,
+}
+
+/// The view's runtime, shut down in the background when dropped: a runtime dropped outright
+/// inside another one panics, and a caller may be inside one.
+struct Background(Option<tokio::runtime::Runtime>);
+
+impl Background {
+    fn handle(&self) -> tokio::runtime::Handle {
+        match &self.0 {
+            Some(runtime) => runtime.handle().clone(),
+            None => unreachable!("taken only on drop"),
+        }
+    }
+}
+
+impl Drop for Background {
+    fn drop(&mut self) {
+        if let Some(runtime) = self.0.take() {
+            runtime.shutdown_background();
+        }
+    }
 }
 
 impl std::fmt::Debug for LiveServer {
@@ -200,10 +225,10 @@ impl LiveServer {
             .build_raw()
             .map_err(|e| LiveError::Foxglove(e.to_string()))?;
         let (ring, registry) = (TapRing::with_slots(options.ring_slots), LinkRegistry::default());
-        let viewers = Arc::new(front::Viewers::default());
+        let viewers = Arc::new(relay::Viewers::default());
         let site = Arc::new(Plots { registry: registry.clone(), plots: options.plots.clone() });
         let viewers_for_pump = viewers.clone();
-        runtime.spawn(async move {
+        runtime.handle().spawn(async move {
             // Registered with the runtime that polls it.
             if let Ok(listener) = tokio::net::TcpListener::from_std(listener) {
                 front::serve(listener, upstream, site, viewers).await;
@@ -231,7 +256,7 @@ impl LiveServer {
             stop,
             pump: Some(pump),
             foxglove: Some(foxglove),
-            runtime: Some(runtime),
+            runtime,
         })
     }
 
@@ -274,7 +299,7 @@ impl LiveServer {
             // Dropping the handle aborts the viewers' tasks.
             drop(server.stop());
         }
-        if let Some(runtime) = self.runtime.take() {
+        if let Some(runtime) = self.runtime.0.take() {
             runtime.shutdown_background();
         }
     }
@@ -286,18 +311,20 @@ fn serve(
     addr: SocketAddr,
     name: &str,
     context: &Arc<Context>,
-) -> Result<(tokio::runtime::Runtime, std::net::TcpListener, WebSocketServerHandle), LiveError> {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(1)
-        .thread_name("robowire-live")
-        .enable_all()
-        .build()
-        .map_err(LiveError::Threads)?;
+) -> Result<(Background, std::net::TcpListener, WebSocketServerHandle), LiveError> {
+    let runtime = Background(Some(
+        tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .thread_name("robowire-live")
+            .enable_all()
+            .build()
+            .map_err(LiveError::Threads)?,
+    ));
+    let handle = runtime.handle();
     let listener = std::net::TcpListener::bind(addr).map_err(|source| LiveError::Bind { addr, source })?;
     listener.set_nonblocking(true).map_err(|source| LiveError::Bind { addr, source })?;
-    let server =
-        WebSocketServer::new().name(name).context(context).bind("127.0.0.1", 0).tokio_runtime(runtime.handle());
-    let foxglove = runtime.block_on(server.start()).map_err(|e| LiveError::Foxglove(e.to_string()))?;
+    let server = WebSocketServer::new().name(name).context(context).bind("127.0.0.1", 0).tokio_runtime(&handle);
+    let foxglove = handle.block_on(server.start()).map_err(|e| LiveError::Foxglove(e.to_string()))?;
     Ok((runtime, listener, foxglove))
 }
 

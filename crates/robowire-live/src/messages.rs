@@ -127,6 +127,7 @@ pub(crate) fn live_stats_json(stats: &LiveStats) -> Value {
             "addr": v.addr.to_string(), "forwarded": v.forwarded, "dropped": v.dropped,
         })).collect::<Vec<_>>(),
         "ring_dropped": stats.ring_dropped,
+        "viewer_dropped_total": stats.viewer_dropped_total,
     })
 }
 
@@ -147,6 +148,7 @@ pub(crate) fn live_stats_schema() -> Schema {
             "channels": counts(&["seen", "sent", "undecodable"]),
             "clients": counts(&["forwarded", "dropped"]),
             "ring_dropped": { "type": "integer", "minimum": 0 },
+            "viewer_dropped_total": { "type": "integer", "minimum": 0 },
         },
     });
     Schema::new("robowire.LiveStats", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())

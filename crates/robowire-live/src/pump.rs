@@ -1,10 +1,11 @@
 //! The live view's own thread: it empties the taps' ring, lets through at most one frame per
-//! link, direction and length per period (counting every one; frames of one message type
-//! mostly share a length, so a slow type is not starved by a fast one on the same link), decodes those to JSON by their link's
+//! link, direction and length per period, and 16 per link and direction (counting every one;
+//! frames of one message type mostly share a length, so a slow type is not starved by a fast one
+//! on the same link), decodes those to JSON by their link's
 //! description and logs them to the Foxglove channels, made on first use; a Unitree payload also
 //! goes as the CDR it is, a robot's IMU attitude as a `foxglove.FrameTransform`.
 
-use std::collections::HashMap;
+use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -13,8 +14,8 @@ use foxglove::{ChannelBuilder, Context, PartialMetadata, RawChannel, Schema};
 use robowire_core::json::{JsonFrame, LinkDescription, Value};
 use robowire_tap::{Direction, LinkRegistry, TapRing, TappedFrame};
 
-use crate::front::Viewers;
 use crate::messages::{self, Level};
+use crate::relay::Viewers;
 use crate::{LinkCount, LiveStats, ViewerCount};
 
 /// How long the thread sleeps when the ring is empty.
@@ -28,13 +29,15 @@ const SILENT_AFTER_NS: u64 = 500_000_000;
 /// Frame lengths whose last send is remembered per link and direction, at most (the oldest goes).
 const LENGTHS: usize = 16;
 
-/// What one link and direction got.
-struct Key {
+/// One link and direction: what it got, and what the view keeps of it.
+struct LinkState {
     count: LinkCount,
     /// When a frame of each length was last let through, newest last.
     last_sent_ns: Vec<(usize, u64)>,
+    /// When any frame was last let through.
+    last_any_sent_ns: Option<u64>,
     last_seen_ns: u64,
-    /// Frames since `window_ns`, and whether the last whole second made it a stream.
+    /// The window's start (ns) and its frames so far: a second of them makes `streaming`.
     window: (u64, u64),
     streaming: bool,
     /// Said silent, not yet back.
@@ -56,7 +59,7 @@ pub(crate) struct Pump {
     pub(crate) stats: Arc<Mutex<LiveStats>>,
     pub(crate) log: Arc<RawChannel>,
     /// By link number, then direction (sent, received).
-    keys: Vec<[Option<Key>; 2]>,
+    keys: Vec<[Option<LinkState>; 2]>,
     transforms: Option<Arc<RawChannel>>,
     live: Option<Arc<RawChannel>>,
     /// Unix time minus the monotonic clock, ns.
@@ -126,9 +129,10 @@ impl Pump {
             self.keys.resize_with(link + 1, || [None, None]);
         }
         let slot = &mut self.keys[link][usize::from(frame.direction == Direction::Received)];
-        let key = slot.get_or_insert_with(|| Key {
+        let key = slot.get_or_insert_with(|| LinkState {
             count: LinkCount { topic: format!("/{name}/{}", frame.direction.name()), ..LinkCount::default() },
             last_sent_ns: Vec::with_capacity(LENGTHS),
+            last_any_sent_ns: None,
             last_seen_ns: frame.monotonic_ns,
             window: (frame.monotonic_ns, 0),
             streaming: false,
@@ -151,6 +155,11 @@ impl Pump {
         }
         let (period_ns, unix_offset_ns) = (self.period_ns, self.unix_offset_ns);
         let key = self.key(link, frame.direction);
+        // At most LENGTHS times the rate per link and direction, whatever the lengths.
+        if key.last_any_sent_ns.is_some_and(|last| frame.monotonic_ns.saturating_sub(last) < period_ns / LENGTHS as u64)
+        {
+            return;
+        }
         let len = frame.bytes().len();
         let sent = key.last_sent_ns.iter().position(|(l, _)| *l == len);
         if let Some(at) = sent {
@@ -162,6 +171,7 @@ impl Pump {
             key.last_sent_ns.remove(0);
         }
         key.last_sent_ns.push((len, frame.monotonic_ns));
+        key.last_any_sent_ns = Some(frame.monotonic_ns);
         key.count.sent += 1;
         let log_time = u64::try_from(i128::from(frame.monotonic_ns) + unix_offset_ns).unwrap_or(0);
         let meta = PartialMetadata { log_time: Some(log_time) };
@@ -221,7 +231,7 @@ impl Pump {
         }
     }
 
-    fn key(&mut self, link: usize, direction: Direction) -> &mut Key {
+    fn key(&mut self, link: usize, direction: Direction) -> &mut LinkState {
         self.keys[link][usize::from(direction == Direction::Received)]
             .as_mut()
             .unwrap_or_else(|| unreachable!("made before any use"))
@@ -285,10 +295,11 @@ impl Pump {
             links: self.keys.iter().flatten().flatten().map(|key| key.count.clone()).collect(),
             viewers: self
                 .viewers
-                .snapshot()
+                .connected()
                 .into_iter()
                 .map(|(addr, forwarded, dropped)| ViewerCount { addr, forwarded, dropped })
                 .collect(),
+            viewer_dropped_total: self.viewers.totals().1,
             ring_dropped: self.ring.counters().dropped(),
         };
         if self.live.is_none() {
@@ -309,10 +320,10 @@ fn device(link: &str) -> &str {
 /// The links registered so far, each by name, with its description's protocol.
 pub(crate) fn registered(registry: &LinkRegistry) -> Vec<(String, &'static str)> {
     let links = registry.lock().unwrap_or_else(PoisonError::into_inner);
-    let mut seen = HashMap::new();
+    let mut seen = HashSet::new();
     links
         .iter()
-        .filter(|(name, _)| seen.insert(name.clone(), ()).is_none())
+        .filter(|(name, _)| seen.insert(name.clone()))
         .map(|(name, description)| (name.clone(), description.protocol()))
         .collect()
 }

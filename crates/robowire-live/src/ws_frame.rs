@@ -104,9 +104,14 @@ pub(crate) fn unmask(payload: &mut [u8], key: [u8; 4]) {
     }
 }
 
-/// A server's close frame: `code` (RFC 6455 §7.4) and a short reason (at most 123 bytes kept).
+/// A server's close frame: `code` (RFC 6455 §7.4) and a short reason (at most 123 bytes of it,
+/// cut between characters).
 pub(crate) fn close_frame(code: u16, reason: &str) -> Vec<u8> {
-    let reason = &reason.as_bytes()[..reason.len().min(123)];
+    let mut cut = reason.len().min(123);
+    while !reason.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    let reason = &reason.as_bytes()[..cut];
     let mut frame = vec![0x88, u8::try_from(2 + reason.len()).unwrap_or(125)];
     frame.extend_from_slice(&code.to_be_bytes());
     frame.extend_from_slice(reason);
@@ -155,5 +160,9 @@ mod tests {
         let h = FrameHeader::parse(&frame).unwrap().unwrap();
         assert_eq!((h.opcode, h.payload_len), (Opcode::Close, 5));
         assert_eq!(close_frame(1000, &"x".repeat(500)).len(), 2 + 125);
+        // 122 bytes, then a 2-byte character across the limit: left out whole.
+        let frame = close_frame(1000, &format!("{}é", "x".repeat(122)));
+        assert_eq!(frame.len(), 2 + 2 + 122);
+        assert!(std::str::from_utf8(&frame[4..]).is_ok());
     }
 }

@@ -5,7 +5,6 @@
 //! makes that a failure.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 use robowire_fixtures::interop;
@@ -18,24 +17,9 @@ pub(crate) fn project() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/live")
 }
 
-/// `node SCRIPT ARGS…` with the project's packages; its stdout as JSON.
+/// `node SCRIPT ARGS…` of the project, its stdout as JSON.
 pub(crate) fn node(node_modules: &Path, script: &str, args: &[&str]) -> Value {
-    let out = Command::new("node")
-        .arg(project().join(script))
-        .args(args)
-        .env("NODE_PATH", node_modules)
-        .output()
-        .expect("running node");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{script}: {}\n{stderr}", out.status);
-    serde_json::from_slice(&out.stdout)
-        .unwrap_or_else(|e| panic!("{script}: {e}: {}", String::from_utf8_lossy(&out.stdout)))
-}
-
-/// Chromium, if the machine has it: `$CHROMIUM` or `/usr/bin/chromium`.
-pub(crate) fn chromium() -> Result<PathBuf, String> {
-    let path = std::env::var_os("CHROMIUM").map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
-    path.exists().then_some(path).ok_or_else(|| "no Chromium (/usr/bin/chromium, or set CHROMIUM)".into())
+    robowire_fixtures::peers::node_json(node_modules, &project().join(script), args)
 }
 
 /// The channel of `topic` in `client.js`'s report.
@@ -75,7 +59,7 @@ fn the_built_in_page_draws_every_device_s_plots_in_chromium() {
     let Some(node_modules) = interop::require(robowire_fixtures::peers::npm_project("live", &project())) else {
         return;
     };
-    let Some(_) = interop::require(chromium()) else { return };
+    let Some(_) = interop::require(robowire_fixtures::peers::chromium()) else { return };
     let live = live(50.0);
     let _feed = Feed::start(&live, Duration::from_millis(2));
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("live-page.png");

@@ -170,6 +170,7 @@ fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_base_fra
 fn get(addr: std::net::SocketAddr, request: &str) -> (String, Vec<u8>) {
     let mut stream = std::net::TcpStream::connect(addr).unwrap();
     stream.write_all(request.as_bytes()).unwrap();
+    stream.shutdown(std::net::Shutdown::Write).unwrap();
     let mut response = Vec::new();
     stream.read_to_end(&mut response).unwrap();
     let split = response.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
@@ -203,6 +204,10 @@ fn the_page_what_it_loads_and_the_plots_of_every_link_are_served_on_the_same_add
     assert_eq!(get(addr, "GET /nothing HTTP/1.1\r\n\r\n").0, "HTTP/1.1 404 Not Found");
     assert_eq!(get(addr, "POST / HTTP/1.1\r\n\r\n").0, "HTTP/1.1 405 Method Not Allowed");
     assert_eq!(get(addr, "GET / HTTP/1.1\r\n").0.split(' ').nth(1), Some("400"), "a head cut short");
+    let long = format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(20_000));
+    assert_eq!(get(addr, &long).0.split(' ').nth(1), Some("431"), "a head too large");
+    let upgrade = "GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nOrigin: https://evil.example\r\n\r\n";
+    assert_eq!(get(addr, upgrade).0.split(' ').nth(1), Some("403"), "a web page of another origin");
     let (status, body) = get(addr, "HEAD / HTTP/1.1\r\n\r\n");
     assert_eq!((status.as_str(), body.len()), ("HTTP/1.1 200 OK", 0));
 }
@@ -215,21 +220,21 @@ fn a_viewer_that_stops_reading_loses_counted_messages_and_another_is_not_held_up
         let mut stalled = connect(live.addr()).await;
         let mut stalled_seen = Seen::default();
         read_until(&mut stalled, &mut stalled_seen, "the stalled viewer subscribed", |s| s.messages.len() > 3).await;
+        let MaybeTlsStream::Plain(tcp) = stalled.get_ref() else { unreachable!("no TLS here") };
+        let stalled_addr = tcp.local_addr().unwrap();
         // From here on it reads nothing: the kernel's buffers fill, then its queue in front.
         let mut healthy = connect(live.addr()).await;
         let mut seen = Seen::default();
         read_until(&mut healthy, &mut seen, "the healthy viewer subscribed", |s| s.messages.contains_key(LOW_STATE))
             .await;
-        let dropped =
-            |live: &robowire_live::LiveServer| -> u64 { live.stats().viewers.iter().map(|v| v.dropped).sum() };
+        let dropped = |live: &robowire_live::LiveServer| {
+            live.stats().viewers.iter().find(|v| v.addr == stalled_addr).map_or(0, |v| v.dropped)
+        };
         read_until(&mut healthy, &mut seen, "the stalled viewer's queue overflowing", |_| dropped(&live) > 0).await;
         // The healthy viewer goes on getting messages after that.
         let before = seen.messages[LOW_STATE].2;
         read_until(&mut healthy, &mut seen, "messages after the overflow", |s| s.messages[LOW_STATE].2 > before + 100)
             .await;
-        let stats = live.stats();
-        let (fast, slow): (Vec<_>, Vec<_>) = stats.viewers.iter().partition(|v| v.dropped == 0);
-        assert_eq!((fast.len(), slow.len()), (1, 1), "{stats:?}");
         drop(stalled);
     });
     drop(feed);
@@ -241,11 +246,11 @@ fn a_viewer_that_sends_what_no_foxglove_client_sends_is_closed_and_the_view_goes
     let _feed = Feed::start(&live, Duration::from_millis(2));
     wait::runtime().block_on(async {
         let cases = [
-            ("not JSON", Message::text("not json")),
-            ("an unknown op", Message::text(r#"{"op":"nope"}"#)),
-            ("a 32 MiB frame", Message::binary(vec![0u8; 32 << 20])),
+            ("not JSON", Message::text("not json"), CloseCode::Protocol),
+            ("an unknown op", Message::text(r#"{"op":"nope"}"#), CloseCode::Protocol),
+            ("a 32 MiB frame", Message::binary(vec![0u8; 32 << 20]), CloseCode::Size),
         ];
-        for (case, message) in cases {
+        for (case, message, code) in cases {
             let mut socket = connect(live.addr()).await;
             // A send may fail once the server has closed: the close is what is looked at.
             let _ = socket.send(message).await;
@@ -259,8 +264,10 @@ fn a_viewer_that_sends_what_no_foxglove_client_sends_is_closed_and_the_view_goes
                 }
             };
             let frame = tokio::time::timeout(WITHIN, closed).await.unwrap_or_else(|_| panic!("{case}: not closed"));
-            if let Some(CloseFrame { code, .. }) = frame {
-                assert_eq!(code, CloseCode::Policy, "{case}");
+            match frame {
+                Some(CloseFrame { code: got, .. }) => assert_eq!(got, code, "{case}"),
+                // A 32 MiB send may see the connection reset before the close frame is read.
+                None => assert_eq!(code, CloseCode::Size, "{case}: no close frame"),
             }
         }
         // The view goes on: a new viewer gets messages.

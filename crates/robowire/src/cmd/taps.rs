@@ -18,9 +18,9 @@ pub(crate) struct LiveArgs {
     /// (the built-in page). ADDR defaults to 127.0.0.1:8765; port 0 takes a free one.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = DEFAULT_LIVE)]
     pub(crate) live: Option<SocketAddr>,
-    /// With --live: at most this many messages a second per link and direction go to the viewers
-    /// (every frame is still counted).
-    #[arg(long, value_name = "HZ", default_value_t = 50.0, requires = "live")]
+    /// With --live: at most this many messages a second per link, direction and message length
+    /// go to the viewers (every frame is still counted).
+    #[arg(long, value_name = "HZ", default_value_t = 50.0)]
     pub(crate) live_rate: f64,
 }
 
@@ -69,7 +69,7 @@ impl Taps {
         if let Some(live) = self.live {
             let stats = live.stop();
             let (seen, sent) = stats.links.iter().fold((0, 0), |(a, b), l| (a + l.seen, b + l.sent));
-            let dropped: u64 = stats.viewers.iter().map(|v| v.dropped).sum();
+            let dropped = stats.viewer_dropped_total;
             eprintln!(
                 "live: {seen} frames seen, {sent} sent to viewers ({} dropped by the view's ring, {dropped} by slow viewers)",
                 stats.ring_dropped
