@@ -101,10 +101,15 @@ pub struct LiveStats {
     pub ring_dropped: u64,
 }
 
-/// Events for the viewers (`/robowire/log`, `foxglove.Log`), from any thread.
+/// Events for the viewers (`/robowire/log`, `foxglove.Log`) and where a robot's base is
+/// (`/tf`), from any thread.
 #[derive(Clone)]
 pub struct LiveEvents {
     channel: Arc<RawChannel>,
+    transforms: Arc<RawChannel>,
+    /// Devices whose base is given by [`base_pose`](Self::base_pose): no attitude from their
+    /// IMU is sent for them.
+    posed: Arc<Mutex<Vec<String>>>,
 }
 
 impl std::fmt::Debug for LiveEvents {
@@ -117,6 +122,25 @@ impl LiveEvents {
     /// `message` about `name` (a device: `go2`) at `level`.
     pub fn log(&self, level: Level, name: &str, message: &str) {
         messages::log(&self.channel, level, name, message);
+    }
+
+    /// Whether `device`'s base is given by [`base_pose`](Self::base_pose).
+    pub(crate) fn posed(&self, device: &str) -> bool {
+        self.posed.lock().unwrap_or_else(PoisonError::into_inner).iter().any(|d| d == device)
+    }
+
+    /// `device`'s base (`{device}/base`) in the world: its position, m, and roll, pitch, yaw
+    /// (ZYX), rad, as a simulator's physics has it. From then on, this is the device's base and
+    /// its IMU's attitude is not sent.
+    pub fn base_pose(&self, device: &str, position_m: [f64; 3], rpy_rad: [f64; 3]) {
+        {
+            let mut posed = self.posed.lock().unwrap_or_else(PoisonError::into_inner);
+            if !posed.iter().any(|d| d == device) {
+                posed.push(device.to_owned());
+            }
+        }
+        let transform = messages::base_transform(device, position_m, rpy_rad, messages::unix_now_ns());
+        self.transforms.log(&serde_json::to_vec(&transform).unwrap_or_default());
     }
 }
 
@@ -218,12 +242,17 @@ impl LiveServer {
                 .map_err(|_| LiveError::Foxglove("its set-up panicked".into()))??;
         let addr = listener.local_addr().map_err(|source| LiveError::Bind { addr, source })?;
         let upstream = SocketAddr::from(([127, 0, 0, 1], foxglove.port()));
-        let log = ChannelBuilder::new("/robowire/log")
-            .context(&context)
-            .message_encoding("json")
-            .schema(messages::log_schema())
-            .build_raw()
-            .map_err(|e| LiveError::Foxglove(e.to_string()))?;
+        let channel = |topic: &str, schema| {
+            ChannelBuilder::new(topic)
+                .context(&context)
+                .message_encoding("json")
+                .schema(schema)
+                .build_raw()
+                .map_err(|e| LiveError::Foxglove(e.to_string()))
+        };
+        let log = channel("/robowire/log", messages::log_schema())?;
+        let transforms = channel("/tf", messages::frame_transform_schema())?;
+        let events = LiveEvents { channel: log, transforms, posed: Arc::default() };
         let (ring, registry) = (TapRing::with_slots(options.ring_slots), LinkRegistry::default());
         let viewers = Arc::new(relay::Viewers::default());
         let site = Arc::new(Plots { registry: registry.clone(), plots: options.plots.clone() });
@@ -239,7 +268,7 @@ impl LiveServer {
         let stop = Arc::new(AtomicBool::new(false));
         let viewers = viewers_for_pump;
         let pump =
-            pump::Pump::new(ring.clone(), registry.clone(), context, period_ns, viewers, stats.clone(), log.clone());
+            pump::Pump::new(ring.clone(), registry.clone(), context, period_ns, viewers, stats.clone(), events.clone());
         let pump = {
             let stop = stop.clone();
             std::thread::Builder::new()
@@ -251,7 +280,7 @@ impl LiveServer {
             addr,
             ring: ring.clone(),
             links: RecordLinks::new(ring, registry),
-            events: LiveEvents { channel: log },
+            events,
             stats,
             stop,
             pump: Some(pump),

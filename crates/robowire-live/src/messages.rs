@@ -96,6 +96,25 @@ pub(crate) fn frame_transform(link: &str, state: &Value, unix_ns: u64) -> Option
     }))
 }
 
+/// A robot's base in the world from where a simulator or an estimator says it is: position, m,
+/// and roll, pitch, yaw (ZYX), rad.
+pub(crate) fn base_transform(device: &str, position_m: [f64; 3], rpy_rad: [f64; 3], unix_ns: u64) -> Value {
+    let [roll, pitch, yaw] = rpy_rad.map(|a| a / 2.0);
+    let (cr, sr, cp, sp, cy, sy) = (roll.cos(), roll.sin(), pitch.cos(), pitch.sin(), yaw.cos(), yaw.sin());
+    json!({
+        "timestamp": time(unix_ns),
+        "parent_frame_id": "world",
+        "child_frame_id": format!("{device}/base"),
+        "translation": { "x": position_m[0], "y": position_m[1], "z": position_m[2] },
+        "rotation": {
+            "x": sr * cp * cy - cr * sp * sy,
+            "y": cr * sp * cy + sr * cp * sy,
+            "z": cr * cp * sy - sr * sp * cy,
+            "w": cr * cp * cy + sr * sp * sy,
+        },
+    })
+}
+
 /// The JSON schema of `foxglove.FrameTransform`.
 pub(crate) fn frame_transform_schema() -> Schema {
     let vector = |names: &[&str]| {
@@ -157,6 +176,20 @@ pub(crate) fn live_stats_schema() -> Schema {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_pose_s_roll_pitch_yaw_is_the_zyx_quaternion() {
+        let t = base_transform("go2", [1.0, 2.0, 0.3], [0.0, 0.0, std::f64::consts::FRAC_PI_2], 0);
+        let r = &t["rotation"];
+        let half = std::f64::consts::FRAC_1_SQRT_2;
+        for (axis, want) in [("x", 0.0), ("y", 0.0), ("z", half), ("w", half)] {
+            assert!((r[axis].as_f64().unwrap() - want).abs() < 1e-12, "{axis}: {t}");
+        }
+        assert_eq!(t["translation"], json!({ "x": 1.0, "y": 2.0, "z": 0.3 }));
+        // Roll alone turns about x.
+        let t = base_transform("go2", [0.0; 3], [0.2, 0.0, 0.0], 0);
+        assert!((t["rotation"]["x"].as_f64().unwrap() - 0.1f64.sin()).abs() < 1e-12, "{t}");
+    }
 
     #[test]
     fn an_imu_quaternion_is_the_base_frame_and_a_position_its_place() {

@@ -16,7 +16,7 @@ use robowire_tap::{Direction, LinkRegistry, TapRing, TappedFrame};
 
 use crate::messages::{self, Level};
 use crate::relay::Viewers;
-use crate::{LinkCount, LiveStats, ViewerCount};
+use crate::{LinkCount, LiveEvents, LiveStats, ViewerCount};
 
 /// How long the thread sleeps when the ring is empty.
 const POLL: Duration = Duration::from_millis(5);
@@ -57,10 +57,9 @@ pub(crate) struct Pump {
     pub(crate) period_ns: u64,
     pub(crate) viewers: Arc<Viewers>,
     pub(crate) stats: Arc<Mutex<LiveStats>>,
-    pub(crate) log: Arc<RawChannel>,
+    pub(crate) events: LiveEvents,
     /// By link number, then direction (sent, received).
     keys: Vec<[Option<LinkState>; 2]>,
-    transforms: Option<Arc<RawChannel>>,
     live: Option<Arc<RawChannel>>,
     /// Unix time minus the monotonic clock, ns.
     unix_offset_ns: i128,
@@ -74,7 +73,7 @@ impl Pump {
         period_ns: u64,
         viewers: Arc<Viewers>,
         stats: Arc<Mutex<LiveStats>>,
-        log: Arc<RawChannel>,
+        events: LiveEvents,
     ) -> Self {
         Self {
             ring,
@@ -83,9 +82,8 @@ impl Pump {
             period_ns,
             viewers,
             stats,
-            log,
+            events,
             keys: Vec::new(),
-            transforms: None,
             live: None,
             unix_offset_ns: i128::from(messages::unix_now_ns()) - i128::from(robowire_rt::monotonic_ns()),
         }
@@ -179,7 +177,9 @@ impl Pump {
         match description.decode(frame.direction, frame.bytes()) {
             Ok(json) => {
                 self.json(link, frame.direction, &topic, description, &json, meta);
-                if let Some(transform) = messages::frame_transform(&name, &json.value, log_time) {
+                if !self.events.posed(device(&name))
+                    && let Some(transform) = messages::frame_transform(&name, &json.value, log_time)
+                {
                     self.transform(&transform, meta);
                 }
             }
@@ -265,11 +265,8 @@ impl Pump {
     }
 
     fn transform(&mut self, transform: &Value, meta: PartialMetadata) {
-        if self.transforms.is_none() {
-            self.transforms = self.channel("/tf", "json", messages::frame_transform_schema());
-        }
-        if let (Some(channel), Ok(bytes)) = (&self.transforms, serde_json::to_vec(transform)) {
-            channel.log_with_meta(&bytes, meta);
+        if let Ok(bytes) = serde_json::to_vec(transform) {
+            self.events.transforms.log_with_meta(&bytes, meta);
         }
     }
 
@@ -287,7 +284,7 @@ impl Pump {
     }
 
     fn log(&self, level: Level, name: &str, message: &str) {
-        messages::log(&self.log, level, name, message);
+        self.events.log(level, name, message);
     }
 
     fn publish_stats(&mut self) {

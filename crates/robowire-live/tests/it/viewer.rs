@@ -277,3 +277,42 @@ fn a_viewer_that_sends_what_no_foxglove_client_sends_is_closed_and_the_view_goes
             .await;
     });
 }
+
+#[test]
+fn a_simulator_s_body_is_the_base_frame_in_place_of_the_imu_s_attitude() {
+    let live = live(50.0);
+    let _feed = Feed::start(&live, Duration::from_millis(2));
+    let events = live.events();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let posing = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                events.base_pose("go2", [1.0, 2.0, 0.3], [0.0, 0.0, 0.5]);
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        })
+    };
+    wait::runtime().block_on(async {
+        let mut socket = connect(live.addr()).await;
+        let mut seen = Seen::default();
+        let z = |seen: &Seen| seen.messages.get("/tf").map(|_| seen.json("/tf")["translation"]["z"].clone());
+        read_until(&mut socket, &mut seen, "the body's pose", |s| z(s) == Some(json!(0.3))).await;
+        // Once posed, every frame of the base is the body's (the IMU's stop): after a moment to let
+        // what was already on its way arrive, 20 in a row.
+        let posed_at = seen.messages["/tf"].2;
+        read_until(&mut socket, &mut seen, "frames after the pose", |s| s.messages["/tf"].2 > posed_at + 10).await;
+        for _ in 0..20 {
+            let before = seen.messages["/tf"].2;
+            read_until(&mut socket, &mut seen, "the next frame", |s| s.messages["/tf"].2 > before).await;
+            let tf = seen.json("/tf");
+            assert_eq!(
+                (tf["child_frame_id"].as_str(), &tf["translation"]["z"]),
+                (Some("go2/base"), &json!(0.3)),
+                "{tf}"
+            );
+        }
+    });
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    posing.join().unwrap();
+}

@@ -362,15 +362,25 @@ fn until_ctrl_c_with_log(
     every_s: f64,
     take_log: impl Fn() -> Vec<String>,
     report: impl Fn() -> String,
+    live: Option<LiveBody<'_>>,
 ) -> anyhow::Result<()> {
     let print_log = || {
         for line in take_log() {
+            if let Some(live) = &live {
+                live.events.log(robowire_live::Level::Info, live.device, &line);
+            }
             println!("{line}");
         }
     };
     print_log();
     let mut last_report = std::time::Instant::now();
-    until_ctrl_c(0.1, || {
+    // 50 times a second: the base's pose for the live view.
+    until_ctrl_c(0.02, || {
+        if let Some(live) = &live
+            && let Some(base) = (live.base)()
+        {
+            live.events.base_pose(live.device, base.position_m.map(f64::from), base.rpy_rad.map(f64::from));
+        }
         print_log();
         if every_s.is_finite() && every_s > 0.0 && last_report.elapsed().as_secs_f64() >= every_s {
             last_report = std::time::Instant::now();
@@ -379,6 +389,14 @@ fn until_ctrl_c_with_log(
     })?;
     print_log();
     Ok(())
+}
+
+/// A simulated robot as the live view shows it: its log lines as events, its physics body's base
+/// as its frame.
+struct LiveBody<'a> {
+    events: robowire_live::LiveEvents,
+    device: &'static str,
+    base: &'a dyn Fn() -> Option<robowire_sim::go2::BasePose>,
 }
 
 fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
@@ -409,6 +427,7 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
         args.dds.domain
     );
     let last = std::cell::Cell::new((0.0, 0.0));
+    let base = || sim.snapshot().base;
     until_ctrl_c_with_log(
         args.report_every_s,
         || logs(sim.take_log(), walker.as_ref()),
@@ -416,6 +435,7 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
             let s = sim.snapshot();
             go2_report(&s) + &physics_report(s.base, s.sim_time_s, s.wall_time_s, &last)
         },
+        taps.events().map(|events| LiveBody { events, device: "go2", base: &base }),
     )?;
     let s = sim.snapshot();
     println!(
@@ -478,6 +498,7 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
         args.dds.domain
     );
     let last = std::cell::Cell::new((0.0, 0.0));
+    let base = || sim.snapshot().base;
     until_ctrl_c_with_log(
         args.report_every_s,
         || logs(sim.take_log(), walker.as_ref()),
@@ -485,6 +506,7 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
             let s = sim.snapshot();
             g1_report(&s) + &physics_report(s.base, s.stream.sim_time_s, s.stream.wall_time_s, &last)
         },
+        taps.events().map(|events| LiveBody { events, device: "g1", base: &base }),
     )?;
     let s = sim.snapshot();
     println!(
