@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 mod front;
+mod head;
 mod messages;
 mod page;
 mod pump;

@@ -15,7 +15,7 @@ use tokio::net::TcpStream;
 use tokio::net::tcp::{OwnedReadHalf, OwnedWriteHalf};
 use tokio::sync::mpsc;
 
-use crate::front::read_head;
+use crate::head::read_head;
 use crate::ws_frame::{self, FrameHeader, Opcode};
 
 /// Data frames waiting for one viewer, at most.

@@ -20,6 +20,7 @@ pub(crate) mod serve;
 pub(crate) mod shm;
 pub(crate) mod sim;
 pub(crate) mod sim_body;
+pub(crate) mod sim_loop;
 pub(crate) mod taps;
 pub(crate) mod unitree;
 pub(crate) mod watch_loop;

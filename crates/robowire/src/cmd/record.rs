@@ -89,28 +89,6 @@ fn create(path: Option<&Path>, command: &str, options: RecorderOptions) -> anyho
         .transpose()
 }
 
-/// Closes the capture and says what it holds.
-pub(crate) fn finish(recorder: Option<Recorder>) -> anyhow::Result<()> {
-    if let Some(recorder) = recorder {
-        let summary = recorder.finish().context("closing the capture")?;
-        eprintln!(
-            "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable, \
-             {} without JSON (the decoder fell behind){}",
-            summary.frames,
-            summary.dropped,
-            summary.oversize,
-            summary.decode_errors,
-            summary.json_skipped,
-            if summary.not_wire > 0 {
-                format!(", {} not in their wire encoding (left out)", summary.not_wire)
-            } else {
-                String::new()
-            }
-        );
-    }
-    Ok(())
-}
-
 #[derive(Debug, Args)]
 pub(crate) struct ReplayArgs {
     /// The capture (`--record FILE.mcap` of another command).

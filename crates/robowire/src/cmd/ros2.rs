@@ -159,7 +159,7 @@ pub(crate) fn run(args: Ros2Args) -> anyhow::Result<ExitCode> {
         );
     }
     drop(devices);
-    crate::cmd::record::finish(recorder)?;
+    crate::cmd::taps::finish_recorder(recorder)?;
     devices_taps.finish()?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);

@@ -162,28 +162,6 @@ pub(crate) fn run(command: SimCommand) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Runs until Ctrl-C, reporting every `every_s` seconds (0: never).
-fn until_ctrl_c(every_s: f64, mut report: impl FnMut()) -> anyhow::Result<()> {
-    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
-    runtime.block_on(async {
-        let enabled = every_s.is_finite() && every_s > 0.0;
-        let mut ticker = tokio::time::interval(Duration::from_secs_f64(if enabled { every_s } else { 3600.0 }));
-        ticker.tick().await;
-        // One listener for the whole loop: a Ctrl-C between two iterations is not lost.
-        let ctrl_c = tokio::signal::ctrl_c();
-        tokio::pin!(ctrl_c);
-        loop {
-            tokio::select! {
-                signal = &mut ctrl_c => {
-                    signal.context("waiting for Ctrl-C")?;
-                    return Ok(());
-                }
-                _ = ticker.tick(), if enabled => report(),
-            }
-        }
-    })
-}
-
 fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
     use zsl_proto::description::{IMU, SPLINE_DAEMON};
     let taps = args.record.start("robowire sim spline")?;
@@ -201,7 +179,7 @@ fn run_spline(args: &SplineSimArgs) -> anyhow::Result<ExitCode> {
         "spline daemon simulator on {} and {} (mode {:o}), 1 kHz. Try: robowire shm status --name {} --imu-name {}. Ctrl-C stops and removes the objects.",
         args.name, args.imu_name, args.mode, args.name, args.imu_name
     );
-    until_ctrl_c(args.report_every_s, || {
+    crate::cmd::sim_loop::until_ctrl_c(args.report_every_s, || {
         let s = sim.stats();
         eprintln!(
             "cycles {} missed {} | lateness p50 {} µs p99 {} µs max {} µs | commands fresh {} repeated {} cleared {} rejected {}",
@@ -241,7 +219,7 @@ fn run_kmc(args: &KmcSimArgs) -> anyhow::Result<ExitCode> {
         sim.pty_path().display(),
         sim.path().display()
     );
-    until_ctrl_c(args.report_every_s, || {
+    crate::cmd::sim_loop::until_ctrl_c(args.report_every_s, || {
         let (s, st) = (sim.stats(), sim.state());
         eprintln!(
             "cmd {:+.2} m/s {:+.2} 1/m | speed {:+.3} m/s | battery {:.2} V | rx: control {} speed-req {} af-read {} af-write {} | sent {} | skipped {} rejected {}",
@@ -288,7 +266,7 @@ fn run_zsl1(args: &Zsl1SimArgs) -> anyhow::Result<ExitCode> {
         args.client.map_or("the address commands come from".to_string(), |c| c.to_string()),
         args.bind
     );
-    until_ctrl_c(args.report_every_s, || {
+    crate::cmd::sim_loop::until_ctrl_c(args.report_every_s, || {
         let s = sim.snapshot();
         let [x, y, z] = s.robot.position_m();
         eprintln!(
@@ -355,50 +333,6 @@ fn g1_report(s: &robowire_sim::g1::G1Snapshot) -> String {
     )
 }
 
-/// Runs a simulator that keeps a log until Ctrl-C: its log lines on stdout as they come (every
-/// 0.1 s), the line `report()` gives on stderr every `every_s` seconds (0: never), the last log
-/// lines once stopped.
-fn until_ctrl_c_with_log(
-    every_s: f64,
-    take_log: impl Fn() -> Vec<String>,
-    report: impl Fn() -> String,
-    live: Option<LiveBody<'_>>,
-) -> anyhow::Result<()> {
-    let print_log = || {
-        for line in take_log() {
-            if let Some(live) = &live {
-                live.events.log(robowire_live::Level::Info, live.device, &line);
-            }
-            println!("{line}");
-        }
-    };
-    print_log();
-    let mut last_report = std::time::Instant::now();
-    // 50 times a second: the base's pose for the live view.
-    until_ctrl_c(0.02, || {
-        if let Some(live) = &live
-            && let Some(base) = (live.base)()
-        {
-            live.events.base_pose(live.device, base.position_m.map(f64::from), base.rpy_rad.map(f64::from));
-        }
-        print_log();
-        if every_s.is_finite() && every_s > 0.0 && last_report.elapsed().as_secs_f64() >= every_s {
-            last_report = std::time::Instant::now();
-            eprintln!("{}", report());
-        }
-    })?;
-    print_log();
-    Ok(())
-}
-
-/// A simulated robot as the live view shows it: its log lines as events, its physics body's base
-/// as its frame.
-struct LiveBody<'a> {
-    events: robowire_live::LiveEvents,
-    device: &'static str,
-    base: &'a dyn Fn() -> Option<robowire_sim::go2::BasePose>,
-}
-
 fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     use robowire_sim::go2::{Go2Sim, Go2SimConfig};
     #[cfg_attr(not(feature = "mujoco"), allow(unused_variables))]
@@ -428,14 +362,14 @@ fn run_go2(args: &Go2SimArgs) -> anyhow::Result<ExitCode> {
     );
     let last = std::cell::Cell::new((0.0, 0.0));
     let base = || sim.snapshot().base;
-    until_ctrl_c_with_log(
+    crate::cmd::sim_loop::until_ctrl_c_with_log(
         args.report_every_s,
         || logs(sim.take_log(), walker.as_ref()),
         || {
             let s = sim.snapshot();
             go2_report(&s) + &physics_report(s.base, s.sim_time_s, s.wall_time_s, &last)
         },
-        taps.events().map(|events| LiveBody { events, device: "go2", base: &base }),
+        taps.events().map(|events| crate::cmd::sim_loop::LiveBody { events, device: "go2", base: &base }),
     )?;
     let s = sim.snapshot();
     println!(
@@ -499,14 +433,14 @@ fn run_g1(args: &G1SimArgs) -> anyhow::Result<ExitCode> {
     );
     let last = std::cell::Cell::new((0.0, 0.0));
     let base = || sim.snapshot().base;
-    until_ctrl_c_with_log(
+    crate::cmd::sim_loop::until_ctrl_c_with_log(
         args.report_every_s,
         || logs(sim.take_log(), walker.as_ref()),
         || {
             let s = sim.snapshot();
             g1_report(&s) + &physics_report(s.base, s.stream.sim_time_s, s.stream.wall_time_s, &last)
         },
-        taps.events().map(|events| LiveBody { events, device: "g1", base: &base }),
+        taps.events().map(|events| crate::cmd::sim_loop::LiveBody { events, device: "g1", base: &base }),
     )?;
     let s = sim.snapshot();
     println!(

@@ -75,6 +75,28 @@ impl Taps {
                 stats.ring_dropped
             );
         }
-        crate::cmd::record::finish(self.recorder)
+        finish_recorder(self.recorder)
     }
+}
+
+/// Closes the capture and says what it holds.
+pub(crate) fn finish_recorder(recorder: Option<Recorder>) -> anyhow::Result<()> {
+    if let Some(recorder) = recorder {
+        let summary = recorder.finish().context("closing the capture")?;
+        eprintln!(
+            "record: {} frames written, {} dropped (the writer fell behind), {} oversize, {} not decodable, \
+             {} without JSON (the decoder fell behind){}",
+            summary.frames,
+            summary.dropped,
+            summary.oversize,
+            summary.decode_errors,
+            summary.json_skipped,
+            if summary.not_wire > 0 {
+                format!(", {} not in their wire encoding (left out)", summary.not_wire)
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
 }
