@@ -6,7 +6,7 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
 
-use tokio::io::{AsyncWriteExt, BufReader};
+use tokio::io::{AsyncReadExt, AsyncWriteExt, BufReader};
 use tokio::net::{TcpListener, TcpStream};
 
 use crate::head::{Head, read_head};
@@ -17,6 +17,10 @@ use crate::relay::{self, Viewers};
 const MAX_CONNECTIONS: usize = 64;
 /// How long a connection has to send its request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
+/// What a closing connection may still send, read and dropped, at most.
+const DRAIN_BYTES: u64 = 1 << 20;
+/// How long a closing connection is read for, at most.
+const DRAIN_FOR: Duration = Duration::from_secs(1);
 /// How long the front waits after a failed accept (out of file descriptors, say).
 const ACCEPT_RETRY: Duration = Duration::from_millis(100);
 /// Web pages that may open the WebSocket besides this address's own page: Foxglove's app.
@@ -61,14 +65,14 @@ async fn handle(
     let head = match tokio::time::timeout(HEAD_TIMEOUT, read_head(&mut read)).await {
         Ok(Ok(bytes)) => Head { bytes },
         Ok(Err(e)) if e.kind() == std::io::ErrorKind::OutOfMemory => {
-            return reply(write, response(431, "text/plain", b"request head too large\n", "")).await;
+            return reply(&mut read, write, response(431, "text/plain", b"request head too large\n", "")).await;
         }
-        _ => return reply(write, response(400, "text/plain", b"bad request\n", "")).await,
+        _ => return reply(&mut read, write, response(400, "text/plain", b"bad request\n", "")).await,
     };
     let (method, path) = head.request_line();
     if head.header("upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket")) {
         if !origin_allowed(head.header("origin").as_deref(), head.header("host").as_deref()) {
-            return reply(write, response(403, "text/plain", b"origin not allowed\n", "")).await;
+            return reply(&mut read, write, response(403, "text/plain", b"origin not allowed\n", "")).await;
         }
         return relay::relay(read, write, &head.bytes, upstream, addr, viewers).await;
     }
@@ -83,14 +87,21 @@ async fn handle(
     if method == "HEAD" {
         out.truncate(head_len(&out));
     }
-    reply(write, out).await
+    reply(&mut read, write, out).await
 }
 
-/// Writes `out`, then ends the connection: the write side shut, what the client still sends
-/// read and dropped for a moment, so that the reply is not lost to a reset.
-async fn reply(mut write: tokio::net::tcp::OwnedWriteHalf, out: Vec<u8>) -> std::io::Result<()> {
+/// Writes `out`, then ends the connection: the write side shut, then what the client still
+/// sends read and dropped (at most [`DRAIN_BYTES`], for at most [`DRAIN_FOR`]), so that closing
+/// with unread bytes does not reset the connection before the client has read the reply.
+async fn reply(
+    read: &mut BufReader<tokio::net::tcp::OwnedReadHalf>,
+    mut write: tokio::net::tcp::OwnedWriteHalf,
+    out: Vec<u8>,
+) -> std::io::Result<()> {
     write.write_all(&out).await?;
     write.shutdown().await?;
+    let (mut rest, mut sink) = (read.take(DRAIN_BYTES), tokio::io::sink());
+    let _ = tokio::time::timeout(DRAIN_FOR, tokio::io::copy(&mut rest, &mut sink)).await;
     Ok(())
 }
 

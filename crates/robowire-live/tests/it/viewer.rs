@@ -170,6 +170,7 @@ fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_base_fra
 fn get(addr: std::net::SocketAddr, request: &str) -> (String, Vec<u8>) {
     let mut stream = std::net::TcpStream::connect(addr).unwrap();
     stream.write_all(request.as_bytes()).unwrap();
+    // Done sending: the server sees the end of a request cut short at once.
     stream.shutdown(std::net::Shutdown::Write).unwrap();
     let mut response = Vec::new();
     stream.read_to_end(&mut response).unwrap();
