@@ -153,6 +153,7 @@ pub struct LiveServer {
     links: RecordLinks,
     events: LiveEvents,
     stats: Arc<Mutex<LiveStats>>,
+    viewers: Arc<relay::Viewers>,
     stop: Arc<AtomicBool>,
     pump: Option<std::thread::JoinHandle<()>>,
     foxglove: Option<WebSocketServerHandle>,
@@ -257,7 +258,7 @@ impl LiveServer {
         let (ring, registry) = (TapRing::with_slots(options.ring_slots), LinkRegistry::default());
         let viewers = Arc::new(relay::Viewers::default());
         let site = Arc::new(Plots { registry: registry.clone(), plots: options.plots.clone() });
-        let viewers_for_pump = viewers.clone();
+        let (viewers_for_pump, viewers_for_server) = (viewers.clone(), viewers.clone());
         runtime.handle().spawn(async move {
             // Registered with the runtime that polls it.
             if let Ok(listener) = tokio::net::TcpListener::from_std(listener) {
@@ -283,6 +284,7 @@ impl LiveServer {
             links: RecordLinks::new(ring, registry),
             events,
             stats,
+            viewers: viewers_for_server,
             stop,
             pump: Some(pump),
             foxglove: Some(foxglove),
@@ -304,6 +306,21 @@ impl LiveServer {
     /// Where events go to the viewers.
     pub fn events(&self) -> LiveEvents {
         self.events.clone()
+    }
+
+    /// Waits until a viewer is connected (Foxglove or the page), at most `within`: whether one
+    /// is. For a run that would otherwise be over before anyone looks (the demo).
+    pub fn wait_for_viewer(&self, within: std::time::Duration) -> bool {
+        let deadline = std::time::Instant::now() + within;
+        loop {
+            if !self.viewers.connected().is_empty() {
+                return true;
+            }
+            if std::time::Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
     }
 
     /// The counts as of the last second.

@@ -3,9 +3,10 @@
 //
 // node page.js http://HOST:PORT/ OUT.png SECONDS_MAX [DEVICE,...]: opens the page, waits until every
 // device it lists (window.robowireLive.devices) that has plots has one with at least MIN_POINTS
-// points, and every DEVICE named is listed, or SECONDS_MAX; screenshots the whole page to OUT.png;
+// points, and every DEVICE named is listed, or the server went away after the page connected,
+// or SECONDS_MAX; screenshots the whole page to OUT.png;
 // prints on stdout
-//   {"devices": {"go2": {"plots", "points", "nonEmptyPlots", "inkPixels"}}, "connected",
+//   {"devices": {"go2": {"plots", "points", "nonEmptyPlots", "inkPixels"}}, "connected", "wasConnected",
 //    "consoleErrors": [...], "waited_ms"}
 // where inkPixels counts the strongly coloured pixels (series, markers; not the grey axes and
 // grid) in the device's plot canvases.
@@ -67,12 +68,17 @@ async function main() {
     const start = Date.now();
     await page.goto(url, { waitUntil: "load" });
     let seen;
+    // Whether the page was connected at some point: a server that then goes away (a demo that
+    // ended) ends the wait, what it drew stays.
+    let wasConnected = false;
     for (;;) {
       seen = await page.evaluate(survey);
       const withPlots = Object.values(seen.devices).filter((d) => d.plots > 0);
       const listed = expectedDevices.every((name) => name in seen.devices);
       const done = listed && withPlots.length > 0 && withPlots.every((d) => d.maxPlotPoints >= MIN_POINTS);
-      if (done || Date.now() - start > Number(secondsMax) * 1000) break;
+      const gone = wasConnected && !seen.connected;
+      wasConnected ||= seen.connected;
+      if (done || gone || Date.now() - start > Number(secondsMax) * 1000) break;
       await new Promise((r) => setTimeout(r, POLL_MS));
     }
     const waited_ms = Date.now() - start;
@@ -81,7 +87,7 @@ async function main() {
     await page.screenshot({ path: out, fullPage: true });
     seen = await page.evaluate(survey);
     for (const d of Object.values(seen.devices)) delete d.maxPlotPoints;
-    process.stdout.write(JSON.stringify({ ...seen, consoleErrors, waited_ms }) + "\n");
+    process.stdout.write(JSON.stringify({ ...seen, wasConnected, consoleErrors, waited_ms }) + "\n");
   } finally {
     await browser.close();
   }

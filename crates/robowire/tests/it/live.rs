@@ -100,7 +100,8 @@ fn the_demo_s_live_page_draws_every_device_in_chromium() {
             node(&node_modules, "page.js", &[&format!("http://{addr}/"), shot.to_str().unwrap(), "60", devices]);
         let status = demo.wait().unwrap();
         assert!(status.success(), "the demo: {status}\n{}", stderr.try_iter().collect::<Vec<_>>().join("\n"));
-        assert_eq!(report["connected"], true, "{report}");
+        // The demo may have ended before the page stopped waiting: what it drew stays.
+        assert_eq!(report["wasConnected"], true, "{report}");
         for device in devices.split(',') {
             let d = &report["devices"][device];
             assert!(d["nonEmptyPlots"].as_u64() > Some(0) && d["inkPixels"].as_u64() > Some(100), "{device}: {report}");

@@ -113,6 +113,9 @@ impl Device {
 /// device's links recorded with the recorder, if any.
 type Scenario = fn(f64, &Output, Option<&RecordLinks>) -> anyhow::Result<DeviceReport>;
 
+/// How long `demo --live` waits for its first viewer.
+const LIVE_VIEWER_WAIT: std::time::Duration = std::time::Duration::from_secs(30);
+
 /// Runs the demo; `loopback`: where the DDS scenarios run (`None`: they are not run).
 pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
@@ -156,6 +159,14 @@ pub(crate) fn run(args: &DemoArgs, loopback: Option<Loopback>) -> anyhow::Result
     let record = taps.links();
     if let Some(events) = taps.events() {
         out.also_to(events, "demo");
+    }
+    if let Some(live) = &taps.live {
+        // Each device's scenario is over in seconds: the first viewer is waited for, so that it
+        // sees every device.
+        eprintln!("live: waiting up to {} s for a viewer", LIVE_VIEWER_WAIT.as_secs());
+        if !live.wait_for_viewer(LIVE_VIEWER_WAIT) {
+            eprintln!("live: no viewer; the demo runs all the same");
+        }
     }
     let mut reports = Vec::new();
     for (device, scenario) in scenarios {
