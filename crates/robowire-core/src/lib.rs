@@ -2,10 +2,14 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "std")]
+extern crate std;
+
 pub mod cdr;
 mod datagram;
 #[cfg(feature = "json")]
 pub mod json;
+pub mod kinematics;
 pub mod le;
 pub mod schedule;
 #[cfg(feature = "serde")]

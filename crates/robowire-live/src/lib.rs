@@ -7,6 +7,7 @@ mod messages;
 mod page;
 mod pump;
 mod relay;
+mod resubscribe;
 mod ws_frame;
 
 use std::net::SocketAddr;
@@ -14,7 +15,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use foxglove::{ChannelBuilder, Context, RawChannel, WebSocketServer, WebSocketServerHandle};
-use robowire_core::json::LinkPlots;
+use robowire_core::json::{JsonFrame, LinkPlots};
+use robowire_core::kinematics::Kinematics;
 use robowire_tap::{LinkRegistry, RecordLinks, TapRing};
 use serde_json::json;
 
@@ -29,6 +31,9 @@ pub struct LiveOptions {
     pub rate_hz: f64,
     /// The plots the page draws, by protocol (each codec's `PLOTS`).
     pub plots: Vec<&'static LinkPlots>,
+    /// The robots whose bodies are placed from their states' joint positions (`/tf_joints`),
+    /// each for the devices of its name.
+    pub robots: Vec<&'static Kinematics>,
     /// The server's name, as Foxglove shows it.
     pub name: String,
     /// Slots of the taps' ring ([`TapRing::with_slots`]): frames waiting for the live view's
@@ -38,7 +43,7 @@ pub struct LiveOptions {
 
 impl Default for LiveOptions {
     fn default() -> Self {
-        Self { rate_hz: 50.0, plots: Vec::new(), name: "robowire".into(), ring_slots: 4096 }
+        Self { rate_hz: 50.0, plots: Vec::new(), robots: Vec::new(), name: "robowire".into(), ring_slots: 4096 }
     }
 }
 
@@ -108,6 +113,9 @@ pub struct LiveStats {
 pub struct LiveEvents {
     channel: Arc<RawChannel>,
     transforms: Arc<RawChannel>,
+    /// `/tf_joints`: a robot's bodies, by [`LiveOptions::robots`].
+    joints: Arc<RawChannel>,
+    robots: Arc<[&'static Kinematics]>,
     /// Devices whose base is given by [`base_pose`](Self::base_pose): no attitude from their
     /// IMU is sent for them.
     posed: Arc<Mutex<Vec<String>>>,
@@ -128,6 +136,18 @@ impl LiveEvents {
     /// Whether `device`'s base is given by [`base_pose`](Self::base_pose).
     pub(crate) fn posed(&self, device: &str) -> bool {
         self.posed.lock().unwrap_or_else(PoisonError::into_inner).iter().any(|d| d == device)
+    }
+
+    /// `device`'s bodies from its decoded `state`, if a robot of its name has a table and the
+    /// state is that robot's.
+    pub(crate) fn joints(&self, device: &str, state: &JsonFrame, meta: foxglove::PartialMetadata) {
+        let unix_ns = meta.log_time.unwrap_or(0);
+        let robot = self.robots.iter().find(|r| r.robot == device && r.state_schema == state.schema);
+        if let Some(transforms) = robot.and_then(|r| messages::joint_transforms(device, r, &state.value, unix_ns))
+            && let Ok(bytes) = serde_json::to_vec(&transforms)
+        {
+            self.joints.log_with_meta(&bytes, meta);
+        }
     }
 
     /// `device`'s base (`{device}/base`) in the world: its position, m, and roll, pitch, yaw
@@ -254,7 +274,9 @@ impl LiveServer {
         };
         let log = channel("/robowire/log", messages::log_schema())?;
         let transforms = channel("/tf", messages::frame_transform_schema())?;
-        let events = LiveEvents { channel: log, transforms, posed: Arc::default() };
+        let joints = channel("/tf_joints", messages::frame_transforms_schema())?;
+        let robots = options.robots.clone().into();
+        let events = LiveEvents { channel: log, transforms, joints, robots, posed: Arc::default() };
         let (ring, registry) = (TapRing::with_slots(options.ring_slots), LinkRegistry::default());
         let viewers = Arc::new(relay::Viewers::default());
         let site = Arc::new(Plots { registry: registry.clone(), plots: options.plots.clone() });

@@ -1,11 +1,12 @@
 //! The messages the live view makes itself, in Foxglove's well-known schemas (JSON encoded):
-//! `foxglove.Log` for events, `foxglove.FrameTransform` for a robot's attitude; and its own
-//! counts.
+//! `foxglove.Log` for events, `foxglove.FrameTransform` for a robot's base and
+//! `foxglove.FrameTransforms` for its bodies; and its own counts.
 
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use foxglove::{RawChannel, Schema};
 use robowire_core::json::Value;
+use robowire_core::kinematics::Kinematics;
 use serde_json::json;
 
 use crate::LiveStats;
@@ -71,6 +72,17 @@ fn time_schema() -> Value {
     })
 }
 
+/// `child` in `parent`: a translation, m, then a rotation (w, x, y, z).
+fn transform(parent: &str, child: &str, translation_m: [f64; 3], [w, x, y, z]: [f64; 4], unix_ns: u64) -> Value {
+    json!({
+        "timestamp": time(unix_ns),
+        "parent_frame_id": parent,
+        "child_frame_id": child,
+        "translation": { "x": translation_m[0], "y": translation_m[1], "z": translation_m[2] },
+        "rotation": { "x": x, "y": y, "z": z, "w": w },
+    })
+}
+
 /// A robot's base in the world from a decoded state: its attitude from the IMU's quaternion
 /// (`imu_state.quaternion`, Unitree's w, x, y, z) and, where the state says it
 /// (`rt/sportmodestate`), its position; the frame is `{device}/base`, the device the link's first
@@ -87,13 +99,8 @@ pub(crate) fn frame_transform(link: &str, state: &Value, unix_ns: u64) -> Option
     let position = state.pointer("/position").and_then(Value::as_array).filter(|p| p.len() == 3);
     let at = |i: usize| position.and_then(|p| number(&p[i])).unwrap_or(0.0);
     let device = link.split('/').next().unwrap_or(link);
-    Some(json!({
-        "timestamp": time(unix_ns),
-        "parent_frame_id": "world",
-        "child_frame_id": format!("{device}/base"),
-        "translation": { "x": at(0), "y": at(1), "z": at(2) },
-        "rotation": { "x": x / norm, "y": y / norm, "z": z / norm, "w": w / norm },
-    }))
+    let rotation = [w, x, y, z].map(|c| c / norm);
+    Some(transform("world", &format!("{device}/base"), [at(0), at(1), at(2)], rotation, unix_ns))
 }
 
 /// A robot's base in the world from where a simulator or an estimator says it is: position, m,
@@ -101,28 +108,45 @@ pub(crate) fn frame_transform(link: &str, state: &Value, unix_ns: u64) -> Option
 pub(crate) fn base_transform(device: &str, position_m: [f64; 3], rpy_rad: [f64; 3], unix_ns: u64) -> Value {
     let [roll, pitch, yaw] = rpy_rad.map(|a| a / 2.0);
     let (cr, sr, cp, sp, cy, sy) = (roll.cos(), roll.sin(), pitch.cos(), pitch.sin(), yaw.cos(), yaw.sin());
-    json!({
-        "timestamp": time(unix_ns),
-        "parent_frame_id": "world",
-        "child_frame_id": format!("{device}/base"),
-        "translation": { "x": position_m[0], "y": position_m[1], "z": position_m[2] },
-        "rotation": {
-            "x": sr * cp * cy - cr * sp * sy,
-            "y": cr * sp * cy + sr * cp * sy,
-            "z": cr * cp * sy - sr * sp * cy,
-            "w": cr * cp * cy + sr * sp * sy,
-        },
-    })
+    let rotation = [
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    ];
+    transform("world", &format!("{device}/base"), position_m, rotation, unix_ns)
 }
 
-/// The JSON schema of `foxglove.FrameTransform`.
-pub(crate) fn frame_transform_schema() -> Schema {
+/// A robot's bodies from a decoded state of `robot`'s: each body's frame (`{device}/{body}`) in
+/// its parent's (`{device}/base` for the base's children) at the state's joint positions, as
+/// one `foxglove.FrameTransforms`. A body whose hinge's position is missing or not finite is left
+/// out. `None` for a state without its motors.
+pub(crate) fn joint_transforms(device: &str, robot: &Kinematics, state: &Value, unix_ns: u64) -> Option<Value> {
+    let motors = state.pointer(robot.motors)?.as_array()?;
+    let transforms: Vec<Value> = robot
+        .bodies
+        .iter()
+        .filter_map(|body| {
+            let q = match body.hinge {
+                Some(hinge) => Some(motors.get(hinge.motor)?.get("q")?.as_f64().filter(|q| q.is_finite())?),
+                None => None,
+            };
+            let pose = body.pose(q);
+            let (parent, child) = (format!("{device}/{}", body.parent), format!("{device}/{}", body.name));
+            Some(transform(&parent, &child, pose.translation_m, pose.rotation, unix_ns))
+        })
+        .collect();
+    Some(json!({ "transforms": transforms }))
+}
+
+/// `foxglove.FrameTransform`'s JSON schema.
+fn frame_transform_json_schema() -> Value {
     let vector = |names: &[&str]| {
         let properties: serde_json::Map<String, Value> =
             names.iter().map(|n| ((*n).to_string(), json!({ "type": "number" }))).collect();
         json!({ "type": "object", "properties": properties })
     };
-    let schema = json!({
+    json!({
         "title": "foxglove.FrameTransform",
         "type": "object",
         "properties": {
@@ -132,8 +156,23 @@ pub(crate) fn frame_transform_schema() -> Schema {
             "translation": vector(&["x", "y", "z"]),
             "rotation": vector(&["x", "y", "z", "w"]),
         },
-    });
+    })
+}
+
+/// The schema of `foxglove.FrameTransform`.
+pub(crate) fn frame_transform_schema() -> Schema {
+    let schema = frame_transform_json_schema();
     Schema::new("foxglove.FrameTransform", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())
+}
+
+/// The schema of `foxglove.FrameTransforms`.
+pub(crate) fn frame_transforms_schema() -> Schema {
+    let schema = json!({
+        "title": "foxglove.FrameTransforms",
+        "type": "object",
+        "properties": { "transforms": { "type": "array", "items": frame_transform_json_schema() } },
+    });
+    Schema::new("foxglove.FrameTransforms", "jsonschema", serde_json::to_vec(&schema).unwrap_or_default())
 }
 
 /// The counts as `/robowire/live` says them.

@@ -3,7 +3,8 @@
 //! frames of one message type mostly share a length, so a slow type is not starved by a fast one
 //! on the same link), decodes those to JSON by their link's
 //! description and logs them to the Foxglove channels, made on first use; a Unitree payload also
-//! goes as the CDR it is, a robot's IMU attitude as a `foxglove.FrameTransform`.
+//! goes as the CDR it is, a robot's IMU attitude as a `foxglove.FrameTransform`, its bodies at
+//! its joints' positions as `foxglove.FrameTransforms`.
 
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -177,6 +178,7 @@ impl Pump {
         match description.decode(frame.direction, frame.bytes()) {
             Ok(json) => {
                 self.json(link, frame.direction, &topic, description, &json, meta);
+                self.events.joints(device(&name), &json, meta);
                 if !self.events.posed(device(&name))
                     && let Some(transform) = messages::frame_transform(&name, &json.value, log_time)
                 {

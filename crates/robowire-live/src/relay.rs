@@ -3,7 +3,8 @@
 //! status) and its data messages. A viewer that does not read loses data messages, whole and
 //! counted, never the JSON; only a viewer so far behind that even the JSON queue fills is
 //! disconnected, as Foxglove's server does. A viewer that sends what no Foxglove client sends is
-//! closed (1002, or 1009 for an oversize frame).
+//! closed (1002, or 1009 for an oversize frame). A subscription the server refuses for a channel
+//! it has just advertised is asked again ([`crate::resubscribe`]).
 
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -16,6 +17,7 @@ use tokio::net::tcp::{OwnedReadHalf, OwnedWriteHalf};
 use tokio::sync::mpsc;
 
 use crate::head::read_head;
+use crate::resubscribe::Subscriptions;
 use crate::ws_frame::{self, FrameHeader, Opcode};
 
 /// Data frames waiting for one viewer, at most.
@@ -130,13 +132,17 @@ async fn frames(
     mut viewer_read: BufReader<OwnedReadHalf>,
     mut viewer_write: OwnedWriteHalf,
     mut server_read: BufReader<OwnedReadHalf>,
-    mut server_write: OwnedWriteHalf,
+    server_write: OwnedWriteHalf,
     counters: &ViewerCounters,
 ) -> std::io::Result<()> {
     let (control_tx, mut control) = mpsc::channel::<Vec<u8>>(CONTROL_QUEUE_FRAMES);
     let (data_tx, mut data) = mpsc::channel::<Vec<u8>>(DATA_QUEUE_FRAMES);
+    // The viewer's frames, and a subscription asked again, go to the server whole, one at a time.
+    let server_write = Arc::new(tokio::sync::Mutex::new(server_write));
+    let subscriptions = Mutex::new(Subscriptions::default());
     // The three directions borrow the halves; they are dropped at this block's end.
     let broke = {
+        let (subscriptions, server_write) = (&subscriptions, &server_write);
         let from_server = async move {
             // Whether the rest of the data message being read is dropped.
             let mut dropping = false;
@@ -170,6 +176,17 @@ async fn frames(
                     }
                 } else {
                     let last = header.opcode == Opcode::Close;
+                    let retry = (header.opcode == Opcode::Text && header.fin)
+                        .then(|| lock(subscriptions).retry(&frame[header.header_len..]))
+                        .flatten();
+                    if let Some((pause, request)) = retry {
+                        let server_write = server_write.clone();
+                        tokio::spawn(async move {
+                            tokio::time::sleep(pause).await;
+                            let _ = server_write.lock().await.write_all(&request).await;
+                        });
+                        continue;
+                    }
                     // Full: this viewer is too far behind for even the server's JSON.
                     if control_tx.try_send(frame).is_err() {
                         return;
@@ -204,10 +221,12 @@ async fn frames(
                     Err(e) if e.kind() == std::io::ErrorKind::InvalidData => return Ended::Broke(1002, e.to_string()),
                     Err(_) => return Ended::Closed,
                 };
-                if let Err(reason) = check_viewer_frame(&header, &frame) {
-                    return Ended::Broke(1002, reason);
+                match check_viewer_frame(&header, &frame) {
+                    Ok(Some(request)) => lock(subscriptions).note(&request),
+                    Ok(None) => {}
+                    Err(reason) => return Ended::Broke(1002, reason),
                 }
-                if server_write.write_all(&frame).await.is_err() || header.opcode == Opcode::Close {
+                if server_write.lock().await.write_all(&frame).await.is_err() || header.opcode == Opcode::Close {
                     return Ended::Closed;
                 }
             }
@@ -269,9 +288,14 @@ pub(crate) async fn read_frame(
     Ok((header, frame))
 }
 
+fn lock(subscriptions: &Mutex<Subscriptions>) -> std::sync::MutexGuard<'_, Subscriptions> {
+    subscriptions.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
 /// A viewer's frame as a Foxglove client sends one: masked; text a whole JSON object whose `op`
-/// is a client operation; no binary (this server takes no client data, services or playback).
-fn check_viewer_frame(header: &FrameHeader, frame: &[u8]) -> Result<(), String> {
+/// is a client operation (that request, for a text frame); no binary (this server takes no client
+/// data, services or playback).
+fn check_viewer_frame(header: &FrameHeader, frame: &[u8]) -> Result<Option<serde_json::Value>, String> {
     let Some(key) = header.mask else { return Err("an unmasked frame".into()) };
     match header.opcode {
         Opcode::Text if header.fin => {
@@ -279,14 +303,14 @@ fn check_viewer_frame(header: &FrameHeader, frame: &[u8]) -> Result<(), String> 
             ws_frame::unmask(&mut payload, key);
             let request: serde_json::Value = serde_json::from_slice(&payload).map_err(|_| "not JSON".to_string())?;
             match request.get("op").and_then(|op| op.as_str()) {
-                Some(op) if VIEWER_OPS.contains(&op) => Ok(()),
+                Some(op) if VIEWER_OPS.contains(&op) => Ok(Some(request)),
                 Some(op) => Err(format!("unknown op {:?}", op.chars().take(32).collect::<String>())),
                 None => Err("no op".into()),
             }
         }
         Opcode::Text | Opcode::Continuation => Err("a fragmented message".into()),
         Opcode::Binary => Err("a binary message (no client data is taken)".into()),
-        Opcode::Close | Opcode::Ping | Opcode::Pong => Ok(()),
+        Opcode::Close | Opcode::Ping | Opcode::Pong => Ok(None),
     }
 }
 
@@ -310,7 +334,8 @@ mod tests {
             let (h, f) = masked_text(text);
             check_viewer_frame(&h, &f)
         };
-        assert_eq!(check(r#"{"op":"subscribe","subscriptions":[{"id":0,"channelId":1}]}"#), Ok(()));
+        let subscribe = r#"{"op":"subscribe","subscriptions":[{"id":0,"channelId":1}]}"#;
+        assert_eq!(check(subscribe), Ok(Some(serde_json::from_str(subscribe).unwrap())));
         assert_eq!(check("not json"), Err("not JSON".into()));
         assert_eq!(check(r#"{"op":"nope"}"#), Err("unknown op \"nope\"".into()));
         assert_eq!(check("[1]"), Err("no op".into()));

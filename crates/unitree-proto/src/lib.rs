@@ -17,6 +17,7 @@ pub mod g1;
 pub mod go2;
 pub mod hg;
 pub mod idl;
+pub mod kinematics;
 pub mod layout;
 mod message;
 pub mod plan;

@@ -10,17 +10,23 @@ use robowire_core::Direction;
 use robowire_live::{LiveOptions, LiveServer};
 use unitree_proto::{CdrEncoding, LowCmd, LowState, Message};
 
-/// A live view on a free port of 127.0.0.1, at `rate_hz`, with every codec's plots.
+/// A live view on a free port of 127.0.0.1, at `rate_hz`, with every codec's plots and the
+/// Unitree robots' bodies.
 pub(crate) fn live(rate_hz: f64) -> LiveServer {
     let plots = unitree_proto::description::PLOTS.iter().chain(&kmc_proto::description::PLOTS).collect();
-    let options = LiveOptions { rate_hz, plots, ..LiveOptions::default() };
+    let robots = unitree_proto::kinematics::ROBOTS.to_vec();
+    let options = LiveOptions { rate_hz, plots, robots, ..LiveOptions::default() };
     LiveServer::start("127.0.0.1:0".parse().unwrap(), options).unwrap()
 }
 
-/// A Go2 LowState, level, as XCDR1 with its header.
+/// The front right calf's position in every [`low_state`], rad.
+pub(crate) const FR_CALF_RAD: f32 = -1.3;
+
+/// A Go2 LowState, level, its front right calf at [`FR_CALF_RAD`], as XCDR1 with its header.
 pub(crate) fn low_state(tick: u32) -> Vec<u8> {
     let mut state = LowState::default();
     state.imu_state.quaternion = [1.0, 0.0, 0.0, 0.0].map(Into::into);
+    state.motor_state[2].q = FR_CALF_RAD.into();
     state.tick = tick.into();
     let mut payload = vec![0; 2048];
     let n = state.encode_cdr(CdrEncoding::Xcdr1, &mut payload).unwrap();

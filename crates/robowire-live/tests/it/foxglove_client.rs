@@ -47,6 +47,9 @@ fn foxglove_s_client_decodes_every_channel_the_json_and_the_cdr_by_the_advertise
     let json = channel(&report, "/go2/low_level/received/unitree_go::msg::dds_::LowState_");
     assert_eq!(json["first"]["imu_state"]["quaternion"][0], 1.0, "{json}");
     assert_eq!(channel(&report, "/tf")["first"]["child_frame_id"], "go2/base");
+    let joints = channel(&report, "/tf_joints");
+    assert_eq!(joints["schemaName"], "foxglove.FrameTransforms");
+    assert_eq!(joints["first"]["transforms"][0]["child_frame_id"], "go2/FR_hip", "{joints}");
     assert_eq!(channel(&report, "/robowire/log")["schemaName"], "foxglove.Log");
     let malformed = node(&node_modules, "client.js", &[&url, "0", "--malformed"]);
     for case in malformed["malformed"].as_array().unwrap() {

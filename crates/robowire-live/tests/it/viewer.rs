@@ -15,7 +15,7 @@ use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode;
 use tokio_tungstenite::tungstenite::{Message, protocol::CloseFrame};
 use tokio_tungstenite::{MaybeTlsStream, WebSocketStream};
 
-use crate::feed::{Feed, live, low_state};
+use crate::feed::{FR_CALF_RAD, Feed, live, low_state};
 
 type Socket = WebSocketStream<MaybeTlsStream<TcpStream>>;
 
@@ -114,17 +114,25 @@ async fn read_until(socket: &mut Socket, seen: &mut Seen, what: &str, done: impl
             seen.take(socket, message).await;
         }
     };
-    tokio::time::timeout(WITHIN, reading).await.unwrap_or_else(|_| panic!("not within {WITHIN:?}: {what}"));
+    if tokio::time::timeout(WITHIN, reading).await.is_err() {
+        let mut topics: Vec<_> = seen.messages.iter().map(|(topic, (_, _, n))| format!("{topic} ({n})")).collect();
+        topics.sort();
+        let mut advertised: Vec<_> = seen.channels.values().map(|c| c.topic.clone()).collect();
+        advertised.sort();
+        let log = seen.messages.get("/robowire/log").map(|(_, last, _)| String::from_utf8_lossy(last).into_owned());
+        panic!("not within {WITHIN:?}: {what}; seen: {topics:?}; advertised: {advertised:?}; last log: {log:?}");
+    }
 }
 
 const LOW_STATE: &str = "/go2/low_level/received/unitree_go::msg::dds_::LowState_";
 const LOW_CMD: &str = "/go2/low_level/sent/unitree_go::msg::dds_::LowCmd_";
 
 #[test]
-fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_base_frame() {
+fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_robot_s_frames() {
     let live = live(50.0);
     let feed = Feed::start(&live, Duration::from_millis(2));
-    let topics = [LOW_STATE, LOW_CMD, "/go2/low_level/received", "/go2/low_level/sent", "/tf", "/robowire/live"];
+    let topics =
+        [LOW_STATE, LOW_CMD, "/go2/low_level/received", "/go2/low_level/sent", "/tf", "/tf_joints", "/robowire/live"];
     wait::runtime().block_on(async {
         let mut socket = connect(live.addr()).await;
         let mut seen = Seen::default();
@@ -153,6 +161,24 @@ fn a_viewer_gets_every_link_as_json_the_unitree_payloads_as_cdr_and_the_base_fra
         assert_eq!((tf["parent_frame_id"].as_str(), tf["child_frame_id"].as_str()), (Some("world"), Some("go2/base")));
         assert_eq!(tf["rotation"]["w"], 1.0);
         assert_eq!(seen.channel("/tf").schema_name, "foxglove.FrameTransform");
+        // The bodies from the LowState's joints: the Go2's 12 and its 4 feet.
+        assert_eq!(seen.channel("/tf_joints").schema_name, "foxglove.FrameTransforms");
+        let joints = seen.json("/tf_joints");
+        let transforms = joints["transforms"].as_array().unwrap();
+        assert_eq!(transforms.len(), 16, "{joints}");
+        let frame = |child: &str| transforms.iter().find(|t| t["child_frame_id"] == child).unwrap().clone();
+        let hip = frame("go2/FR_hip");
+        assert_eq!(
+            (hip["parent_frame_id"].as_str(), hip["translation"]["x"].as_f64()),
+            (Some("go2/base"), Some(0.1934))
+        );
+        // The calf turned about its +y by its position: the quaternion of that half angle.
+        let calf = frame("go2/FR_calf");
+        assert_eq!(calf["parent_frame_id"], "go2/FR_thigh");
+        let half = f64::from(FR_CALF_RAD) / 2.0;
+        let (w, y) = (calf["rotation"]["w"].as_f64().unwrap(), calf["rotation"]["y"].as_f64().unwrap());
+        assert!((w - half.cos()).abs() < 1e-9 && (y - half.sin()).abs() < 1e-9, "{calf}");
+        assert_eq!(frame("go2/FR_foot")["translation"]["z"], -0.213);
         let counts = seen.json("/robowire/live");
         let go2 = counts["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/go2/low_level/received");
         let go2 = go2.unwrap_or_else(|| panic!("{counts}"));

@@ -13,6 +13,8 @@
 //! the bodies below it.
 
 mod band;
+#[cfg(test)]
+mod kinematics_check;
 mod rig;
 
 use std::path::{Path, PathBuf};

@@ -31,6 +31,7 @@ impl LiveArgs {
         let options = LiveOptions {
             rate_hz: self.live_rate,
             plots: crate::cmd::captures::link_plots(),
+            robots: unitree_proto::kinematics::ROBOTS.to_vec(),
             name: command.to_owned(),
             ..LiveOptions::default()
         };

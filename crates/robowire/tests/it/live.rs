@@ -62,7 +62,7 @@ fn channel<'a>(report: &'a Value, topic: &str) -> &'a Value {
 }
 
 #[test]
-fn sim_go2_live_opens_in_foxglove_s_client_with_its_json_its_cdr_and_its_frame() {
+fn sim_go2_live_opens_in_foxglove_s_client_with_its_json_its_cdr_and_its_frames() {
     let Some(node_modules) = node_modules() else { return };
     with_loopback_multicast(|| {
         let (mut sim, addr, _) = start_live(&["sim", "go2", "--interface", "lo"]);
@@ -82,6 +82,14 @@ fn sim_go2_live_opens_in_foxglove_s_client_with_its_json_its_cdr_and_its_frame()
         assert_eq!(
             (tf["schemaName"].as_str(), tf["first"]["child_frame_id"].as_str()),
             (Some("foxglove.FrameTransform"), Some("go2/base"))
+        );
+        // The Go2's bodies from its LowState's joints, hanging from the base.
+        let joints = channel(&report, "/tf_joints");
+        let hip = &joints["first"]["transforms"][0];
+        assert_eq!(
+            (joints["schemaName"].as_str(), hip["parent_frame_id"].as_str(), hip["child_frame_id"].as_str()),
+            (Some("foxglove.FrameTransforms"), Some("go2/base"), Some("go2/FR_hip")),
+            "{joints}"
         );
         assert!(channel(&report, "/robowire/live")["count"].as_u64() >= Some(1), "{report}");
     });
