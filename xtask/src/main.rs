@@ -30,9 +30,9 @@ enum Task {
         #[arg(long, default_value_t = 20)]
         time: u64,
     },
-    /// Run every test of the project: `cargo test --workspace`, the physics tests (when MuJoCo
-    /// is here: `cargo xtask mujoco`), then the Python suite on the wheel built as users build
-    /// it, on CPython 3.10 and 3.12 (or 3.13).
+    /// Run every test of the project: `cargo test --workspace`, the Python suite on the wheel
+    /// built as users build it, on CPython 3.10 and 3.12 (or 3.13), then the physics tests (when
+    /// MuJoCo is here: `cargo xtask mujoco`).
     Test {
         /// Only the Python suite (the wheel, both CPythons).
         #[arg(long)]

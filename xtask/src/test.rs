@@ -33,12 +33,14 @@ fn is_root() -> bool {
         .unwrap_or(false)
 }
 
-/// `cargo test --workspace`, the physics tests ([`crate::mujoco`]), then the Python suite.
+/// `cargo test --workspace`, the Python suite, then the physics tests ([`crate::mujoco`]).
 pub fn test_all() -> anyhow::Result<()> {
     let root = workspace_root();
     cargo(&root, &["test", "--workspace"])?;
-    crate::mujoco::test(&root, &target_dir(&root))?;
-    test_python()
+    // The Python suite runs the CLI that run built (`target/debug/robowire`): built again by
+    // itself, with the features of its own dependencies only, half the workspace would be rebuilt.
+    python_suite(&root)?;
+    crate::mujoco::test(&root, &target_dir(&root))
 }
 
 /// Builds the wheel and runs the Python suite: on the CPython 3.10 interop environment (gated
@@ -49,8 +51,13 @@ pub fn test_all() -> anyhow::Result<()> {
 /// before, outside.
 pub fn test_python() -> anyhow::Result<()> {
     let root = workspace_root();
-    let target = target_dir(&root);
     cargo(&root, &["build", "-q", "-p", "robowire"])?;
+    python_suite(&root)
+}
+
+/// [`test_python`] with the CLI built.
+fn python_suite(root: &Path) -> anyhow::Result<()> {
+    let target = target_dir(root);
     let py310 = match unitree_python() {
         Ok(python) => Some(python),
         Err(e) => {
@@ -60,7 +67,7 @@ pub fn test_python() -> anyhow::Result<()> {
     };
     let (version, second) = second_python()?;
     let second_venv = bare_venv(&target, &version, &second)?;
-    let wheel = build_wheel(&root, &target, py310.as_ref().unwrap_or(&second_venv))?;
+    let wheel = build_wheel(root, &target, py310.as_ref().unwrap_or(&second_venv))?;
     // DDS: root makes its namespace in the suite; anyone else runs it in a user namespace.
     let userns = if is_root() { Ok(false) } else { userns::command("true").map(|_| true) };
     let dds = match &userns {
@@ -80,7 +87,7 @@ pub fn test_python() -> anyhow::Result<()> {
     };
     let runs = py310.map(|python| suite(python, "vendor,sdk,mcap,cli")).into_iter().chain([suite(second_venv, "cli")]);
     for run_ in runs {
-        pytest_run(&root, &target, &run_, &userns, dds)?;
+        pytest_run(root, &target, &run_, &userns, dds)?;
     }
     // With MuJoCo here, the physics tests once more on a wheel built with the feature, in a
     // venv of their own: after the suite's runs, as maturin also writes each wheel it builds
@@ -88,10 +95,10 @@ pub fn test_python() -> anyhow::Result<()> {
     match crate::mujoco::lib_dir(&target) {
         Ok(dir) => {
             let venv = bare_venv(&target, &format!("{version}-physics"), &second)?;
-            let wheel = build_wheel_with(&root, &target, &venv, Some(&dir))?;
+            let wheel = build_wheel_with(root, &target, &venv, Some(&dir))?;
             let tests = &["test_physics.py", "test_policy.py"];
             let physics = PytestRun { python: venv, wheel, require: "physics".into(), tests, mujoco: Some(dir) };
-            pytest_run(&root, &target, &physics, &userns, dds)
+            pytest_run(root, &target, &physics, &userns, dds)
         }
         Err(missing) => interop::missing("the Python physics tests (MuJoCo)", missing).map_err(anyhow::Error::msg),
     }

@@ -351,7 +351,9 @@ fn has_nightly() -> bool {
     Command::new("cargo").args(["+nightly", "--version"]).output().is_ok_and(|o| o.status.success())
 }
 
-/// Writes the seeds and runs each selected target for `seconds`.
+/// Writes the seeds, builds the targets once and runs each selected one for `seconds`, as many
+/// at a time as the machine has cores (each run's output in `fuzz/logs/<target>.log`, shown when
+/// it fails).
 ///
 /// With a nightly toolchain the targets run under AddressSanitizer; with stable only, with
 /// `-s none` (no sanitizer; the property checks still run).
@@ -368,34 +370,62 @@ pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
         bail!("unknown fuzz target {only:?}; targets: {}", names.join(", "));
     }
     let nightly = has_nightly() && std::env::var("ROBOWIRE_FUZZ_STABLE").is_err();
-    for target in targets {
-        let corpus = fuzz_dir.join("corpus").join(target.name);
-        std::fs::create_dir_all(&corpus)?;
-        for (name, input) in seeds_of(target)? {
-            std::fs::write(corpus.join(name), input)?;
-        }
+    let how = if nightly { "nightly, AddressSanitizer" } else { "stable, -s none" };
+    let cargo_fuzz = |verb: &str| {
         let mut command = Command::new("cargo");
         if nightly {
             command.arg("+nightly");
         }
-        command.args(["fuzz", "run"]);
+        command.args(["fuzz", verb]);
         if !nightly {
             command.args(["-s", "none"]);
         }
-        command.arg(target.name).arg(&corpus).arg("--").arg(format!("-max_total_time={seconds}"));
-        println!(
-            "fuzz {} for {seconds} s ({})",
-            target.name,
-            if nightly { "nightly, AddressSanitizer" } else { "stable, -s none" }
-        );
-        let status = command.current_dir(&root).status().context("running cargo fuzz")?;
-        if !status.success() {
-            bail!(
-                "fuzz target {} failed ({status}); the input is under {}; commit it to {} to replay it in cargo test",
-                target.name,
-                display(&fuzz_dir.join("artifacts").join(target.name)),
-                display(&fuzz_dir.join("regressions").join(target.name))
-            );
+        command.current_dir(&root);
+        command
+    };
+    let mut build = cargo_fuzz("build");
+    if let Some(name) = only {
+        build.arg(name);
+    }
+    let status = build.status().context("running cargo fuzz build")?;
+    if !status.success() {
+        bail!("cargo fuzz build failed ({status})");
+    }
+    let logs = fuzz_dir.join("logs");
+    std::fs::create_dir_all(&logs)?;
+    let at_once = std::thread::available_parallelism().map_or(1, usize::from);
+    for batch in targets.chunks(at_once) {
+        let mut running = Vec::with_capacity(batch.len());
+        for target in batch {
+            let corpus = fuzz_dir.join("corpus").join(target.name);
+            std::fs::create_dir_all(&corpus)?;
+            for (name, input) in seeds_of(target)? {
+                std::fs::write(corpus.join(name), input)?;
+            }
+            let log_path = logs.join(format!("{}.log", target.name));
+            let log = std::fs::File::create(&log_path)?;
+            let mut command = cargo_fuzz("run");
+            command.arg(target.name).arg(&corpus).arg("--").arg(format!("-max_total_time={seconds}"));
+            command.stdout(log.try_clone()?).stderr(log);
+            println!("fuzz {} for {seconds} s ({how})", target.name);
+            running.push((target, log_path, command.spawn().context("running cargo fuzz")?));
+        }
+        for (target, log_path, mut child) in running {
+            let status = child.wait().context("waiting for cargo fuzz")?;
+            let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+            if !status.success() {
+                let tail: Vec<&str> = log.lines().rev().take(40).collect();
+                eprintln!("{}", tail.into_iter().rev().collect::<Vec<_>>().join("\n"));
+                bail!(
+                    "fuzz target {} failed ({status}); its log is {}, the input under {}; commit it to {} to replay it in cargo test",
+                    target.name,
+                    display(&log_path),
+                    display(&fuzz_dir.join("artifacts").join(target.name)),
+                    display(&fuzz_dir.join("regressions").join(target.name))
+                );
+            }
+            let runs = log.lines().rev().find(|l| l.starts_with("Done ")).unwrap_or("done");
+            println!("fuzz {}: {runs}", target.name);
         }
     }
     Ok(())
