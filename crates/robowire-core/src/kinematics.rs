@@ -6,7 +6,7 @@
 //! # #[cfg(feature = "std")] {
 //! use robowire_core::kinematics::{Body, Hinge, Pose};
 //!
-//! // A thigh 0.2 m below its hip, turned about +y: at a quarter turn its end points backward.
+//! // A calf 0.2 m below its thigh, turned about +y: at a quarter turn its foot points backward.
 //! let calf = Body {
 //!     name: "calf",
 //!     parent: "thigh",
@@ -29,7 +29,7 @@ pub struct Kinematics {
     pub state_schema: &'static str,
     /// Where, in that JSON, the array of motor states is (a JSON pointer: `/motor_state`); a
     /// motor's position is the field `q` (rad) of its element.
-    pub motors: &'static str,
+    pub motor_states_pointer: &'static str,
     /// Every body but the base, each after its parent. The base is `base`.
     pub bodies: &'static [Body],
 }

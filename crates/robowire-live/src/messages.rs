@@ -122,7 +122,7 @@ pub(crate) fn base_transform(device: &str, position_m: [f64; 3], rpy_rad: [f64; 
 /// one `foxglove.FrameTransforms`. A body whose hinge's position is missing or not finite is left
 /// out. `None` for a state without its motors.
 pub(crate) fn joint_transforms(device: &str, robot: &Kinematics, state: &Value, unix_ns: u64) -> Option<Value> {
-    let motors = state.pointer(robot.motors)?.as_array()?;
+    let motors = state.pointer(robot.motor_states_pointer)?.as_array()?;
     let transforms: Vec<Value> = robot
         .bodies
         .iter()

@@ -3,8 +3,8 @@
 //! status) and its data messages. A viewer that does not read loses data messages, whole and
 //! counted, never the JSON; only a viewer so far behind that even the JSON queue fills is
 //! disconnected, as Foxglove's server does. A viewer that sends what no Foxglove client sends is
-//! closed (1002, or 1009 for an oversize frame). A subscription the server refuses for a channel
-//! it has just advertised is asked again ([`crate::resubscribe`]).
+//! closed (1002, or 1009 for an oversize frame). A viewer's subscription that the server refuses
+//! for an unknown channel is asked again while the viewer holds it ([`crate::resubscribe`]).
 
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -139,10 +139,12 @@ async fn frames(
     let (data_tx, mut data) = mpsc::channel::<Vec<u8>>(DATA_QUEUE_FRAMES);
     // The viewer's frames, and a subscription asked again, go to the server whole, one at a time.
     let server_write = Arc::new(tokio::sync::Mutex::new(server_write));
-    let subscriptions = Mutex::new(Subscriptions::default());
+    let subscriptions = Arc::new(Mutex::new(Subscriptions::default()));
+    // Retries waiting to be sent: aborted when this connection ends.
+    let mut retries = tokio::task::JoinSet::new();
     // The three directions borrow the halves; they are dropped at this block's end.
     let broke = {
-        let (subscriptions, server_write) = (&subscriptions, &server_write);
+        let (subscriptions, server_write, retries) = (&subscriptions, &server_write, &mut retries);
         let from_server = async move {
             // Whether the rest of the data message being read is dropped.
             let mut dropping = false;
@@ -179,11 +181,15 @@ async fn frames(
                     let retry = (header.opcode == Opcode::Text && header.fin)
                         .then(|| lock(subscriptions).retry(&frame[header.header_len..]))
                         .flatten();
-                    if let Some((pause, request)) = retry {
-                        let server_write = server_write.clone();
-                        tokio::spawn(async move {
-                            tokio::time::sleep(pause).await;
-                            let _ = server_write.lock().await.write_all(&request).await;
+                    if let Some(retry) = retry {
+                        let (server_write, subscriptions) = (server_write.clone(), subscriptions.clone());
+                        retries.spawn(async move {
+                            tokio::time::sleep(retry.pause).await;
+                            // The viewer's own frames go under this lock, an unsubscribe noted first.
+                            let mut server_write = server_write.lock().await;
+                            if lock(&subscriptions).holds(retry.channel, retry.subscription) {
+                                let _ = server_write.write_all(&retry.frame).await;
+                            }
                         });
                         continue;
                     }
@@ -223,6 +229,7 @@ async fn frames(
                 };
                 match check_viewer_frame(&header, &frame) {
                     Ok(Some(request)) => lock(subscriptions).note(&request),
+                    Ok(None) if header.opcode == Opcode::Close => lock(subscriptions).clear(),
                     Ok(None) => {}
                     Err(reason) => return Ended::Broke(1002, reason),
                 }

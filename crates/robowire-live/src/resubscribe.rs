@@ -3,7 +3,7 @@
 //! ID" in between, and never gets that channel (seen under load, 1 run in 15, for a channel made
 //! while a viewer was connected). The relay remembers what its viewer subscribed to; when the
 //! server refuses one of those for an unknown channel, it keeps the refusal from the viewer and
-//! asks again, after a pause, a few times.
+//! asks again, after a pause, a few times, unless the viewer has let that subscription go.
 
 use std::collections::HashMap;
 use std::time::Duration;
@@ -43,10 +43,15 @@ impl Subscriptions {
         }
     }
 
+    /// Forgets every subscription (the viewer is closing).
+    pub(crate) fn clear(&mut self) {
+        self.by_channel.clear();
+    }
+
     /// For a server's text message: if it refuses one of the viewer's subscriptions for an unknown
-    /// channel and retries remain, the pause to make and the request to send again (a masked
-    /// text frame). A refusal so handled is not the viewer's to see.
-    pub(crate) fn retry(&mut self, message: &[u8]) -> Option<(Duration, Vec<u8>)> {
+    /// channel and retries remain, the retry to make. A refusal so handled is not the viewer's to
+    /// see.
+    pub(crate) fn retry(&mut self, message: &[u8]) -> Option<Retry> {
         // Most server messages are data or advertisements: only a status naming the refusal is parsed.
         if !message.windows(UNKNOWN.len()).any(|w| w == UNKNOWN.as_bytes()) {
             return None;
@@ -62,8 +67,26 @@ impl Subscriptions {
         }
         *retries += 1;
         let request = json!({ "op": "subscribe", "subscriptions": [{ "id": *id, "channelId": channel }] });
-        Some((PAUSE * u32::from(*retries), masked_text(request.to_string().as_bytes())))
+        let frame = masked_text(request.to_string().as_bytes());
+        Some(Retry { pause: PAUSE * u32::from(*retries), channel, subscription: *id, frame })
     }
+
+    /// Whether the viewer still holds `subscription` on `channel` (a retry due is sent only then).
+    pub(crate) fn holds(&self, channel: u64, subscription: u64) -> bool {
+        self.by_channel.get(&channel).is_some_and(|(id, _)| *id == subscription)
+    }
+}
+
+/// A subscription to ask for again.
+#[derive(Debug)]
+pub(crate) struct Retry {
+    /// How long to wait first.
+    pub(crate) pause: Duration,
+    /// The channel and the viewer's subscription id.
+    pub(crate) channel: u64,
+    pub(crate) subscription: u64,
+    /// The request: a masked text frame.
+    pub(crate) frame: Vec<u8>,
 }
 
 /// A text frame as a client sends it: masked (with a zero key, which leaves the bytes as they are).
@@ -98,14 +121,15 @@ mod tests {
     fn a_refused_subscription_is_asked_again_a_few_times_with_longer_pauses() {
         let mut subscriptions = Subscriptions::default();
         subscriptions.note(&json!({ "op": "subscribe", "subscriptions": [{ "id": 7, "channelId": 3 }] }));
-        let (pause, frame) = subscriptions.retry(&refusal(3)).unwrap();
-        assert_eq!(pause, PAUSE);
+        let Retry { pause, channel, subscription, frame } = subscriptions.retry(&refusal(3)).unwrap();
+        assert_eq!((pause, channel, subscription), (PAUSE, 3, 7));
+        assert!(subscriptions.holds(3, 7) && !subscriptions.holds(3, 8));
         let header = FrameHeader::parse(&frame).unwrap().unwrap();
         assert_eq!((header.opcode, header.mask, header.fin), (Opcode::Text, Some([0; 4]), true));
         let request: Value = serde_json::from_slice(&frame[header.header_len..]).unwrap();
         assert_eq!(request, json!({ "op": "subscribe", "subscriptions": [{ "id": 7, "channelId": 3 }] }));
         for n in 2..=RETRIES {
-            assert_eq!(subscriptions.retry(&refusal(3)).unwrap().0, PAUSE * u32::from(n));
+            assert_eq!(subscriptions.retry(&refusal(3)).unwrap().pause, PAUSE * u32::from(n));
         }
         assert!(subscriptions.retry(&refusal(3)).is_none(), "at most {RETRIES} times");
     }
@@ -123,6 +147,10 @@ mod tests {
         assert!(subscriptions.retry(b"Unknown channel ID: 4, not JSON").is_none());
         subscriptions.note(&json!({ "op": "unsubscribe", "subscriptionIds": [1] }));
         assert!(subscriptions.retry(&refusal(4)).is_none(), "unsubscribed");
+        assert!(!subscriptions.holds(4, 1), "a retry due is not sent");
+        subscriptions.note(&json!({ "op": "subscribe", "subscriptions": [{ "id": 2, "channelId": 4 }] }));
+        subscriptions.clear();
+        assert!(!subscriptions.holds(4, 2), "closing");
     }
 
     #[test]

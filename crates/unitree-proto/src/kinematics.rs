@@ -2,7 +2,7 @@
 //! ([`Kinematics`](robowire_core::kinematics::Kinematics)): each body's place and orientation
 //! in its parent's frame and its hinge's axis are those of robowire's MuJoCo models
 //! (`robowire-sim/models`, from Unitree's URDFs) as MuJoCo compiles them; robowire-sim's physics
-//! tests check every body's pose against MuJoCo's at random joint positions. Bodies are named
+//! tests check every body's pose against MuJoCo's at pseudo-random joint positions. Bodies are named
 //! as in those models; the base (the Go2's trunk, the G1's pelvis) is `base`.
 
 use robowire_core::kinematics::{Body, Hinge, Kinematics};
@@ -35,7 +35,7 @@ const fn welded(name: &'static str, parent: &'static str, origin_m: [f64; 3]) ->
 pub static GO2: Kinematics = Kinematics {
     robot: "go2",
     state_schema: <LowState as Message>::DDS_TYPE_NAME,
-    motors: "/motor_state",
+    motor_states_pointer: "/motor_state",
     bodies: &[
         hinge("FR_hip", "base", [0.1934, -0.0465, 0.0], LEVEL, 0, X),
         hinge("FR_thigh", "FR_hip", [0.0, -0.0955, 0.0], LEVEL, 1, Y),
@@ -56,8 +56,9 @@ pub static GO2: Kinematics = Kinematics {
     ],
 };
 
-/// The hip roll links' pitch of −0.1749 rad and the knees' of +0.1749 rad (the URDF's `rpy`).
+/// The hip roll links' pitch of −0.1749 rad (the URDF's `rpy`).
 const HIP_ROLL_TILT: [f64; 4] = [0.9961786849744957, 0.0, -0.08733858026373247, 0.0];
+/// The knees' pitch of +0.1749 rad.
 const KNEE_TILT: [f64; 4] = [0.9961786849744957, 0.0, 0.08733858026373247, 0.0];
 /// The shoulders' mounting (the URDF's `rpy` of the shoulder pitch and roll links).
 const LEFT_SHOULDER_PITCH: [f64; 4] =
@@ -72,7 +73,7 @@ const RIGHT_SHOULDER_ROLL: [f64; 4] = [0.9902682552548409, 0.1391717738427347, 0
 pub static G1: Kinematics = Kinematics {
     robot: "g1",
     state_schema: <HgLowState as Message>::DDS_TYPE_NAME,
-    motors: "/motor_state",
+    motor_states_pointer: "/motor_state",
     bodies: &[
         hinge("left_hip_pitch_link", "base", [0.0, 0.064452, -0.1027], LEVEL, 0, Y),
         hinge("left_hip_roll_link", "left_hip_pitch_link", [0.0, 0.052, -0.030465], HIP_ROLL_TILT, 1, X),

@@ -410,25 +410,42 @@ pub fn run(only: Option<&str>, seconds: u64) -> anyhow::Result<()> {
             println!("fuzz {} for {seconds} s ({how})", target.name);
             running.push((target, log_path, command.spawn().context("running cargo fuzz")?));
         }
+        // Every run of the batch is waited for, so that none outlives a failure.
+        let mut failed = Vec::new();
         for (target, log_path, mut child) in running {
             let status = child.wait().context("waiting for cargo fuzz")?;
             let log = std::fs::read_to_string(&log_path).unwrap_or_default();
-            if !status.success() {
-                let tail: Vec<&str> = log.lines().rev().take(40).collect();
-                eprintln!("{}", tail.into_iter().rev().collect::<Vec<_>>().join("\n"));
-                bail!(
-                    "fuzz target {} failed ({status}); its log is {}, the input under {}; commit it to {} to replay it in cargo test",
-                    target.name,
-                    display(&log_path),
-                    display(&fuzz_dir.join("artifacts").join(target.name)),
-                    display(&fuzz_dir.join("regressions").join(target.name))
-                );
+            if status.success() {
+                let runs = log.lines().rev().find(|l| l.starts_with("Done ")).unwrap_or("done");
+                println!("fuzz {}: {runs}", target.name);
+                continue;
             }
-            let runs = log.lines().rev().find(|l| l.starts_with("Done ")).unwrap_or("done");
-            println!("fuzz {}: {runs}", target.name);
+            eprintln!("{}", failure_report(&log));
+            failed.push(format!(
+                "fuzz target {} failed ({status}); its log is {}, the input under {}; commit it to {} to replay it in cargo test",
+                target.name,
+                display(&log_path),
+                display(&fuzz_dir.join("artifacts").join(target.name)),
+                display(&fuzz_dir.join("regressions").join(target.name))
+            ));
+        }
+        if !failed.is_empty() {
+            bail!("{}", failed.join("\n"));
         }
     }
     Ok(())
+}
+
+/// What a failed run's log says of the failure: from the panic or the sanitizer's report on
+/// (at most 80 lines), else its last 40 lines.
+fn failure_report(log: &str) -> String {
+    let lines: Vec<&str> = log.lines().collect();
+    let start = lines.iter().position(|l| l.contains("panicked at") || l.starts_with("==") && l.contains("ERROR"));
+    let shown = match start {
+        Some(at) => &lines[at..lines.len().min(at + 80)],
+        None => &lines[lines.len().saturating_sub(40)..],
+    };
+    shown.join("\n")
 }
 
 fn display(path: &Path) -> String {
