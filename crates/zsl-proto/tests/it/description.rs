@@ -12,7 +12,7 @@ use zsl_proto::zerocopy::IntoBytes;
 
 /// The golden datagrams: (the vendor call or state it is, its bytes).
 fn golden() -> Vec<(String, Vec<u8>)> {
-    let entries: Vec<Value> = serde_json::from_str(include_str!("../../../fixtures/zsl1/frames.json")).unwrap();
+    let entries: Vec<Value> = serde_json::from_str(include_str!("../../../../fixtures/zsl1/frames.json")).unwrap();
     entries
         .iter()
         .map(|e| {

@@ -10,7 +10,7 @@ use serde_json::Value;
 
 /// The golden frames: (name, direction as the fixture says, bytes, fields).
 fn golden() -> Vec<(String, String, Vec<u8>, Value)> {
-    let entries: Vec<Value> = serde_json::from_str(include_str!("../../../fixtures/kmc/frames.json")).unwrap();
+    let entries: Vec<Value> = serde_json::from_str(include_str!("../../../../fixtures/kmc/frames.json")).unwrap();
     entries
         .iter()
         .map(|e| {

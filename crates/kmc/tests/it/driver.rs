@@ -1,6 +1,6 @@
 //! The Driver on a pseudo-terminal against the chassis simulator: order, counts and content of
 //! what goes over the line. Rates, the command timeout's length and the stop burst's timing are
-//! `kmc-proto`'s fake-clock tests (`kmc-proto/tests/stream.rs`); nothing here measures time.
+//! `kmc-proto`'s fake-clock tests (`kmc-proto/tests/it/stream.rs`); nothing here measures time.
 
 use std::time::Duration;
 
