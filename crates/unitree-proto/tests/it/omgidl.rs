@@ -7,8 +7,7 @@
 //! Gated like every interop test: without node, npm or the npm registry the tests skip with a
 //! line; `ROBOWIRE_INTEROP=1` makes that a failure.
 
-mod golden;
-
+use crate::golden;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -329,7 +328,7 @@ fn golden_payloads_decode_to_the_vendors_fields() {
 }
 
 /// `SportModeState_` as Unitree's SDK serializes it (`tests/interop/sport_mode_state.py`: a
-/// distinct value in every field, in XCDR1 and XCDR2; also `tests/sport_mode_state.rs`'s), decoded by Foxglove with
+/// distinct value in every field, in XCDR1 and XCDR2; also `tests/it/sport_mode_state.rs`'s), decoded by Foxglove with
 /// [`idl::GO2_SPORT_MODE_STATE`]: XCDR1 exactly; XCDR2 with the array-of-structs gap
 /// (`path_point`).
 #[test]

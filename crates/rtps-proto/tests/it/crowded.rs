@@ -2,9 +2,7 @@
 //! made-up GUID prefixes and an infinite lease, as a flood of bit-flipped captures makes them)
 //! does not shut a real newcomer out: the participant heard from least recently makes room.
 
-#[allow(dead_code)] // each test binary uses a part of it
-mod pair;
-
+use crate::pair;
 use std::net::SocketAddr;
 use std::time::Duration;
 

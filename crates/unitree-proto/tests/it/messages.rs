@@ -1,7 +1,6 @@
 //! Layouts, CRC, image and CDR round trips, errors (the CRC'd messages, and `SportModeState_`).
 
-#[path = "../benches/oracle.rs"]
-mod oracle;
+use crate::oracle;
 
 use proptest::prelude::*;
 use robowire_core::cdr::CdrType;

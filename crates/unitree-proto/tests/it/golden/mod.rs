@@ -5,7 +5,7 @@ use serde_json::Value;
 
 /// The parsed vectors file.
 pub(crate) fn vectors() -> Value {
-    serde_json::from_str(include_str!("../../../../fixtures/unitree/vectors.json")).unwrap()
+    serde_json::from_str(include_str!("../../../../../fixtures/unitree/vectors.json")).unwrap()
 }
 
 /// The vendor's fields of the `lowcmd` or `lowstate` vector named `name`.

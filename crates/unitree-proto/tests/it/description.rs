@@ -2,8 +2,7 @@
 //! serializer) decode to their DDS type and the vendor's fields; HG messages and the services'
 //! requests and answers by what they are; any bytes give JSON or a typed error.
 
-mod golden;
-
+use crate::golden;
 use proptest::prelude::*;
 use robowire_core::Direction;
 use robowire_core::json::LinkDescription;
