@@ -4,7 +4,7 @@
 //! leaves and comes back. Each test runs in a private network namespace
 //! (`with_loopback_multicast`) on a domain of its own.
 //!
-//! The Fast DDS side is `fastdds_peer/peer.cpp`, built here once into the cargo target directory
+//! The Fast DDS side is `tests/fastdds_peer/peer.cpp`, built here once into the cargo target directory
 //! (`fastdds-peer/`, rebuilt when its sources change) with fastddsgen's type support of Unitree's
 //! IDL (`fastdds_peer/unitree_{go,hg}.idl`). It computes Unitree's CRC in C++ over the C struct
 //! image, independently of robowire, and prints one JSON line per event. A missing `fastddsgen`,

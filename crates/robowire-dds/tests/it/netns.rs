@@ -10,6 +10,9 @@ fn the_body_runs_where_loopback_carries_multicast() {
     with_loopback_multicast(|| assert!(loopback_has_multicast(), "lo without multicast where the body runs"));
 }
 
+/// [`fails_on_purpose`]'s name in the test binary (`tests/it`), for `--exact`.
+const FAILS_ON_PURPOSE: &str = "netns::fails_on_purpose";
+
 #[test]
 #[ignore = "fails on purpose: run by a_body_that_fails_in_its_namespace_fails_the_test"]
 fn fails_on_purpose() {
@@ -20,11 +23,11 @@ fn fails_on_purpose() {
 fn a_body_that_fails_in_its_namespace_fails_the_test() {
     let Some(()) = robowire_fixtures::interop::require(available()) else { return };
     let out = Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "fails_on_purpose", "--include-ignored", "--test-threads=1"])
+        .args(["--exact", FAILS_ON_PURPOSE, "--include-ignored", "--test-threads=1"])
         .output()
         .unwrap();
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(!out.status.success(), "{stdout}{stderr}");
-    assert!(stdout.contains("test fails_on_purpose ... FAILED"), "{stdout}{stderr}");
+    assert!(stdout.contains(&format!("test {FAILS_ON_PURPOSE} ... FAILED")), "{stdout}{stderr}");
     assert!(stdout.contains("failing on purpose in the namespace"), "the body's panic is shown: {stdout}{stderr}");
 }

@@ -27,8 +27,9 @@ use rustdds::{
 };
 use unitree_proto::{CdrEncoding, HgLowState, LowCmd, LowState, Message};
 
-// Each test uses a domain of its own: where `lo` already carries multicast, the tests share this
-// namespace and would otherwise meet.
+// Each test uses a domain of its own, 21 to 27, apart from the other modules' (0 and fastdds.rs's
+// 1 to 11): where `lo` already carries multicast, the tests of this binary share this namespace
+// and would otherwise meet.
 
 /// How long anything may take before the test fails (a watchdog, not a measurement).
 const WAIT: Duration = Duration::from_secs(30);
@@ -195,7 +196,7 @@ fn robowire_sees<M: CdrType>(by: &Participant, guid: [u8; 16], writer: bool, top
 
 #[test]
 fn discovery_both_ways() {
-    let domain: u16 = 1;
+    let domain: u16 = 21;
     with_loopback_multicast(|| {
         runtime().block_on(async {
             let robowire = robowire_participant(domain);
@@ -275,7 +276,7 @@ fn discovery_both_ways() {
 /// writer to robowire's typed reader, best effort or reliable. Reliable: every one of a burst,
 /// in order.
 fn lowcmd_and_lowstate_both_ways(reliable: bool) {
-    let domain: u16 = if reliable { 3 } else { 2 };
+    let domain: u16 = if reliable { 23 } else { 22 };
     const BURST: u32 = 20;
     let qos = Qos { reliable, depth: if reliable { 32 } else { 1 }, ..Qos::WRITER };
     runtime().block_on(async {
@@ -464,7 +465,7 @@ fn rtps_message(frame: &[u8]) -> Option<([u8; 12], Vec<Submessage>)> {
 /// DATA_FRAGs of each side seen on the wire.
 #[test]
 fn a_fragmented_hg_lowstate_both_ways() {
-    let domain: u16 = 4;
+    let domain: u16 = 24;
     with_loopback_multicast(|| {
         // rustdds sizes its datagrams by the interface MTU (`lo`: 65536, one DATA); at 1500 it
         // sends 256-byte fragments. Only in a namespace of the test's own: this thread's, or this
@@ -535,7 +536,7 @@ fn a_fragmented_hg_lowstate_both_ways() {
 /// late robowire reader.
 #[test]
 fn transient_local_late_joiners_both_ways() {
-    let domain: u16 = 5;
+    let domain: u16 = 25;
     with_loopback_multicast(|| {
         runtime().block_on(async {
             let qos = Qos { transient_local: true, depth: 1, ..Qos::WRITER };
@@ -568,7 +569,7 @@ fn transient_local_late_joiners_both_ways() {
 /// incompatibility on its side; robowire's side has discovered the endpoint and does not match it.
 #[test]
 fn a_reliable_reader_and_a_best_effort_writer_do_not_match() {
-    let domain: u16 = 6;
+    let domain: u16 = 26;
     with_loopback_multicast(|| {
         runtime().block_on(async {
             let best_effort = Qos { reliable: false, ..Qos::WRITER };
@@ -644,7 +645,7 @@ fn a_reliable_reader_and_a_best_effort_writer_do_not_match() {
 /// back, is discovered and matched, and samples cross both ways again.
 #[test]
 fn the_rustdds_participant_leaves_and_comes_back() {
-    let domain: u16 = 7;
+    let domain: u16 = 27;
     with_loopback_multicast(|| {
         runtime().block_on(async {
             let qos = Qos { reliable: true, depth: 8, ..Qos::WRITER };
