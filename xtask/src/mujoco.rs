@@ -92,7 +92,7 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
     };
     let runs: [&[&str]; 3] = [
         &["test", "-p", "robowire-sim", "--features", "mujoco", "--test", "physics", "--test", "unitree_conformance"],
-        &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "physics"],
+        &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "it", "--", "physics::"],
         &["test", "-p", "robowire", "--features", "mujoco", "--test", "physics"],
     ];
     for args in runs {

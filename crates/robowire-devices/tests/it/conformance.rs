@@ -1,8 +1,8 @@
 //! One conformance suite for every `sim:` kind: each property of the one device shape
 //! written once, over `robowire_devices::{open, AnyDevice, OpenOptions}`, and checked on every
-//! simulator. Each (kind, property) pair is a test named `<kind>::<property>`
-//! (`cargo test --test conformance zsl1w::` runs one kind, `::silence` one property); DDS kinds
-//! run where loopback carries multicast (`robowire_dds::netns`).
+//! simulator. Each (kind, property) pair is a test named `conformance::<kind>::<property>`
+//! (`cargo test --test it conformance::zsl1w::` runs one kind, `::silence` one property); DDS
+//! kinds run where loopback carries multicast (`robowire_dds::netns`).
 //!
 //! The properties: a first state arrives and observes something ([`first_state`]); a silent
 //! simulator is `Disconnected`, then `Connected` again when it speaks ([`silence`]); `close`
