@@ -11,11 +11,11 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use robowire_dds::netns::with_loopback_multicast;
+use robowire_fixtures::wait::one_at_a_time;
 use serde_json::Value;
 use unitree::g1::{CommandError, Device, G1, G1Error, G1Options, JOINTS};
 
-mod common;
-use common::{WAIT, pattern};
+use crate::common::{WAIT, pattern};
 
 fn f32s(value: &Value) -> Vec<f32> {
     value.as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect()
@@ -23,6 +23,9 @@ fn f32s(value: &Value) -> Vec<f32> {
 
 #[test]
 fn cyclonedds_robot_gets_our_lowcmds_field_for_field_with_unitree_crc_and_its_mode_machine() {
+    // Alone, as when it was a binary of its own: no simulator of the other modules beside
+    // CycloneDDS's robot on the two cores, nor on its domain.
+    let _turn = one_at_a_time();
     let Some(python) = robowire_fixtures::interop::require(robowire_fixtures::peers::unitree_python()) else {
         return;
     };

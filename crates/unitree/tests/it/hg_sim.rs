@@ -8,6 +8,7 @@ use std::time::Duration;
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
+use robowire_fixtures::wait::one_at_a_time;
 use unitree::{Connection, Device, Hg, HgLowCmd, LowLevel, LowLevelOptions, UnitreeError};
 use unitree_proto::Message;
 
@@ -15,6 +16,9 @@ const WAIT: Duration = Duration::from_secs(20);
 
 #[test]
 fn hg_commands_and_damping_keep_the_machine_mode() {
+    // Alone, as when it was a binary of its own: its HG LowCmds on `rt/lowcmd` must not meet the
+    // G1 simulator of `g1_dds` and `g1_follow` where `lo` already carries multicast.
+    let _turn = one_at_a_time();
     with_loopback_multicast(|| {
         let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
         runtime.block_on(async {

@@ -22,8 +22,7 @@ use unitree_proto::Message;
 use unitree_proto::api::g1_loco;
 use unitree_proto::g1::{ARM_SDK_TOPIC, slot};
 
-mod common;
-use common::{WAIT, pattern};
+use crate::common::{WAIT, pattern};
 
 /// Every `rt/lowcmd` and `rt/arm_sdk` frame on the wire, in order.
 #[derive(Debug, Default)]
