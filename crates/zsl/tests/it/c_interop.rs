@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
+use robowire_fixtures::wait::one_at_a_time;
 use robowire_shm::CreateOptions;
 use robowire_sim::spline::{CommandUpdate, SplineDaemon};
 use zsl::spline::SplineError;
@@ -102,6 +103,8 @@ fn c_layout_matches_rust_layout() {
 
 #[test]
 fn c_client_against_the_rust_daemon() {
+    // One 1 kHz spline daemon at a time in this binary, as `spline_sim`'s (two cores).
+    let _turn = one_at_a_time();
     let peer = peer();
     let name = name("client");
     let mut daemon = SplineDaemon::create(&name, &CreateOptions::default()).unwrap();
@@ -157,6 +160,8 @@ fn c_client_against_the_rust_daemon() {
 
 #[test]
 fn rust_client_against_the_c_daemon() {
+    // One 1 kHz spline daemon at a time in this binary, as `spline_sim`'s (two cores).
+    let _turn = one_at_a_time();
     let peer = peer();
     let name = name("daemon");
     let mut c_daemon = Command::new(&peer).args(["daemon", &name, "3000"]).spawn().unwrap();
