@@ -1,9 +1,10 @@
 //! 10 % random garbage between valid frames: every frame the garbage did not overlap is
 //! recovered, and the counters account for every other byte.
 
-use crate::strategies::*;
 use kmc_proto::{ChassisFrameDecoder, HostFrameDecoder, MAX_FRAME_LEN, StreamDecoder};
 use proptest::prelude::*;
+
+use crate::strategies::*;
 
 /// Positions `[start, end)` of the original frames in a stream with garbage between them.
 fn interleave(frames: &[Vec<u8>], garbage: &[Vec<u8>]) -> (Vec<u8>, Vec<(usize, usize)>) {

@@ -1,8 +1,9 @@
 //! Every frame type survives encode → decode, alone and in a stream cut at random places.
 
-use crate::strategies::*;
 use kmc_proto::{ChassisFrame, ChassisFrameDecoder, FrameBuffer, HostFrame, HostFrameDecoder, StreamDecoder};
 use proptest::prelude::*;
+
+use crate::strategies::*;
 
 /// Feeds `stream` in the given chunk sizes (cycled) and returns the re-encoded frames.
 fn decode_chunked<D: StreamDecoder>(

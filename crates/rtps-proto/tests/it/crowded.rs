@@ -2,13 +2,14 @@
 //! made-up GUID prefixes and an infinite lease, as a flood of bit-flipped captures makes them)
 //! does not shut a real newcomer out: the participant heard from least recently makes room.
 
-use crate::pair;
 use std::net::SocketAddr;
 use std::time::Duration;
 
 use rtps_proto::discovery::Qos;
 use rtps_proto::participant::{Destination, Event, LostReason, Participant};
 use rtps_proto::{GuidPrefix, Limits, Time};
+
+use crate::pair;
 
 #[test]
 fn forged_announcements_that_fill_the_participant_table_do_not_shut_out_a_newcomer() {

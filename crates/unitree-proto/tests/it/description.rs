@@ -2,7 +2,6 @@
 //! serializer) decode to their DDS type and the vendor's fields; HG messages and the services'
 //! requests and answers by what they are; any bytes give JSON or a typed error.
 
-use crate::golden;
 use proptest::prelude::*;
 use robowire_core::Direction;
 use robowire_core::json::LinkDescription;
@@ -10,6 +9,8 @@ use serde_json::{Value, json};
 use unitree_proto::api::{self, Request, RequestHeader, Response};
 use unitree_proto::description::{API_CLIENT, API_SERVER, DESCRIPTIONS, GO2_LOW_LEVEL, HG_LOW_LEVEL};
 use unitree_proto::{CdrEncoding, HgLowCmd, HgLowState, LowCmd, LowState, Message};
+
+use crate::golden;
 
 fn hex(text: &str) -> Vec<u8> {
     (0..text.len()).step_by(2).map(|i| u8::from_str_radix(&text[i..i + 2], 16).unwrap()).collect()

@@ -1,7 +1,5 @@
 //! Layouts, CRC, image and CDR round trips, errors (the CRC'd messages, and `SportModeState_`).
 
-use crate::oracle;
-
 use proptest::prelude::*;
 use robowire_core::cdr::CdrType;
 use unitree_proto::crc::{crc32_words, crc32_words_table};
@@ -10,6 +8,8 @@ use unitree_proto::sport_state::SportModeState;
 use unitree_proto::{
     CdrEncoding, DecodeError, FromZeros, HgLowCmd, HgLowState, IntoBytes, LowCmd, LowState, Message, go2,
 };
+
+use crate::oracle;
 
 /// `true` for every image byte a field covers, `false` for padding.
 fn field_mask(layout: &StructLayout, mask: &mut [bool], base: usize) {

@@ -7,7 +7,6 @@
 //! Gated like every interop test: without node, npm or the npm registry the tests skip with a
 //! line; `ROBOWIRE_INTEROP=1` makes that a failure.
 
-use crate::golden;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -18,6 +17,8 @@ use unitree_proto::api::{Request, RequestHeader, Response};
 use unitree_proto::idl::{self, IdlSchema, schema_of_type};
 use unitree_proto::layout::{Scalar, Shape, StructLayout};
 use unitree_proto::{CdrEncoding, HgLowCmd, HgLowState, LowCmd, LowState, Message};
+
+use crate::golden;
 
 /// The npm project: `package.json`, its lock file and the script.
 fn project() -> PathBuf {
