@@ -91,7 +91,18 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
         None => dir.clone().into_os_string(),
     };
     let runs: [&[&str]; 3] = [
-        &["test", "-p", "robowire-sim", "--features", "mujoco", "--test", "physics", "--test", "unitree_conformance"],
+        &[
+            "test",
+            "-p",
+            "robowire-sim",
+            "--features",
+            "mujoco",
+            "--test",
+            "it",
+            "--",
+            "physics::",
+            "unitree_conformance::",
+        ],
         &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "it", "--", "physics::"],
         &["test", "-p", "robowire", "--features", "mujoco", "--test", "physics"],
     ];

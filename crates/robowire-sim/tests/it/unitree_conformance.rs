@@ -1,8 +1,9 @@
 //! One set of checks every simulated Unitree robot passes on the wire, in a private network
 //! (`robowire_dds::netns`), whatever moves its joints: the Go2 and the G1 on the kinematic joint
 //! model, and with the `mujoco` feature on physics (the G1 hanging). Each check is written once
-//! over [`conformance::Simulator`]; each (simulator, check) pair is a test named
-//! `<robot>_<body>::<check>` (`cargo test physics` runs the physics ones).
+//! over [`crate::conformance::Simulator`]; each (simulator, check) pair is a test named
+//! `unitree_conformance::<robot>_<body>::<check>` (`cargo test --features mujoco --test it
+//! conformance::go2_physics::` runs the physics Go2's).
 //!
 //! The checks: LowCmds ignored and counted until `motion_switcher` ReleaseMode, then driving a
 //! joint ([`release`]); every LowState sealed, a LowCmd with a wrong CRC counted and not applied
@@ -10,12 +11,8 @@
 //! clearing ([`faults`]); `rt/sportmodestate` from the physics ([`sport_state`]); lock-step time
 //! ([`lock_step`]).
 
-mod conformance;
-mod unitree_wire;
-
 use std::time::{Duration, Instant};
 
-use conformance::{Body, Client, Simulator, State};
 use robowire_dds::netns::with_loopback_multicast;
 use robowire_fixtures::wait::until;
 use robowire_sim::g1::G1Sim;
@@ -23,7 +20,9 @@ use robowire_sim::go2::{AdvanceError, Go2Fault as Fault, Go2Sim, SimClock};
 use unitree_proto::Message;
 use unitree_proto::api::{self, motion_switcher, status};
 use unitree_proto::robot::Robot;
-use unitree_wire::{Unsealed, WAIT};
+
+use crate::conformance::{Body, Client, Simulator, State};
+use crate::unitree_wire::{Unsealed, WAIT};
 
 /// How far from where it stands a check sends its joint, rad.
 const STEP_RAD: f32 = 0.4;
@@ -160,7 +159,7 @@ fn sport_state<S: Simulator>(body: Body) {
     let sim = S::spawn(body, SimClock::default());
     let c = Client::<S>::new(1);
     let mut reader = c.participant.reader::<SportModeState>(SPORT_MODE_STATE_TOPIC, Qos::READER).unwrap();
-    let sport = conformance::recv_within(&c.runtime, &mut reader, WAIT).expect("rt/sportmodestate in time");
+    let sport = crate::conformance::recv_within(&c.runtime, &mut reader, WAIT).expect("rt/sportmodestate in time");
     let height = sport.body_height.get();
     assert!(S::BODY_HEIGHT_M.contains(&height), "body height {height} m outside {:?}", S::BODY_HEIGHT_M);
     let base = sim.counts().base.expect("a base with physics");

@@ -1,14 +1,14 @@
 //! The chassis simulator from the host end of the serial transport, as a driver sees it:
 //! requests answered, faults injected on the line, an unplugged and re-plugged adapter.
 
-mod hammer;
-
 use std::time::Duration;
 
 use kmc_proto::{AfFrame, ChassisFrame, ChassisFrameDecoder, HostFrame, MAX_FRAME_LEN, PcControl};
 use robowire_fixtures::wait::runtime;
 use robowire_serial::{Backoff, SerialError, SerialLink, SerialPortOptions};
 use robowire_sim::kmc::{ChassisSim, ChassisSimConfig, Fault};
+
+use crate::hammer;
 
 /// Every wait is bounded, so a broken simulator fails the test instead of hanging it.
 const WATCHDOG: Duration = Duration::from_secs(5);

@@ -1,14 +1,14 @@
 //! The ZSL-1 simulator from the client end of the UDP transport, with the ZSL-1 client codec:
 //! strict state, answers at once to a changed command, injected faults seen on the wire.
 
-mod hammer;
-
 use std::time::{Duration, Instant};
 
 use robowire_sim::zsl1::{Zsl1Fault, Zsl1Sim, Zsl1SimConfig};
 use robowire_udp::{Peer, UdpError, UdpLink};
 use zsl_proto::codec::{ClientCodec, StateDecoding};
 use zsl_proto::udp::{ControlMode, DatagramError, HighLevelCommand, HighLevelState, Model, ReturnCode};
+
+use crate::hammer;
 
 const WATCHDOG: Duration = Duration::from_secs(10);
 

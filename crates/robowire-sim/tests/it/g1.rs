@@ -3,8 +3,6 @@
 //! `mode` per motor), PR and AB on the ankles, `rt/arm_sdk` blended by its weight, the services
 //! refusing motion after ReleaseMode, and the faults.
 
-mod unitree_wire;
-
 use std::time::Instant;
 
 use robowire_dds::netns::with_loopback_multicast;
@@ -14,7 +12,8 @@ use robowire_sim::g1::{G1Fault, G1Sim, G1SimConfig, G1Snapshot, HOLDING_ACTIONS,
 use unitree_proto::api::{self, g1_arm, g1_loco, motion_switcher, status};
 use unitree_proto::g1::{self, ARM_SDK_JOINTS, ARM_SDK_TOPIC, G1Variant, ModePr, slot};
 use unitree_proto::{HgLowCmd, HgLowState, Message};
-use unitree_wire::{ServiceClient, Unsealed, WAIT};
+
+use crate::unitree_wire::{ServiceClient, Unsealed, WAIT};
 
 /// The other end of the wire: Unitree's side.
 struct Client {

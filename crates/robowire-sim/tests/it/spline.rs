@@ -2,8 +2,6 @@
 //! handshake and the versioned IMU record, as `zsl-proto` lays them out and `robowire-shm`
 //! implements them, without the `zsl` facade.
 
-mod hammer;
-
 use std::time::{Duration, Instant};
 
 use robowire_shm::{MappedRegion, SharedRegion};
@@ -13,6 +11,8 @@ use zsl_proto::shm::{
     SPLINE_DATA_LEN, SplineCommandBlock, SplineStateBlock,
 };
 use zsl_proto::zerocopy::{FromZeros, IntoBytes};
+
+use crate::hammer;
 
 /// Polls `take` until it gives a block, for at most 20 s (generous: a failure, not slowness).
 fn fresh_state(region: &MappedRegion, consumer: ConsumerIndex) -> SplineStateBlock {

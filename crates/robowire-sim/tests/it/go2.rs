@@ -1,8 +1,6 @@
 //! The simulated Go2's state stream while its public API is called in a loop from another
 //! thread, in a private network (`robowire_dds::netns`): `rt/lowstate` keeps its ticks.
 
-mod hammer;
-
 use std::time::{Duration, Instant};
 
 use robowire_dds::netns::with_loopback_multicast;
@@ -10,6 +8,8 @@ use robowire_dds::qos::Qos;
 use robowire_dds::{Participant, ParticipantOptions};
 use robowire_sim::go2::{Go2Fault, Go2Sim, Go2SimConfig};
 use unitree_proto::{LowState, Message};
+
+use crate::hammer;
 
 /// Generous: a condition not reached within this is a failure, not slowness.
 const WAIT: Duration = Duration::from_secs(20);
