@@ -99,11 +99,12 @@ pub fn test(root: &Path, target: &Path) -> anyhow::Result<()> {
             "mujoco",
             "--lib",
             "--test",
-            "physics",
-            "--test",
-            "unitree_conformance",
+            "it",
+            "--",
+            "physics::",
+            "unitree_conformance::",
         ],
-        &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "physics"],
+        &["test", "-p", "robowire-devices", "--features", "mujoco", "--test", "it", "--", "physics::"],
         &["test", "-p", "robowire", "--features", "mujoco", "--test", "physics"],
     ];
     for args in runs {

@@ -69,7 +69,7 @@ def test_the_physics_g1_by_address_hangs_or_stands_on_its_band(dds):
     with robowire.open("sim:g1", domain=13, physics=True) as g1:
         assert tilt_rad(g1) < 0.1, "hanging by its pelvis"
     # Free: on the floor, held on its band until a LowCmd stream drives its legs (robowire-sim's
-    # tests/physics.rs lets it go).
+    # tests/it/physics.rs lets it go).
     with robowire.open("sim:g1", domain=13, physics=True, free_base=True) as g1:
         assert tilt_rad(g1) < 0.1, "standing on its band"
 

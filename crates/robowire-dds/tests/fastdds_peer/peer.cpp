@@ -1,4 +1,4 @@
-// A Fast DDS 2.9 peer for robowire-dds's interoperability tests (../fastdds.rs), built by the
+// A Fast DDS 2.9 peer for robowire-dds's interoperability tests (../it/fastdds.rs), built by the
 // test into the cargo target directory with fastddsgen's type support of unitree_go.idl and
 // unitree_hg.idl.
 //

@@ -1,6 +1,6 @@
 """Unitree's own IDL class of the HG BmsState_ (cyclonedds' serializer): a sample with a distinct
 value in every field, serialized in XCDR1 and XCDR2, printed as one JSON line for
-tests/hg_bms_state.rs."""
+tests/it/hg_bms_state.rs."""
 import json
 import sys
 

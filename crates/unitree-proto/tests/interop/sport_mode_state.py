@@ -1,6 +1,6 @@
 """Unitree's own IDL class of the Go2 SportModeState_ (cyclonedds' serializer): a sample with a
 distinct value in every field (floats exact in float32), serialized in XCDR1 and XCDR2, printed
-as one JSON line for tests/sport_mode_state.rs and tests/omgidl.rs."""
+as one JSON line for tests/it/sport_mode_state.rs and tests/it/omgidl.rs."""
 import dataclasses
 import json
 
