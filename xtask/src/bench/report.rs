@@ -45,7 +45,12 @@ pub fn page(rows: &[Row], quick: bool) -> String {
         rows.iter().filter(|r| r.met.is_some()).count(),
     );
     out.push('\n');
-    let sources = BENCHES.iter().map(|(package, bench)| format!("crates/{package}/benches/{bench}.rs"));
+    let root = crate::workspace_root();
+    // A bench is `benches/{bench}.rs` or, split in modules, `benches/{bench}/main.rs`.
+    let sources = BENCHES.iter().map(|(package, bench)| {
+        let file = format!("crates/{package}/benches/{bench}.rs");
+        if root.join(&file).exists() { file } else { format!("crates/{package}/benches/{bench}/main.rs") }
+    });
     for source in sources.chain(OTHER_SOURCES.iter().map(|s| s.to_string())) {
         let _ = writeln!(out, "- [`{source}`](../{source})");
     }

@@ -1,5 +1,5 @@
 """A CycloneDDS participant (the `cyclonedds` Python binding, Unitree's IDL classes and CRC) as the
-other end of robowire-dds's interoperability tests (`tests/it/cyclone.rs`). Each scenario prints
+other end of robowire-dds's interoperability tests (`tests/cyclone.rs`). Each scenario prints
 JSON lines on stdout (one object a line, an "event" in each) and reads words on stdin ("go",
 "quit") where robowire's side has to say when. Every wait has a deadline; a scenario that misses one
 prints {"event": "error", ...} and exits 1.
