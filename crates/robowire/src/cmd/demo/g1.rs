@@ -195,6 +195,7 @@ fn scenario(duration_s: f64, out: &Output, record: Option<&RecordLinks>) -> anyh
         // The LowCmd stream runs from this first command on: its rate is taken from here.
         let streaming = Instant::now();
         robot.hold(&start)?;
+        progress.loop_started(robot.stats().low_level.commands_sent);
         let ignored = until(Duration::from_secs(5), || sim.snapshot().lowcmd.ignored_mode > 0).await;
         let ignored = if ignored { sim.snapshot().lowcmd.ignored_mode } else { 0 };
         let released = robot.release().await.context("releasing the controller")?;

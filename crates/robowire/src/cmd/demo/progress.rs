@@ -44,6 +44,12 @@ impl<'a> Progress<'a> {
         if live { LIVE_EVERY } else { LOG_EVERY }
     }
 
+    /// The loop starts now, its counter at `loop_count`: the next line's rate is taken from here,
+    /// not from the scenario's start (a G1's LowCmd stream starts seconds in).
+    pub(crate) fn loop_started(&mut self, loop_count: u64) {
+        self.last = (Instant::now(), loop_count);
+    }
+
     /// Whether it is time to show a new line (one clock read; cheap enough for a 1 kHz loop).
     pub(crate) fn due(&self) -> bool {
         Instant::now() >= self.next_at
