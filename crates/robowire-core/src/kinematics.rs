@@ -98,8 +98,8 @@ impl Body {
     }
 }
 
-/// The Hamilton product `a · b` (w, x, y, z).
-fn multiply(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+/// The Hamilton product `a · b` of quaternions (w, x, y, z).
+pub fn multiply(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     let [aw, ax, ay, az] = a;
     let [bw, bx, by, bz] = b;
     [
@@ -110,8 +110,15 @@ fn multiply(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     ]
 }
 
-/// `v` turned by the unit quaternion `q` (w, x, y, z).
-fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+/// `v` in the frame of orientation `q` (a unit quaternion, w x y z): `q⁻¹ v q`, the inverse of
+/// [`rotate`] (a world vector as a body of that orientation sees it).
+pub fn rotate_into(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let [w, x, y, z] = q;
+    rotate([w, -x, -y, -z], v)
+}
+
+/// `v` turned by the unit quaternion `q` (w, x, y, z): `q v q⁻¹`.
+pub fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
     let [w, x, y, z] = q;
     let t = [2.0 * (y * v[2] - z * v[1]), 2.0 * (z * v[0] - x * v[2]), 2.0 * (x * v[1] - y * v[0])];
     [

@@ -10,6 +10,8 @@
 //!   period)/period.
 //! - The last action is the policy's raw output, zeros before the first step.
 
+use robowire_core::kinematics::{multiply, rotate, rotate_into};
+
 use crate::config::{ImuType, PolicyConfig};
 pub use crate::term::Term;
 
@@ -201,19 +203,8 @@ pub fn roll_pitch_rad([gx, gy, gz]: [f64; 3]) -> (f64, f64) {
 }
 
 /// A world-frame vector `v` in the body frame of orientation `q` (w, x, y, z): q⁻¹ v q.
-pub fn rotate_into_body([w, x, y, z]: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    rotate([w, -x, -y, -z], v)
-}
-
-/// `v` rotated by the unit quaternion `q` (w, x, y, z).
-fn rotate([w, x, y, z]: [f64; 4], [vx, vy, vz]: [f64; 3]) -> [f64; 3] {
-    // t = 2 (q.xyz × v); v' = v + w t + q.xyz × t
-    let t = [2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)];
-    [
-        vx + w * t[0] + (y * t[2] - z * t[1]),
-        vy + w * t[1] + (z * t[0] - x * t[2]),
-        vz + w * t[2] + (x * t[1] - y * t[0]),
-    ]
+pub fn rotate_into_body(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    rotate_into(q, v)
 }
 
 /// sin and cos of the gait phase at the `step`-th step (from 1).
@@ -231,14 +222,4 @@ pub fn torso_to_pelvis(torso: [f64; 4], gyro: [f64; 3], yaw: f64, yaw_rate: f64)
     let pelvis = multiply(torso, [c, 0.0, 0.0, -s]);
     let turned = rotate([c, 0.0, 0.0, s], gyro);
     (pelvis, [turned[0], turned[1], turned[2] - yaw_rate])
-}
-
-/// The Hamilton product a·b of quaternions (w, x, y, z).
-fn multiply([aw, ax, ay, az]: [f64; 4], [bw, bx, by, bz]: [f64; 4]) -> [f64; 4] {
-    [
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ]
 }

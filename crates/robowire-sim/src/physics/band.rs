@@ -2,6 +2,8 @@
 //! damper on the free joint's six degrees of freedom, as generalized forces the caller applies
 //! each step until it lets go.
 
+use robowire_core::kinematics::multiply;
+
 /// Stiffness, N/m.
 const STIFFNESS: f64 = 1.0e4;
 /// Stiffness, N·m/rad.
@@ -46,16 +48,6 @@ impl Band {
         }
         out
     }
-}
-
-/// The Hamilton product a·b of quaternions (w, x, y, z).
-fn multiply([aw, ax, ay, az]: [f64; 4], [bw, bx, by, bz]: [f64; 4]) -> [f64; 4] {
-    [
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ]
 }
 
 #[cfg(test)]

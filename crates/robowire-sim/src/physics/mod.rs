@@ -22,6 +22,8 @@ use std::path::{Path, PathBuf};
 use mujoco_rs::mujoco_c::{mjtDisableBit, mjtJoint};
 use mujoco_rs::prelude::*;
 
+use robowire_core::kinematics::rotate_into;
+
 use crate::joints::PdTarget;
 use crate::plant::{BaseReading, JointReading, Plant};
 
@@ -354,7 +356,7 @@ impl Plant for Physics {
             rpy_rad: f(rpy_of(quat)),
             // A free joint's angular velocity is in the body's frame already.
             gyro_radps: f([qvel[v + 3], qvel[v + 4], qvel[v + 5]]),
-            accelerometer_mps2: f(rotate_to_body(quat, specific_world)),
+            accelerometer_mps2: f(rotate_into(quat, specific_world)),
             position_m: f([qpos[p], qpos[p + 1], qpos[p + 2]]),
             velocity_mps: f([qvel[v], qvel[v + 1], qvel[v + 2]]),
         })
@@ -386,19 +388,6 @@ pub(crate) fn rpy_of(q: [f64; 4]) -> [f64; 3] {
     [roll, pitch, yaw]
 }
 
-/// `v` (world frame) in the frame of the body whose orientation is `q` (w, x, y, z).
-fn rotate_to_body(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    // v_body = q* · v · q: the rotation by the conjugate.
-    let [w, x, y, z] = q;
-    let (x, y, z) = (-x, -y, -z);
-    let t = [2.0 * (y * v[2] - z * v[1]), 2.0 * (z * v[0] - x * v[2]), 2.0 * (x * v[1] - y * v[0])];
-    [
-        v[0] + w * t[0] + (y * t[2] - z * t[1]),
-        v[1] + w * t[1] + (z * t[0] - x * t[2]),
-        v[2] + w * t[2] + (x * t[1] - y * t[0]),
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -415,7 +404,7 @@ mod tests {
     #[test]
     fn a_yawed_body_sees_the_world_x_axis_turned() {
         let h = std::f64::consts::FRAC_PI_4; // a quarter turn about z
-        let v = rotate_to_body([h.cos(), 0.0, 0.0, h.sin()], [1.0, 0.0, 9.81]);
+        let v = rotate_into([h.cos(), 0.0, 0.0, h.sin()], [1.0, 0.0, 9.81]);
         assert!((v[0]).abs() < 1e-12 && (v[1] + 1.0).abs() < 1e-12 && (v[2] - 9.81).abs() < 1e-12, "{v:?}");
     }
 }
